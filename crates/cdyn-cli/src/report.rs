@@ -1,0 +1,86 @@
+//! What a set of cases leaves behind: `summary.json`, the figures, and a
+//! table on the terminal.
+
+use crate::plot::{self, Figure, Scale};
+use crate::runner::CaseResult;
+use anyhow::{Context, Result};
+use serde_json::json;
+use std::path::Path;
+
+/// Writes `dir/summary.json` with every case.
+pub fn write_summary(dir: &Path, cases: &[CaseResult], extra: serde_json::Value) -> Result<()> {
+    let mut doc = json!({ "cases": cases });
+    if let (Some(doc), serde_json::Value::Object(extra)) = (doc.as_object_mut(), extra) {
+        doc.extend(extra);
+    }
+    let path = dir.join("summary.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&doc)? + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Which time history a figure shows.
+#[derive(Clone, Copy)]
+pub enum Quantity {
+    Phi,
+    Psi,
+    Err,
+}
+
+/// Writes one figure (PNG and SVG) of a quantity for every case that has it.
+pub fn write_figure(dir: &Path, stem: &str, title: &str, quantity: Quantity, cases: &[CaseResult]) -> Result<()> {
+    let series: Vec<plot::Series> = cases
+        .iter()
+        .filter_map(|c| {
+            let s = &c.series;
+            let y = match quantity {
+                Quantity::Phi => &s.phi,
+                Quantity::Psi => &s.psi,
+                Quantity::Err => &s.err,
+            };
+            let points: Vec<(f64, f64)> = s.t.iter().copied().zip(y.iter().copied()).collect();
+            (points.iter().any(|p| p.1 != 0.0)).then(|| plot::Series { label: c.name.clone(), points })
+        })
+        .collect();
+    let y_label = match quantity {
+        Quantity::Phi => "|Φ| (largest constraint violation)",
+        Quantity::Psi => "|Ψ| (energy constraint violation)",
+        Quantity::Err => "|X − X*| (error against the exact solution)",
+    };
+    plot::write_figure(
+        &dir.join(stem),
+        &Figure { title, x_label: "t", y_label, scale: Scale::LogAbs, series: &series },
+    )
+}
+
+/// The three figures of the paper (Figs. 3–5) for these cases.
+pub fn write_figures(dir: &Path, title: &str, cases: &[CaseResult]) -> Result<()> {
+    write_figure(dir, "fig3_phi", &format!("{title}: geometric constraint violation"), Quantity::Phi, cases)?;
+    write_figure(dir, "fig4_psi", &format!("{title}: energy constraint violation"), Quantity::Psi, cases)?;
+    if cases.iter().any(|c| !c.series.err.is_empty()) {
+        write_figure(dir, "fig5_err_x", &format!("{title}: error in X"), Quantity::Err, cases)?;
+    }
+    Ok(())
+}
+
+/// A fixed-width table of the cases, one line each.
+pub fn table(cases: &[CaseResult]) -> String {
+    let opt = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.3e}"));
+    let mut out = format!(
+        "{:<24} {:>11} {:>11} {:>11} {:>11} {:>7} {:>9}\n",
+        "case", "max|phi|", "max|psi|", "max|err_x|", "err_x(end)", "steps", "rhs_evals"
+    );
+    for c in cases {
+        out += &format!(
+            "{:<24} {:>11.3e} {:>11.3e} {:>11} {:>11} {:>7} {:>9}{}\n",
+            c.name,
+            c.max_abs_phi,
+            c.max_abs_psi,
+            opt(c.max_abs_err_x),
+            opt(c.err_x_final),
+            c.steps,
+            c.rhs_evals,
+            c.error.as_ref().map_or(String::new(), |e| format!("  FAILED: {e}")),
+        );
+    }
+    out
+}

@@ -1,0 +1,203 @@
+//! How violations are pushed back: the control laws of the paper as plain
+//! data (Eqs. 13, 19, 20–27, 28–40, 48–53) and the control term `U(x, t)`
+//! they add to the uncontrolled state equations.
+
+use crate::dynamics::Dynamics;
+use crate::energy;
+use crate::error::{Result, non_negative, positive};
+use crate::model::Model;
+
+/// A gain either fixed, or set at every evaluation from a target decay rate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Gain {
+    /// The gain itself (`ζ` for CVSGF).
+    Fixed(f64),
+    /// A target linearized decay rate (`α_g`, Eq. 40): `ζᵢ = α_g / (2|∇Φᵢ|²)`.
+    Rate(f64),
+}
+
+/// Control of the holonomic constraints.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Geometric {
+    #[default]
+    None,
+    /// Baumgarte's `Φ̈ + α Φ̇ + β Φ = 0` (Eqs. 13, 48).
+    Baumgarte { alpha: f64, beta: f64 },
+    /// CVSGF: `dq/dt = v − 2 Φ_qᵀ Z Φ` (Eqs. 28, 49).
+    Gradient(Gain),
+}
+
+impl Geometric {
+    /// Baumgarte gains from a natural frequency `ω` and damping ratio:
+    /// `α = 2 ratio ω`, `β = ω²`. Critical damping is ratio 1.
+    pub fn baumgarte_from(omega: f64, damping_ratio: f64) -> Result<Self> {
+        let omega = positive("omega", omega)?;
+        let ratio = non_negative("damping_ratio", damping_ratio)?;
+        Ok(Geometric::Baumgarte {
+            alpha: 2.0 * ratio * omega,
+            beta: omega * omega,
+        })
+    }
+}
+
+/// Gains of the gradient energy control.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EnergyGain {
+    /// `ρ_q`, `ρ_v` as given (Eq. 20).
+    Fixed { rho_q: f64, rho_v: f64 },
+    /// `ρ_q = 0` and `ρ_v = α_e / (2|Ψ_v|²)` at every evaluation (Eqs. 27, 44).
+    Rate { alpha_e: f64 },
+}
+
+/// Control of the energy constraint `Ψ`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Energy {
+    #[default]
+    None,
+    /// Baumgarte-type `Ψ̇ + η Ψ = 0` through a second multiplier (Eqs. 14–19).
+    Baumgarte { eta: f64 },
+    /// Steepest descent on `Ψ²` (Eqs. 20, 22, 44).
+    Gradient(EnergyGain),
+}
+
+/// Where the control term is integrated (Eqs. 54–59).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Application {
+    /// `U` is part of the right-hand side the scheme integrates.
+    #[default]
+    InRhs,
+    /// The scheme integrates `f`; `U(x_k)` is added with one forward Euler step (Eq. 58).
+    ForwardEuler,
+    /// The scheme integrates `f`; `U(x̂_{k+1})` is added with one backward Euler step (Eq. 59).
+    BackwardEuler,
+}
+
+/// A complete stabilization method: one row of the table in `equations.md`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Control {
+    pub geometric: Geometric,
+    pub energy: Energy,
+    pub application: Application,
+}
+
+/// Below this `|Ψ_v|²` (or `vᵀMv`) the energy control has no direction to
+/// act along — the system is at rest — and is skipped rather than divided by zero.
+const REST: f64 = 1e-30;
+
+impl Control {
+    /// No control at all (Eq. 8).
+    pub fn none() -> Self {
+        Self::default()
+    }
+
+    /// Whether any control term can be non-zero.
+    pub fn is_active(&self) -> bool {
+        self.geometric != Geometric::None || self.energy != Energy::None
+    }
+
+    /// Checks every gain is finite and not negative.
+    pub fn validate(&self) -> Result<()> {
+        match self.geometric {
+            Geometric::None => {}
+            Geometric::Baumgarte { alpha, beta } => {
+                non_negative("alpha", alpha)?;
+                non_negative("beta", beta)?;
+            }
+            Geometric::Gradient(Gain::Fixed(z)) => _ = non_negative("zeta", z)?,
+            Geometric::Gradient(Gain::Rate(a)) => _ = non_negative("alpha_g", a)?,
+        }
+        match self.energy {
+            Energy::None => {}
+            Energy::Baumgarte { eta } => _ = non_negative("eta", eta)?,
+            Energy::Gradient(EnergyGain::Fixed { rho_q, rho_v }) => {
+                non_negative("rho_q", rho_q)?;
+                non_negative("rho_v", rho_v)?;
+            }
+            Energy::Gradient(EnergyGain::Rate { alpha_e }) => _ = non_negative("alpha_e", alpha_e)?,
+        }
+        Ok(())
+    }
+
+    /// Writes the control term `U = (U_q, U_v)` at a state whose dynamics
+    /// `d` were just evaluated. `psi` and `e_dot` are `Ψ` and `Ė` there;
+    /// `scratch` has length `m`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn terms(
+        &self,
+        model: &Model,
+        d: &Dynamics,
+        v: &[f64],
+        psi: f64,
+        e_dot: f64,
+        u_q: &mut [f64],
+        u_v: &mut [f64],
+        scratch: &mut [f64],
+    ) {
+        u_q.fill(0.0);
+        u_v.fill(0.0);
+        let pattern = model.pattern();
+        match self.geometric {
+            Geometric::None => {}
+            Geometric::Baumgarte { alpha, beta } => {
+                // A_B − A for γ_B = γ − α Φ̇ − β Φ.
+                for ((b, pd), p) in scratch.iter_mut().zip(&d.phi_dot).zip(&d.phi) {
+                    *b = alpha * pd + beta * p;
+                }
+                d.add_constraint_response(model, scratch, u_v);
+            }
+            Geometric::Gradient(gain) => {
+                // U_q = −2 Φ_qᵀ Z Φ
+                for (r, s) in scratch.iter_mut().enumerate() {
+                    let zeta = match gain {
+                        Gain::Fixed(z) => z,
+                        Gain::Rate(alpha_g) => {
+                            let g2: f64 = pattern.row(r).map(|j| d.jac[j] * d.jac[j]).sum();
+                            if g2 > 0.0 { alpha_g / (2.0 * g2) } else { 0.0 }
+                        }
+                    };
+                    *s = zeta * d.phi[r];
+                }
+                for (r, &s) in scratch.iter().enumerate() {
+                    for j in pattern.row(r) {
+                        u_q[pattern.cols[j]] -= 2.0 * s * d.jac[j];
+                    }
+                }
+            }
+        }
+        match self.energy {
+            Energy::None => {}
+            Energy::Gradient(gain) => {
+                let (rho_q, rho_v) = match gain {
+                    EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
+                    EnergyGain::Rate { alpha_e } => {
+                        let g2 = energy::psi_v_norm2(model, v);
+                        (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
+                    }
+                };
+                // U_q −= 2ρ_q Ψ Ψ_q,  U_v −= 2ρ_v Ψ Ψ_v,  Ψ_q = ∇V, Ψ_v = M v
+                for (u, g) in u_q.iter_mut().zip(&d.grad_potential) {
+                    *u -= 2.0 * rho_q * psi * g;
+                }
+                for ((u, m), v) in u_v.iter_mut().zip(model.mass()).zip(v) {
+                    *u -= 2.0 * rho_v * psi * m * v;
+                }
+            }
+            Energy::Baumgarte { eta } => {
+                // μ = [Ψ_v A_geo + Ψ_q v − Ė + η Ψ] / (Ψ_v M⁻¹ Ψ_vᵀ), with
+                // A_geo = A + U_v so far, Ψ_v = Mv, M⁻¹ Ψ_vᵀ = v (Eqs. 17–19).
+                let two_t = 2.0 * model.kinetic(v);
+                if two_t > REST {
+                    let mut num = eta * psi - e_dot;
+                    for i in 0..v.len() {
+                        num += model.mass()[i] * v[i] * (d.acc[i] + u_v[i])
+                            + d.grad_potential[i] * v[i];
+                    }
+                    let mu = num / two_t;
+                    for (u, v) in u_v.iter_mut().zip(v) {
+                        *u -= mu * v;
+                    }
+                }
+            }
+        }
+    }
+}

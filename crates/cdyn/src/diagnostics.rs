@@ -1,0 +1,80 @@
+//! What a sample reports: the violations `Φ`, `Φ̇`, `Ψ` and the coupling
+//! measure `Y_c` (Eq. 47), computed without factorizing anything.
+
+use crate::energy;
+use crate::model::Model;
+
+/// Violations at one state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Measures {
+    /// The constraint value of largest magnitude, with its sign.
+    pub phi: f64,
+    /// The largest `|Φ̇|`.
+    pub phi_dot: f64,
+    /// The energy constraint `Ψ`.
+    pub psi: f64,
+    /// `max_i |Y_ci|`, `Y_ci = ∇_(q,v)Ψ · ∇_(q,v)Φ_i = Ψ_q · ∇Φ_i`.
+    pub coupling: f64,
+}
+
+/// Buffers for measuring; one per model.
+pub struct Probe {
+    phi: Vec<f64>,
+    phi_dot: Vec<f64>,
+    gamma: Vec<f64>,
+    jac: Vec<f64>,
+    grad: Vec<f64>,
+}
+
+impl Probe {
+    pub fn new(model: &Model) -> Self {
+        let m = model.m();
+        Self {
+            phi: vec![0.0; m],
+            phi_dot: vec![0.0; m],
+            gamma: vec![0.0; m],
+            jac: vec![0.0; model.pattern().nnz()],
+            grad: vec![0.0; model.n()],
+        }
+    }
+
+    /// Measures the violations at `(q, v, e, t)` for initial energy `e0`.
+    pub fn measure(
+        &mut self,
+        model: &Model,
+        q: &[f64],
+        v: &[f64],
+        e: f64,
+        t: f64,
+        e0: f64,
+    ) -> Measures {
+        model.constraints(
+            q,
+            v,
+            t,
+            &mut self.phi,
+            &mut self.phi_dot,
+            &mut self.gamma,
+            &mut self.jac,
+        );
+        self.grad.fill(0.0);
+        let potential = model.potential(q, Some(&mut self.grad));
+        let pattern = model.pattern();
+        let mut out = Measures {
+            psi: energy::psi(model, v, potential, e, e0),
+            ..Measures::default()
+        };
+        for r in 0..model.m() {
+            if self.phi[r].abs() > out.phi.abs() {
+                out.phi = self.phi[r];
+            }
+            out.phi_dot = out.phi_dot.max(self.phi_dot[r].abs());
+            let y: f64 = pattern
+                .row(r)
+                .map(|j| self.grad[pattern.cols[j]] * self.jac[j])
+                .sum();
+            out.coupling = out.coupling.max(y.abs());
+        }
+        out
+    }
+}

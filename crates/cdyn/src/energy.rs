@@ -1,0 +1,38 @@
+//! The energy constraint `Ψ = T + V − E₀ − ∫Ė dτ` (Eq. 14 ff.).
+//!
+//! `∫Ė` is carried as one extra state `e` with `de/dt = Ė`. `Ė` comes from
+//! the model, not from the user: the power of the non-conservative forces,
+//! plus the power that rheonomic (driving) constraints put in, `λᵀ Φ_t`
+//! (the constraint force `−Φ_qᵀ λ` times `v`, with `Φ_q v = −Φ_t`). For a
+//! scleronomic system `Φ_t = 0` exactly, so drift off `Φ̇ = 0` is not
+//! mistaken for an energy input.
+
+use crate::dynamics::Dynamics;
+use crate::model::Model;
+
+/// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e`, with `V` taken from the dynamics.
+pub fn psi(model: &Model, v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
+    model.kinetic(v) + potential - e0 - e
+}
+
+/// `Ė = F·v + λᵀ Φ_t`, with `Φ_t = Φ̇ − Φ_q v`, from an evaluated [`Dynamics`].
+pub fn energy_input(model: &Model, d: &Dynamics, v: &[f64]) -> f64 {
+    let pattern = model.pattern();
+    let drives: f64 = (0..model.m())
+        .map(|r| {
+            let jv: f64 = pattern.row(r).map(|j| d.jac[j] * v[pattern.cols[j]]).sum();
+            d.lambda[r] * (d.phi_dot[r] - jv)
+        })
+        .sum();
+    d.force_power + drives
+}
+
+/// `|Ψ_v|² = |M v|²`.
+pub fn psi_v_norm2(model: &Model, v: &[f64]) -> f64 {
+    model
+        .mass()
+        .iter()
+        .zip(v)
+        .map(|(m, v)| (m * v) * (m * v))
+        .sum()
+}

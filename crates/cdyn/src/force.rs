@@ -1,0 +1,93 @@
+//! Potentials and non-conservative forces as small local elements.
+//!
+//! A potential element contributes `V` and, by automatic differentiation,
+//! the conservative force `−∇V`. A force element contributes a generalized
+//! force on its coordinates; its power `F·v` is the energy input `Ė` that the
+//! energy constraint integrates.
+
+use crate::scalar::Scalar;
+use num_dual::DualSVec64;
+use std::any::Any;
+
+/// Potential energy `V(x)` of `K` coordinates.
+pub trait Potential<const K: usize>: Send + Sync + 'static {
+    fn energy<D: Scalar>(&self, x: [D; K]) -> D;
+}
+
+/// A non-conservative generalized force on `K` coordinates, from their
+/// positions `x`, velocities `xd` and the time.
+pub trait Force<const K: usize>: Send + Sync + 'static {
+    fn force<D: Scalar>(&self, x: [D; K], xd: [D; K], t: D) -> [D; K];
+}
+
+/// A run of potential elements of one type.
+pub(crate) trait PotentialBlock: Send + Sync {
+    /// Returns `V` and adds `∇V` into `grad`.
+    fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64;
+    fn energy(&self, q: &[f64]) -> f64;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// A run of force elements of one type.
+pub(crate) trait ForceBlock: Send + Sync {
+    /// Adds the forces into `f` and returns their power.
+    fn add_forces(&self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> f64;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+pub(crate) struct PotentialGroup<P, const K: usize> {
+    pub items: Vec<(P, [usize; K])>,
+}
+
+impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
+    fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64 {
+        let mut total = 0.0;
+        for (p, idx) in &self.items {
+            let x = std::array::from_fn(|j| DualSVec64::<K>::from_re(q[idx[j]]).derivative(j));
+            let e = p.energy(x);
+            total += e.re;
+            if let Some(d) = &e.eps.0 {
+                for (j, &i) in idx.iter().enumerate() {
+                    grad[i] += d[j];
+                }
+            }
+        }
+        total
+    }
+
+    fn energy(&self, q: &[f64]) -> f64 {
+        let mut total = 0.0;
+        for (p, idx) in &self.items {
+            total += p.energy(std::array::from_fn(|j| q[idx[j]]));
+        }
+        total
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+pub(crate) struct ForceGroup<F, const K: usize> {
+    pub items: Vec<(F, [usize; K])>,
+}
+
+impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
+    fn add_forces(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let mut power = 0.0;
+        for (f, idx) in &self.items {
+            let x = std::array::from_fn(|j| q[idx[j]]);
+            let xd = std::array::from_fn(|j| v[idx[j]]);
+            let fx = f.force(x, xd, t);
+            for j in 0..K {
+                out[idx[j]] += fx[j];
+                power += fx[j] * xd[j];
+            }
+        }
+        power
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}

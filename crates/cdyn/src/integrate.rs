@@ -1,0 +1,263 @@
+//! Fixed-step schemes as data (Eqs. 54–59): their weights, order and
+//! start-up, and one step `x_k → x_{k+1}` with the control term either in
+//! the right-hand side or integrated by a separate Euler step.
+//!
+//! The integrator knows nothing of models: it sees a right-hand side split
+//! into `f` (what the scheme integrates) and the control term `U`.
+
+use crate::control::Application;
+
+/// A fixed-step scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scheme {
+    Euler,
+    AdamsBashforth2,
+    AdamsBashforth3,
+    RungeKutta4,
+}
+
+/// How a scheme combines evaluations.
+#[derive(Debug, Clone, Copy)]
+pub enum Formula {
+    /// `x_{k+1} = x_k + h Σ_j w_j F_{k−j}`
+    Multistep(&'static [f64]),
+    /// An explicit Butcher tableau: `a` is strictly lower-triangular, row by row.
+    RungeKutta {
+        a: &'static [&'static [f64]],
+        b: &'static [f64],
+        c: &'static [f64],
+    },
+}
+
+/// Everything that distinguishes one scheme from another.
+#[derive(Debug, Clone, Copy)]
+pub struct SchemeInfo {
+    pub name: &'static str,
+    pub order: u32,
+    /// Right-hand-side evaluations per step once started.
+    pub evaluations: usize,
+    /// Past evaluations the formula reads (1 for one-step schemes).
+    pub history: usize,
+    /// The scheme used while the history fills up.
+    pub startup: Option<Scheme>,
+    pub formula: Formula,
+}
+
+const RK4_A: &[&[f64]] = &[&[], &[0.5], &[0.0, 0.5], &[0.0, 0.0, 1.0]];
+const RK4_B: &[f64] = &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+const RK4_C: &[f64] = &[0.0, 0.5, 0.5, 1.0];
+
+impl Scheme {
+    pub const ALL: [Scheme; 4] = [
+        Scheme::Euler,
+        Scheme::AdamsBashforth2,
+        Scheme::AdamsBashforth3,
+        Scheme::RungeKutta4,
+    ];
+
+    pub fn info(self) -> SchemeInfo {
+        match self {
+            Scheme::Euler => SchemeInfo {
+                name: "euler",
+                order: 1,
+                evaluations: 1,
+                history: 1,
+                startup: None,
+                formula: Formula::Multistep(&[1.0]),
+            },
+            Scheme::AdamsBashforth2 => SchemeInfo {
+                name: "ab2",
+                order: 2,
+                evaluations: 1,
+                history: 2,
+                startup: Some(Scheme::RungeKutta4),
+                formula: Formula::Multistep(&[1.5, -0.5]),
+            },
+            Scheme::AdamsBashforth3 => SchemeInfo {
+                name: "ab3",
+                order: 3,
+                evaluations: 1,
+                history: 3,
+                startup: Some(Scheme::RungeKutta4),
+                formula: Formula::Multistep(&[23.0 / 12.0, -16.0 / 12.0, 5.0 / 12.0]),
+            },
+            Scheme::RungeKutta4 => SchemeInfo {
+                name: "rk4",
+                order: 4,
+                evaluations: 4,
+                history: 1,
+                startup: None,
+                formula: Formula::RungeKutta {
+                    a: RK4_A,
+                    b: RK4_B,
+                    c: RK4_C,
+                },
+            },
+        }
+    }
+
+    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`).
+    pub fn from_name(name: &str) -> Option<Scheme> {
+        Scheme::ALL.into_iter().find(|s| s.info().name == name)
+    }
+}
+
+/// A state equation `ẋ = f(x, t) + U(x, t)`.
+pub trait Rhs {
+    type Error;
+    /// Length of the state `x`.
+    fn len(&self) -> usize;
+    /// Whether `U` can be non-zero.
+    fn has_control(&self) -> bool;
+    /// Writes `f(x, t)` and, when `u` is given, `U(x, t)`.
+    fn eval(
+        &mut self,
+        x: &[f64],
+        t: f64,
+        f: &mut [f64],
+        u: Option<&mut [f64]>,
+    ) -> Result<(), Self::Error>;
+}
+
+/// Steps a state with one scheme and one way of applying the control.
+/// All buffers are allocated here, none in [`step`](Self::step).
+pub struct Integrator {
+    scheme: Scheme,
+    application: Application,
+    /// Past evaluations, newest first.
+    history: Vec<Vec<f64>>,
+    filled: usize,
+    stages: Vec<Vec<f64>>,
+    stage_x: Vec<f64>,
+    u: Vec<f64>,
+    scratch: Vec<f64>,
+}
+
+impl Integrator {
+    pub fn new(scheme: Scheme, application: Application, len: usize) -> Self {
+        let info = scheme.info();
+        let stages = [Some(scheme), info.startup]
+            .into_iter()
+            .flatten()
+            .map(|s| match s.info().formula {
+                Formula::RungeKutta { b, .. } => b.len(),
+                Formula::Multistep(_) => 1,
+            })
+            .max()
+            .unwrap_or(1);
+        Self {
+            scheme,
+            application,
+            history: vec![vec![0.0; len]; info.history],
+            filled: 0,
+            stages: vec![vec![0.0; len]; stages],
+            stage_x: vec![0.0; len],
+            u: vec![0.0; len],
+            scratch: vec![0.0; len],
+        }
+    }
+
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// Forgets the history, so the next step starts the scheme afresh.
+    pub fn restart(&mut self) {
+        self.filled = 0;
+    }
+
+    /// The scheme the next step uses: the start-up one until enough history exists.
+    pub fn active_scheme(&self) -> Scheme {
+        let info = self.scheme.info();
+        if self.filled + 1 < info.history {
+            info.startup.unwrap_or(self.scheme)
+        } else {
+            self.scheme
+        }
+    }
+
+    /// Advances `x` from `t` to `t + h`.
+    pub fn step<R: Rhs>(
+        &mut self,
+        rhs: &mut R,
+        x: &mut [f64],
+        t: f64,
+        h: f64,
+    ) -> Result<(), R::Error> {
+        let active = self.active_scheme().info();
+        let control = rhs.has_control();
+        let split = control && self.application != Application::InRhs;
+        // F(x_k): f + U in the right-hand side, f alone when split; U(x_k) kept for forward Euler.
+        self.history.rotate_right(1);
+        self.evaluate_first(rhs, x, t, control)?;
+        self.filled = (self.filled + 1).min(self.history.len());
+        match active.formula {
+            Formula::Multistep(w) => {
+                for (j, &wj) in w.iter().enumerate() {
+                    for (xi, fi) in x.iter_mut().zip(&self.history[j]) {
+                        *xi += h * wj * fi;
+                    }
+                }
+            }
+            Formula::RungeKutta { a, b, c } => {
+                self.stages[0].copy_from_slice(&self.history[0]);
+                for i in 1..b.len() {
+                    self.stage_x.copy_from_slice(x);
+                    for (j, &aij) in a[i].iter().enumerate() {
+                        if aij != 0.0 {
+                            for (s, k) in self.stage_x.iter_mut().zip(&self.stages[j]) {
+                                *s += h * aij * k;
+                            }
+                        }
+                    }
+                    let ki = &mut self.stages[i];
+                    if control && !split {
+                        rhs.eval(&self.stage_x, t + c[i] * h, ki, Some(&mut self.u))?;
+                        add(ki, &self.u);
+                    } else {
+                        rhs.eval(&self.stage_x, t + c[i] * h, ki, None)?;
+                    }
+                }
+                for (i, &bi) in b.iter().enumerate() {
+                    for (xi, k) in x.iter_mut().zip(&self.stages[i]) {
+                        *xi += h * bi * k;
+                    }
+                }
+            }
+        }
+        if split {
+            if self.application == Application::BackwardEuler {
+                rhs.eval(x, t + h, &mut self.scratch, Some(&mut self.u))?;
+            }
+            for (xi, ui) in x.iter_mut().zip(&self.u) {
+                *xi += h * ui;
+            }
+        }
+        Ok(())
+    }
+
+    fn evaluate_first<R: Rhs>(
+        &mut self,
+        rhs: &mut R,
+        x: &[f64],
+        t: f64,
+        control: bool,
+    ) -> Result<(), R::Error> {
+        let f = &mut self.history[0];
+        match (control, self.application) {
+            (false, _) | (true, Application::BackwardEuler) => rhs.eval(x, t, f, None),
+            (true, Application::ForwardEuler) => rhs.eval(x, t, f, Some(&mut self.u)),
+            (true, Application::InRhs) => {
+                rhs.eval(x, t, f, Some(&mut self.u))?;
+                add(f, &self.u);
+                Ok(())
+            }
+        }
+    }
+}
+
+fn add(a: &mut [f64], b: &[f64]) {
+    for (a, b) in a.iter_mut().zip(b) {
+        *a += b;
+    }
+}

@@ -1,0 +1,27 @@
+#![doc = include_str!("../README.md")]
+
+pub mod constraint;
+pub mod control;
+pub mod diagnostics;
+pub mod dynamics;
+pub mod energy;
+pub mod error;
+pub mod force;
+pub mod integrate;
+mod linalg;
+pub mod methods;
+pub mod model;
+pub mod models;
+pub mod reference;
+pub mod scalar;
+pub mod simulate;
+pub mod system;
+
+pub use constraint::Constraint;
+pub use control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+pub use error::{Error, Result};
+pub use force::{Force, Potential};
+pub use integrate::Scheme;
+pub use model::Model;
+pub use scalar::Scalar;
+pub use simulate::{Settings, Simulation};

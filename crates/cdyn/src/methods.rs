@@ -1,0 +1,74 @@
+//! The stabilization methods compared in the paper's test, as named cases.
+
+use crate::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+
+/// The gains every case draws from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MethodGains {
+    /// CVSGF gain: fixed `ζ` or target rate `α_g`.
+    pub cvsgf: Gain,
+    /// Gradient energy control gains.
+    pub energy: EnergyGain,
+    /// Baumgarte `α`, `β`.
+    pub baumgarte_alpha: f64,
+    pub baumgarte_beta: f64,
+}
+
+impl MethodGains {
+    /// The paper's test: `α_g = α_e = 40` (`ζ = 20`, `ρ_v` set every step so
+    /// that `2ρ_v|Ψ_v|² = 40`, `ρ_q = 0`), Baumgarte `β = 40` critically
+    /// damped, `α = 2√40`.
+    pub fn paper() -> Self {
+        Self {
+            cvsgf: Gain::Fixed(20.0),
+            energy: EnergyGain::Rate { alpha_e: 40.0 },
+            baumgarte_alpha: 2.0 * 40f64.sqrt(),
+            baumgarte_beta: 40.0,
+        }
+    }
+}
+
+/// The cases of the paper's comparison for a model in redundant
+/// coordinates, by name: the four controls with the control inside the
+/// right-hand side, CVSGF + energy (Eq. 51) with forward and with backward
+/// Euler control.
+pub fn redundant_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
+    let baumgarte = Geometric::Baumgarte {
+        alpha: g.baumgarte_alpha,
+        beta: g.baumgarte_beta,
+    };
+    let cvsgf = Geometric::Gradient(g.cvsgf);
+    let energy = Energy::Gradient(g.energy);
+    let c = |geometric, energy, application| Control {
+        geometric,
+        energy,
+        application,
+    };
+    vec![
+        ("none", Control::none()),
+        ("baumgarte", c(baumgarte, Energy::None, Application::InRhs)),
+        ("cvsgf", c(cvsgf, Energy::None, Application::InRhs)),
+        ("energy", c(Geometric::None, energy, Application::InRhs)),
+        ("baumgarte_energy", c(baumgarte, energy, Application::InRhs)),
+        ("cvsgf_energy", c(cvsgf, energy, Application::ForwardEuler)),
+        (
+            "cvsgf_energy_backward",
+            c(cvsgf, energy, Application::BackwardEuler),
+        ),
+    ]
+}
+
+/// The cases for a model in independent coordinates: without and with
+/// energy control (in the right-hand side, as the `energy` case).
+pub fn independent_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
+    vec![
+        ("theta", Control::none()),
+        (
+            "theta_energy",
+            Control {
+                energy: Energy::Gradient(g.energy),
+                ..Control::none()
+            },
+        ),
+    ]
+}

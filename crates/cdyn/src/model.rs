@@ -1,0 +1,262 @@
+//! What a system is: coordinates with a constant diagonal mass matrix,
+//! holonomic constraint elements, potentials and non-conservative forces.
+//!
+//! In redundant (Cartesian) coordinates every body's mass matrix is
+//! constant and diagonal — `(m, m, I)` for a planar body, `m` per axis for a
+//! point mass — which is what makes the formulation cheap: `M⁻¹` is free and
+//! `Φ_q M⁻¹ Φ_qᵀ` inherits the sparsity of the constraints.
+
+use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
+use crate::error::{Error, Result};
+use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
+
+/// Sparsity of `Φ_q`: row `r` has entries at `cols[start[r]..start[r + 1]]`.
+#[derive(Debug, Clone, Default)]
+pub struct Pattern {
+    pub start: Vec<usize>,
+    pub cols: Vec<usize>,
+}
+
+impl Pattern {
+    pub fn row(&self, r: usize) -> std::ops::Range<usize> {
+        self.start[r]..self.start[r + 1]
+    }
+    pub fn nnz(&self) -> usize {
+        self.cols.len()
+    }
+}
+
+/// A constrained mechanical system, ready to simulate.
+pub struct Model {
+    mass: Vec<f64>,
+    inv_mass: Vec<f64>,
+    constraints: Vec<Box<dyn ConstraintBlock>>,
+    potentials: Vec<Box<dyn PotentialBlock>>,
+    forces: Vec<Box<dyn ForceBlock>>,
+    pattern: Pattern,
+    /// First row and first Jacobian entry of each constraint block.
+    offsets: Vec<(usize, usize)>,
+}
+
+/// Builds a [`Model`] element by element.
+pub struct ModelBuilder {
+    mass: Vec<f64>,
+    constraints: Vec<Box<dyn ConstraintBlock>>,
+    potentials: Vec<Box<dyn PotentialBlock>>,
+    forces: Vec<Box<dyn ForceBlock>>,
+    error: Option<Error>,
+}
+
+impl ModelBuilder {
+    fn check_indices<const K: usize>(&mut self, what: &str, at: &[usize; K]) -> bool {
+        if self.error.is_some() {
+            return false;
+        }
+        let n = self.mass.len();
+        for (j, &i) in at.iter().enumerate() {
+            if i >= n {
+                self.error = Some(Error::InvalidModel(format!(
+                    "{what} reads coordinate {i}, but the model has only {n}"
+                )));
+                return false;
+            }
+            if at[..j].contains(&i) {
+                self.error = Some(Error::InvalidModel(format!(
+                    "{what} reads coordinate {i} twice"
+                )));
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Adds `R` constraint rows reading the coordinates `at`.
+    pub fn constrain<C: Constraint<K, R>, const K: usize, const R: usize>(
+        mut self,
+        c: C,
+        at: [usize; K],
+    ) -> Self {
+        if self.check_indices("a constraint", &at) {
+            let item = (c, at);
+            match self
+                .constraints
+                .last_mut()
+                .and_then(|b| b.as_any_mut().downcast_mut::<ConstraintGroup<C, K, R>>())
+            {
+                Some(g) => g.items.push(item),
+                None => self
+                    .constraints
+                    .push(Box::new(ConstraintGroup { items: vec![item] })),
+            }
+        }
+        self
+    }
+
+    /// Adds a potential energy term reading the coordinates `at`.
+    pub fn potential<P: Potential<K>, const K: usize>(mut self, p: P, at: [usize; K]) -> Self {
+        if self.check_indices("a potential", &at) {
+            let item = (p, at);
+            match self
+                .potentials
+                .last_mut()
+                .and_then(|b| b.as_any_mut().downcast_mut::<PotentialGroup<P, K>>())
+            {
+                Some(g) => g.items.push(item),
+                None => self
+                    .potentials
+                    .push(Box::new(PotentialGroup { items: vec![item] })),
+            }
+        }
+        self
+    }
+
+    /// Adds a non-conservative force acting on the coordinates `at`.
+    pub fn force<F: Force<K>, const K: usize>(mut self, f: F, at: [usize; K]) -> Self {
+        if self.check_indices("a force", &at) {
+            let item = (f, at);
+            match self
+                .forces
+                .last_mut()
+                .and_then(|b| b.as_any_mut().downcast_mut::<ForceGroup<F, K>>())
+            {
+                Some(g) => g.items.push(item),
+                None => self.forces.push(Box::new(ForceGroup { items: vec![item] })),
+            }
+        }
+        self
+    }
+
+    pub fn build(self) -> Result<Model> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        if self.mass.is_empty() {
+            return Err(Error::InvalidModel(
+                "a model needs at least one coordinate".into(),
+            ));
+        }
+        for &m in &self.mass {
+            crate::error::positive("mass", m)?;
+        }
+        let mut pattern = Pattern {
+            start: vec![0],
+            cols: Vec::new(),
+        };
+        let mut offsets = Vec::with_capacity(self.constraints.len());
+        for b in &self.constraints {
+            offsets.push((pattern.start.len() - 1, pattern.cols.len()));
+            b.columns(&mut pattern.cols);
+            for _ in 0..b.rows() {
+                let last = *pattern.start.last().unwrap();
+                pattern.start.push(last + b.width());
+            }
+        }
+        let m = pattern.start.len() - 1;
+        let n = self.mass.len();
+        if m >= n {
+            return Err(Error::InvalidModel(format!(
+                "{m} constraints on {n} coordinates leave no motion"
+            )));
+        }
+        Ok(Model {
+            inv_mass: self.mass.iter().map(|m| 1.0 / m).collect(),
+            mass: self.mass,
+            constraints: self.constraints,
+            potentials: self.potentials,
+            forces: self.forces,
+            pattern,
+            offsets,
+        })
+    }
+}
+
+impl Model {
+    /// Starts a model whose coordinates have these (diagonal) masses.
+    pub fn builder(mass: Vec<f64>) -> ModelBuilder {
+        ModelBuilder {
+            mass,
+            constraints: Vec::new(),
+            potentials: Vec::new(),
+            forces: Vec::new(),
+            error: None,
+        }
+    }
+
+    /// Number of coordinates `n`.
+    pub fn n(&self) -> usize {
+        self.mass.len()
+    }
+    /// Number of constraint rows `m`.
+    pub fn m(&self) -> usize {
+        self.pattern.start.len() - 1
+    }
+    pub fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+    pub fn inv_mass(&self) -> &[f64] {
+        &self.inv_mass
+    }
+    pub fn pattern(&self) -> &Pattern {
+        &self.pattern
+    }
+    /// Whether any force element is present (then `Ė` is not identically zero).
+    pub fn has_forces(&self) -> bool {
+        !self.forces.is_empty()
+    }
+
+    /// `Φ`, `Φ̇`, `γ` and the Jacobian values (in [`Pattern`] order).
+    pub(crate) fn constraints(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+        gamma: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        for (b, &(r0, j0)) in self.constraints.iter().zip(&self.offsets) {
+            let (r1, j1) = (r0 + b.rows(), j0 + b.rows() * b.width());
+            b.evaluate(
+                q,
+                v,
+                t,
+                ConstraintValues {
+                    phi: &mut phi[r0..r1],
+                    phi_dot: &mut phi_dot[r0..r1],
+                    gamma: &mut gamma[r0..r1],
+                    jac: &mut jac[j0..j1],
+                },
+            );
+        }
+    }
+
+    /// `Φ(q, t)` alone.
+    pub fn constraint_values(&self, q: &[f64], t: f64, phi: &mut [f64]) {
+        for (b, &(r0, _)) in self.constraints.iter().zip(&self.offsets) {
+            b.values(q, t, &mut phi[r0..r0 + b.rows()]);
+        }
+    }
+
+    /// Potential energy; adds `∇V` into `grad` when given.
+    pub fn potential(&self, q: &[f64], grad: Option<&mut [f64]>) -> f64 {
+        match grad {
+            Some(g) => self
+                .potentials
+                .iter()
+                .map(|p| p.energy_and_gradient(q, g))
+                .sum(),
+            None => self.potentials.iter().map(|p| p.energy(q)).sum(),
+        }
+    }
+
+    /// Adds the non-conservative forces into `f`; returns their power.
+    pub fn add_forces(&self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> f64 {
+        self.forces.iter().map(|b| b.add_forces(q, v, t, f)).sum()
+    }
+
+    /// Kinetic energy `½ vᵀ M v`.
+    pub fn kinetic(&self, v: &[f64]) -> f64 {
+        0.5 * self.mass.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
+    }
+}

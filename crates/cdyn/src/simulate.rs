@@ -1,0 +1,231 @@
+//! The simulation loop: a model, a control law and a scheme stepped from
+//! a consistent initial state, with observers called every `k` steps. A
+//! step that leaves the state non-finite, or the violation past a limit,
+//! stops the run with an error naming the step and time; observers have
+//! seen every step before it.
+
+use crate::control::Control;
+use crate::diagnostics::{Measures, Probe};
+use crate::error::{Error, Result, positive};
+use crate::integrate::{Integrator, Rhs, Scheme};
+use crate::model::Model;
+use crate::system::{ControlledSystem, EvalError, split_state};
+
+/// How to simulate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    pub scheme: Scheme,
+    pub h: f64,
+    pub control: Control,
+    /// The initial state must satisfy `|Φ|, |Φ̇| ≤` this, unless `None`.
+    pub consistency_tolerance: Option<f64>,
+    /// Stop when `max |Φ|` exceeds this.
+    pub violation_limit: f64,
+}
+
+impl Settings {
+    pub fn new(scheme: Scheme, h: f64, control: Control) -> Self {
+        Self {
+            scheme,
+            h,
+            control,
+            consistency_tolerance: Some(1e-9),
+            violation_limit: f64::INFINITY,
+        }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        positive("h", self.h)?;
+        self.control.validate()?;
+        if let Some(tol) = self.consistency_tolerance {
+            positive("consistency tolerance", tol)?;
+        }
+        if !(self.violation_limit > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "violation limit",
+                value: self.violation_limit,
+                reason: "must be positive",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A running simulation.
+pub struct Simulation<'m> {
+    system: ControlledSystem<'m>,
+    integrator: Integrator,
+    probe: Probe,
+    settings: Settings,
+    x: Vec<f64>,
+    step: u64,
+}
+
+impl<'m> Simulation<'m> {
+    /// Starts at `t = 0` from `(q0, v0)`, checking the settings and, unless
+    /// disabled, that the initial state satisfies the constraints.
+    pub fn new(model: &'m Model, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        settings.validate()?;
+        let n = model.n();
+        if q0.len() != n || v0.len() != n {
+            return Err(Error::InvalidModel(format!(
+                "initial state has {} positions and {} velocities, the model has {n} coordinates",
+                q0.len(),
+                v0.len()
+            )));
+        }
+        if let Some((i, &x)) = q0
+            .iter()
+            .chain(v0)
+            .enumerate()
+            .find(|(_, x)| !x.is_finite())
+        {
+            return Err(Error::InvalidModel(format!(
+                "initial state component {i} is {x}"
+            )));
+        }
+        let e0 = model.kinetic(v0) + model.potential(q0, None);
+        let mut x = Vec::with_capacity(2 * n + 1);
+        x.extend_from_slice(q0);
+        x.extend_from_slice(v0);
+        x.push(0.0);
+        let mut probe = Probe::new(model);
+        if let Some(tolerance) = settings.consistency_tolerance {
+            let m = probe.measure(model, q0, v0, 0.0, 0.0, e0);
+            if m.phi.abs() > tolerance || m.phi_dot > tolerance {
+                return Err(Error::InconsistentInitialState {
+                    phi: m.phi.abs(),
+                    phi_dot: m.phi_dot,
+                    tolerance,
+                });
+            }
+        }
+        let system = ControlledSystem::new(model, settings.control, e0);
+        let integrator =
+            Integrator::new(settings.scheme, settings.control.application, system.len());
+        Ok(Self {
+            system,
+            integrator,
+            probe,
+            settings,
+            x,
+            step: 0,
+        })
+    }
+
+    pub fn model(&self) -> &'m Model {
+        self.system.model()
+    }
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.step
+    }
+    /// Current time, `step · h` (not accumulated, so it does not drift).
+    pub fn t(&self) -> f64 {
+        self.step as f64 * self.settings.h
+    }
+    pub fn q(&self) -> &[f64] {
+        &self.x[..self.model().n()]
+    }
+    pub fn v(&self) -> &[f64] {
+        let n = self.model().n();
+        &self.x[n..2 * n]
+    }
+    /// `∫Ė dτ` so far.
+    pub fn energy_input(&self) -> f64 {
+        self.x[2 * self.model().n()]
+    }
+    /// `E₀ = T₀ + V₀`.
+    pub fn initial_energy(&self) -> f64 {
+        self.system.e0
+    }
+    /// Right-hand-side evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.system.evaluations
+    }
+
+    /// Violations at the current state.
+    pub fn measure(&mut self) -> Measures {
+        let model = self.system.model();
+        let (q, v, e) = split_state(&self.x, model.n());
+        self.probe.measure(model, q, v, e, self.t(), self.system.e0)
+    }
+
+    /// One step of size `h`.
+    pub fn step(&mut self) -> Result<()> {
+        let t = self.t();
+        let step = self.step;
+        self.integrator
+            .step(&mut self.system, &mut self.x, t, self.settings.h)
+            .map_err(|e| match e {
+                EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
+                EvalError::NonFinite { .. } => Error::Diverged {
+                    step: step + 1,
+                    t: t + self.settings.h,
+                },
+            })?;
+        self.step += 1;
+        if self.x.iter().any(|x| !x.is_finite()) {
+            return Err(Error::Diverged {
+                step: self.step,
+                t: self.t(),
+            });
+        }
+        // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.
+        if self.settings.violation_limit.is_finite() {
+            let phi = self
+                .system
+                .dynamics
+                .phi
+                .iter()
+                .fold(0.0_f64, |a, p| a.max(p.abs()));
+            if phi > self.settings.violation_limit {
+                return Err(Error::ViolationLimit {
+                    step,
+                    t,
+                    phi,
+                    limit: self.settings.violation_limit,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Steps until `t_end` (the last step ends at or just past it), calling
+    /// `observe` at the start and after every `every`-th step and the last.
+    pub fn run<E: From<Error>>(
+        &mut self,
+        t_end: f64,
+        every: u64,
+        mut observe: impl FnMut(&mut Self) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let steps = steps_to(t_end, self.settings.h)?;
+        let every = every.max(1);
+        observe(self)?;
+        while self.step < steps {
+            self.step()?;
+            if self.step % every == 0 || self.step == steps {
+                observe(self)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Number of steps of size `h` to reach `t_end`, tolerating round-off in `t_end / h`.
+pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
+    positive("t_end", t_end)?;
+    positive("h", h)?;
+    let ratio = t_end / h;
+    if ratio > 1e12 {
+        return Err(Error::InvalidParameter {
+            name: "t_end / h",
+            value: ratio,
+            reason: "more than 1e12 steps",
+        });
+    }
+    Ok((ratio - 1e-9 * ratio.max(1.0)).ceil().max(1.0) as u64)
+}
