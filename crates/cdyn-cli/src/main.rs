@@ -13,7 +13,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "cdyn", version, about = "Constrained dynamics in redundant coordinates, with constraint and energy violations pushed back (CVSGF)")]
+#[command(
+    name = "cdyn",
+    version,
+    about = "Constrained dynamics in redundant coordinates, with constraint and energy violations pushed back (CVSGF)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -48,7 +52,8 @@ fn main() -> ExitCode {
 }
 
 fn output_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create output directory {}", dir.display()))
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -64,10 +69,21 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Run { scenario, out } => {
             let case = scenario::load(&scenario)?.case(&scenario)?;
+            case.check().map_err(|e| match e {
+                cdyn::Error::InconsistentInitialState { .. } => anyhow::anyhow!(
+                    "{}: [initial]: {e}; set off_constraint = true to start there anyway",
+                    scenario.display()
+                ),
+                e => anyhow::anyhow!("{}: {e}", scenario.display()),
+            })?;
             output_dir(&out)?;
             let result = runner::run_case(&case, &out)?;
             let results = [result];
-            report::write_summary(&out, &results, serde_json::json!({ "scenario": scenario.display().to_string() }))?;
+            report::write_summary(
+                &out,
+                &results,
+                serde_json::json!({ "scenario": scenario.display().to_string() }),
+            )?;
             report::write_figures(&out, &results[0].name, &results)?;
             print!("{}", report::table(&results));
             println!("wrote {}", out.display());

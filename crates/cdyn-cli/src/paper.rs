@@ -20,11 +20,23 @@ pub fn cases() -> Result<Vec<Case>> {
     let mut cases = Vec::new();
     for (name, control) in redundant_cases(&gains) {
         let example = cartesian_pendulum(params)?;
-        cases.push(Case { name: name.into(), example, settings: Settings::new(Scheme::AdamsBashforth3, H, control), t_end: T_END, every: 1 });
+        cases.push(Case {
+            name: name.into(),
+            example,
+            settings: Settings::new(Scheme::AdamsBashforth3, H, control),
+            t_end: T_END,
+            every: 1,
+        });
     }
     for (name, control) in independent_cases(&gains) {
         let example = theta_pendulum(params)?;
-        cases.push(Case { name: name.into(), example, settings: Settings::new(Scheme::AdamsBashforth3, H, control), t_end: T_END, every: 1 });
+        cases.push(Case {
+            name: name.into(),
+            example,
+            settings: Settings::new(Scheme::AdamsBashforth3, H, control),
+            t_end: T_END,
+            every: 1,
+        });
     }
     Ok(cases)
 }
@@ -32,7 +44,10 @@ pub fn cases() -> Result<Vec<Case>> {
 /// Runs every case into `dir`, writes the summary and figures, and returns
 /// the results (failed cases carry their error).
 pub fn run(dir: &Path) -> Result<Vec<CaseResult>> {
-    let results = cases()?.iter().map(|c| run_case(c, dir)).collect::<Result<Vec<_>>>()?;
+    let results = cases()?
+        .iter()
+        .map(|c| run_case(c, dir))
+        .collect::<Result<Vec<_>>>()?;
     let setup = json!({
         "problem": "Example 1: unit pendulum in Cartesian coordinates, X(0)=1, Y(0)=0, VX(0)=0, VY(0)=2, g=1",
         "scheme": "ab3 (rk4 start-up)", "h": H, "t_end": T_END,

@@ -27,7 +27,13 @@ pub enum Quantity {
 }
 
 /// Writes one figure (PNG and SVG) of a quantity for every case that has it.
-pub fn write_figure(dir: &Path, stem: &str, title: &str, quantity: Quantity, cases: &[CaseResult]) -> Result<()> {
+pub fn write_figure(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    quantity: Quantity,
+    cases: &[CaseResult],
+) -> Result<()> {
     let series: Vec<plot::Series> = cases
         .iter()
         .filter_map(|c| {
@@ -38,26 +44,53 @@ pub fn write_figure(dir: &Path, stem: &str, title: &str, quantity: Quantity, cas
                 Quantity::Err => &s.err,
             };
             let points: Vec<(f64, f64)> = s.t.iter().copied().zip(y.iter().copied()).collect();
-            (points.iter().any(|p| p.1 != 0.0)).then(|| plot::Series { label: c.name.clone(), points })
+            (points.iter().any(|p| p.1 != 0.0)).then(|| plot::Series {
+                label: c.name.clone(),
+                points,
+            })
         })
         .collect();
     let y_label = match quantity {
-        Quantity::Phi => "|Φ| (largest constraint violation)",
-        Quantity::Psi => "|Ψ| (energy constraint violation)",
-        Quantity::Err => "|X − X*| (error against the exact solution)",
+        Quantity::Phi => "Φ (largest constraint violation)",
+        Quantity::Psi => "Ψ (energy constraint violation)",
+        Quantity::Err => "X − X* (error against the exact solution)",
     };
     plot::write_figure(
         &dir.join(stem),
-        &Figure { title, x_label: "t", y_label, scale: Scale::LogAbs, series: &series },
+        &Figure {
+            title,
+            x_label: "t",
+            y_label,
+            scale: Scale::LogAbs,
+            series: &series,
+        },
     )
 }
 
 /// The three figures of the paper (Figs. 3–5) for these cases.
 pub fn write_figures(dir: &Path, title: &str, cases: &[CaseResult]) -> Result<()> {
-    write_figure(dir, "fig3_phi", &format!("{title}: geometric constraint violation"), Quantity::Phi, cases)?;
-    write_figure(dir, "fig4_psi", &format!("{title}: energy constraint violation"), Quantity::Psi, cases)?;
+    write_figure(
+        dir,
+        "fig3_phi",
+        &format!("{title}: geometric constraint violation"),
+        Quantity::Phi,
+        cases,
+    )?;
+    write_figure(
+        dir,
+        "fig4_psi",
+        &format!("{title}: energy constraint violation"),
+        Quantity::Psi,
+        cases,
+    )?;
     if cases.iter().any(|c| !c.series.err.is_empty()) {
-        write_figure(dir, "fig5_err_x", &format!("{title}: error in X"), Quantity::Err, cases)?;
+        write_figure(
+            dir,
+            "fig5_err_x",
+            &format!("{title}: error in X"),
+            Quantity::Err,
+            cases,
+        )?;
     }
     Ok(())
 }
@@ -79,7 +112,9 @@ pub fn table(cases: &[CaseResult]) -> String {
             opt(c.err_x_final),
             c.steps,
             c.rhs_evals,
-            c.error.as_ref().map_or(String::new(), |e| format!("  FAILED: {e}")),
+            c.error
+                .as_ref()
+                .map_or(String::new(), |e| format!("  FAILED: {e}")),
         );
     }
     out

@@ -20,6 +20,19 @@ pub struct Case {
     pub every: u64,
 }
 
+impl Case {
+    /// Checks that the case can start: settings valid, initial state consistent.
+    pub fn check(&self) -> cdyn::Result<()> {
+        Simulation::new(
+            &self.example.model,
+            self.settings,
+            &self.example.q0,
+            &self.example.v0,
+        )
+        .map(|_| ())
+    }
+}
+
 /// What a case produced.
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
@@ -92,7 +105,9 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     let outcome = Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0)
         .map_err(anyhow::Error::from)
         .and_then(|mut sim| {
-            let run = sim.run(case.t_end, case.every, |s| record(s, ex, &mut csv, &mut result));
+            let run = sim.run(case.t_end, case.every, |s| {
+                record(s, ex, &mut csv, &mut result)
+            });
             result.steps = sim.steps();
             result.t_final = sim.t();
             result.rhs_evals = sim.evaluations();
@@ -100,7 +115,8 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
             result.v_end = sim.v().to_vec();
             run
         });
-    csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
+    csv.flush()
+        .with_context(|| format!("cannot write {}", path.display()))?;
     if let Err(e) = outcome {
         if e.downcast_ref::<cdyn::Error>().is_none() {
             return Err(e.context(format!("cannot write {}", path.display())));
@@ -110,17 +126,22 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     Ok(result)
 }
 
-fn record(sim: &mut Simulation, ex: &Example, csv: &mut impl Write, r: &mut CaseResult) -> Result<()> {
+fn record(
+    sim: &mut Simulation,
+    ex: &Example,
+    csv: &mut impl Write,
+    r: &mut CaseResult,
+) -> Result<()> {
     let m = sim.measure();
     let (t, q, v) = (sim.t(), sim.q(), sim.v());
     let err = ex.error(q, v, t);
-    write!(csv, "{t}")?;
+    write!(csv, "{t:e}")?;
     for o in ex.observe(q, v) {
-        write!(csv, ",{o}")?;
+        write!(csv, ",{o:e}")?;
     }
-    write!(csv, ",{},{}", m.phi, m.psi)?;
+    write!(csv, ",{:e},{:e}", m.phi, m.psi)?;
     if let Some(e) = err {
-        write!(csv, ",{e}")?;
+        write!(csv, ",{e:e}")?;
         r.max_abs_err_x = Some(r.max_abs_err_x.unwrap_or(0.0).max(e.abs()));
         r.err_x_final = Some(e);
         r.series.err.push(e);

@@ -146,7 +146,11 @@ pub fn load(path: &Path) -> Result<Scenario> {
 fn check(file: &str, key: &str, value: f64, positive: bool) -> Result<f64> {
     let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
     if !ok {
-        let what = if positive { "finite and positive" } else { "finite and not negative" };
+        let what = if positive {
+            "finite and positive"
+        } else {
+            "finite and not negative"
+        };
         bail!("{file}: {key} = {value}: must be {what}");
     }
     Ok(value)
@@ -161,7 +165,10 @@ impl Scenario {
         let h = check(file, "[integrator] h", i.h, true)?;
         let t_end = check(file, "[integrator] t_end", i.t_end, true)?;
         if t_end / h > 1e9 {
-            bail!("{file}: [integrator] t_end / h = {:e} steps is more than 1e9", t_end / h);
+            bail!(
+                "{file}: [integrator] t_end / h = {:e} steps is more than 1e9",
+                t_end / h
+            );
         }
         let scheme = match i.scheme {
             SchemeName::Euler => Scheme::Euler,
@@ -178,10 +185,17 @@ impl Scenario {
             settings.consistency_tolerance = None;
         }
         let mut example = self.example(file)?;
-        for (key, given, default) in [("q", &init.q, &mut example.q0), ("v", &init.v, &mut example.v0)] {
+        for (key, given, default) in [
+            ("q", &init.q, &mut example.q0),
+            ("v", &init.v, &mut example.v0),
+        ] {
             if let Some(given) = given {
                 if given.len() != default.len() {
-                    bail!("{file}: [initial] {key} has {} values, the model has {} coordinates", given.len(), default.len());
+                    bail!(
+                        "{file}: [initial] {key} has {} values, the model has {} coordinates",
+                        given.len(),
+                        default.len()
+                    );
                 }
                 if let Some(x) = given.iter().find(|x| !x.is_finite()) {
                     bail!("{file}: [initial] {key} contains {x}: must be finite");
@@ -195,11 +209,25 @@ impl Scenario {
             Some(e) => bail!("{file}: [output] every = {e}: must be at least 1"),
         };
         let name = match &self.output.name {
-            Some(n) if !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) => n.clone(),
+            Some(n)
+                if !n.is_empty()
+                    && n.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) =>
+            {
+                n.clone()
+            }
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
-            None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
+            None => path
+                .file_stem()
+                .map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        Ok(Case { name, example, settings, t_end, every })
+        Ok(Case {
+            name,
+            example,
+            settings,
+            t_end,
+            every,
+        })
     }
 
     fn example(&self, file: &str) -> Result<Example> {
@@ -208,7 +236,12 @@ impl Scenario {
         let p = PendulumParams {
             mass: check(file, "[model] mass", m.mass.unwrap_or(d.mass), true)?,
             length: check(file, "[model] length", m.length.unwrap_or(d.length), true)?,
-            gravity: check(file, "[model] gravity", m.gravity.unwrap_or(d.gravity), false)?,
+            gravity: check(
+                file,
+                "[model] gravity",
+                m.gravity.unwrap_or(d.gravity),
+                false,
+            )?,
             theta0: m.theta0.unwrap_or(d.theta0),
             omega0: m.omega0.unwrap_or(d.omega0),
         };
@@ -234,16 +267,50 @@ impl MethodSpec {
             Ok(())
         };
         let g = self.geometric;
-        used("zeta", self.zeta, g == GeometricKind::Cvsgf, "geometric = \"cvsgf\"")?;
-        used("alpha_g", self.alpha_g, g == GeometricKind::Cvsgf, "geometric = \"cvsgf\"")?;
-        for (key, value) in [("alpha", self.alpha), ("beta", self.beta), ("omega", self.omega), ("damping_ratio", self.damping_ratio)] {
-            used(key, value, g == GeometricKind::Baumgarte, "geometric = \"baumgarte\"")?;
+        used(
+            "zeta",
+            self.zeta,
+            g == GeometricKind::Cvsgf,
+            "geometric = \"cvsgf\"",
+        )?;
+        used(
+            "alpha_g",
+            self.alpha_g,
+            g == GeometricKind::Cvsgf,
+            "geometric = \"cvsgf\"",
+        )?;
+        for (key, value) in [
+            ("alpha", self.alpha),
+            ("beta", self.beta),
+            ("omega", self.omega),
+            ("damping_ratio", self.damping_ratio),
+        ] {
+            used(
+                key,
+                value,
+                g == GeometricKind::Baumgarte,
+                "geometric = \"baumgarte\"",
+            )?;
         }
         let e = self.energy;
-        for (key, value) in [("alpha_e", self.alpha_e), ("rho_q", self.rho_q), ("rho_v", self.rho_v)] {
-            used(key, value, e == EnergyKind::Gradient, "energy = \"gradient\"")?;
+        for (key, value) in [
+            ("alpha_e", self.alpha_e),
+            ("rho_q", self.rho_q),
+            ("rho_v", self.rho_v),
+        ] {
+            used(
+                key,
+                value,
+                e == EnergyKind::Gradient,
+                "energy = \"gradient\"",
+            )?;
         }
-        used("eta", self.eta, e == EnergyKind::Baumgarte, "energy = \"baumgarte\"")?;
+        used(
+            "eta",
+            self.eta,
+            e == EnergyKind::Baumgarte,
+            "energy = \"baumgarte\"",
+        )?;
         let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
 
         let geometric = match g {
@@ -251,27 +318,45 @@ impl MethodSpec {
             GeometricKind::Cvsgf => match (self.zeta, self.alpha_g) {
                 (Some(z), None) => Geometric::Gradient(Gain::Fixed(num("zeta", z)?)),
                 (None, Some(a)) => Geometric::Gradient(Gain::Rate(num("alpha_g", a)?)),
-                _ => bail!("{file}: [method] geometric = \"cvsgf\" needs exactly one of zeta, alpha_g"),
+                _ => bail!(
+                    "{file}: [method] geometric = \"cvsgf\" needs exactly one of zeta, alpha_g"
+                ),
             },
-            GeometricKind::Baumgarte => match (self.alpha, self.beta, self.omega, self.damping_ratio) {
-                (Some(a), Some(b), None, None) => Geometric::Baumgarte { alpha: num("alpha", a)?, beta: num("beta", b)? },
-                (None, None, Some(w), ratio) => {
-                    let w = check(file, "[method] omega", w, true)?;
-                    Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)?
+            GeometricKind::Baumgarte => {
+                match (self.alpha, self.beta, self.omega, self.damping_ratio) {
+                    (Some(a), Some(b), None, None) => Geometric::Baumgarte {
+                        alpha: num("alpha", a)?,
+                        beta: num("beta", b)?,
+                    },
+                    (None, None, Some(w), ratio) => {
+                        let w = check(file, "[method] omega", w, true)?;
+                        Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)?
+                    }
+                    _ => bail!(
+                        "{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega (and damping_ratio, default 1)"
+                    ),
                 }
-                _ => bail!("{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega (and damping_ratio, default 1)"),
-            },
+            }
         };
         let energy = match e {
             EnergyKind::None => Energy::None,
             EnergyKind::Baumgarte => match self.eta {
-                Some(eta) => Energy::Baumgarte { eta: num("eta", eta)? },
+                Some(eta) => Energy::Baumgarte {
+                    eta: num("eta", eta)?,
+                },
                 None => bail!("{file}: [method] energy = \"baumgarte\" needs eta"),
             },
             EnergyKind::Gradient => match (self.alpha_e, self.rho_q, self.rho_v) {
-                (Some(a), None, None) => Energy::Gradient(EnergyGain::Rate { alpha_e: num("alpha_e", a)? }),
-                (None, q, Some(v)) => Energy::Gradient(EnergyGain::Fixed { rho_q: num("rho_q", q.unwrap_or(0.0))?, rho_v: num("rho_v", v)? }),
-                _ => bail!("{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q, default 0)"),
+                (Some(a), None, None) => Energy::Gradient(EnergyGain::Rate {
+                    alpha_e: num("alpha_e", a)?,
+                }),
+                (None, q, Some(v)) => Energy::Gradient(EnergyGain::Fixed {
+                    rho_q: num("rho_q", q.unwrap_or(0.0))?,
+                    rho_v: num("rho_v", v)?,
+                }),
+                _ => bail!(
+                    "{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q, default 0)"
+                ),
             },
         };
         let application = match self.apply {
@@ -279,6 +364,10 @@ impl MethodSpec {
             Apply::ForwardEuler => Application::ForwardEuler,
             Apply::BackwardEuler => Application::BackwardEuler,
         };
-        Ok(Control { geometric, energy, application })
+        Ok(Control {
+            geometric,
+            energy,
+            application,
+        })
     }
 }
