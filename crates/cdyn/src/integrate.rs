@@ -106,7 +106,7 @@ impl Scheme {
 pub trait Rhs {
     type Error;
     /// Length of the state `x`.
-    fn len(&self) -> usize;
+    fn state_len(&self) -> usize;
     /// Whether `U` can be non-zero.
     fn has_control(&self) -> bool;
     /// Writes `f(x, t)` and, when `u` is given, `U(x, t)`.

@@ -89,7 +89,7 @@ impl DenseSchur {
             if !d.is_finite() {
                 return Err(Breakdown::NonFinite);
             }
-            if !(d > PIVOT_TOLERANCE * self.diag[j]) {
+            if d.is_nan() || d <= PIVOT_TOLERANCE * self.diag[j] {
                 return Err(Breakdown::Singular(j));
             }
             let d = d.sqrt();

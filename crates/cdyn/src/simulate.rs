@@ -40,7 +40,7 @@ impl Settings {
         if let Some(tol) = self.consistency_tolerance {
             positive("consistency tolerance", tol)?;
         }
-        if !(self.violation_limit > 0.0) {
+        if self.violation_limit.is_nan() || self.violation_limit <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: "violation limit",
                 value: self.violation_limit,
@@ -101,8 +101,11 @@ impl<'m> Simulation<'m> {
             }
         }
         let system = ControlledSystem::new(model, settings.control, e0);
-        let integrator =
-            Integrator::new(settings.scheme, settings.control.application, system.len());
+        let integrator = Integrator::new(
+            settings.scheme,
+            settings.control.application,
+            system.state_len(),
+        );
         Ok(Self {
             system,
             integrator,
@@ -207,7 +210,7 @@ impl<'m> Simulation<'m> {
         observe(self)?;
         while self.step < steps {
             self.step()?;
-            if self.step % every == 0 || self.step == steps {
+            if self.step.is_multiple_of(every) || self.step == steps {
                 observe(self)?;
             }
         }

@@ -58,7 +58,7 @@ impl<'m> ControlledSystem<'m> {
 impl Rhs for ControlledSystem<'_> {
     type Error = EvalError;
 
-    fn len(&self) -> usize {
+    fn state_len(&self) -> usize {
         2 * self.model.n() + 1
     }
 

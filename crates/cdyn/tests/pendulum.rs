@@ -151,7 +151,7 @@ fn one_euler_step_of_every_control_matches_the_hand_computation() {
     let x0 = [1.02, 0.05, 0.1, 1.8];
     for c in all_controls() {
         let mut sys = ControlledSystem::new(&model, c, e0);
-        let mut integ = Integrator::new(Scheme::Euler, c.application, sys.len());
+        let mut integ = Integrator::new(Scheme::Euler, c.application, sys.state_len());
         let mut x = [x0[0], x0[1], x0[2], x0[3], 0.0];
         integ.step(&mut sys, &mut x, 0.0, h).unwrap();
         let f = |s: [f64; 4]| {
@@ -289,7 +289,7 @@ fn gradient_energy_control_decays_psi_at_the_target_rate() {
 fn energy_perturbed(control: Control, t_end: f64) -> Vec<(f64, f64)> {
     let model = pendulum();
     let mut sys = ControlledSystem::new(&model, control, 2.0);
-    let mut integ = Integrator::new(Scheme::RungeKutta4, control.application, sys.len());
+    let mut integ = Integrator::new(Scheme::RungeKutta4, control.application, sys.state_len());
     let mut x = [1.0, 0.0, 0.0, 2.002, 0.0];
     let h = 1e-3;
     let mut out = Vec::new();
@@ -334,7 +334,7 @@ fn backward_euler_cvsgf_with_unit_gain_step_is_a_gauss_newton_projection() {
             application: Application::BackwardEuler,
         };
         let mut sys = ControlledSystem::new(&model, c, 2.0);
-        let mut integ = Integrator::new(Scheme::Euler, c.application, sys.len());
+        let mut integ = Integrator::new(Scheme::Euler, c.application, sys.state_len());
         let r = (1.0 + 2.0 * eps as f64).sqrt();
         let mut x = [r, 0.0, 0.0, 2.0, 0.0];
         let (xh, yh) = (x[0] + h * x[2], x[1] + h * x[3]);
