@@ -12,10 +12,12 @@ mod linalg;
 pub mod methods;
 pub mod model;
 pub mod models;
+pub mod planar;
 pub mod reference;
 pub mod scalar;
 pub mod simulate;
 pub mod system;
+pub mod timefn;
 
 pub use constraint::Constraint;
 pub use control::{Application, Control, Energy, EnergyGain, Gain, Geometric};

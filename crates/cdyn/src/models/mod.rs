@@ -1,8 +1,12 @@
 //! Built-in systems, each with its initial state and, where one exists,
 //! its reference solution. Tests, benchmarks and the command line share them.
 
+mod andrews;
+mod mechanisms;
 mod pendulum;
 
+pub use andrews::andrews;
+pub use mechanisms::*;
 pub use pendulum::{PendulumParams, cartesian_pendulum, theta_pendulum};
 
 /// `(q, v)` of the exact solution at time `t`, in the model's coordinates.
@@ -24,6 +28,19 @@ pub struct Example {
 }
 
 impl Example {
+    /// A mechanism as an example whose observables are its coordinates.
+    pub fn from_mechanism(built: crate::planar::Built, reference: Option<Reference>) -> Self {
+        let n = built.model.n();
+        Example {
+            model: built.model,
+            q0: built.q0,
+            v0: built.v0,
+            observables: built.names,
+            observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
+            reference,
+        }
+    }
+
     /// The observables of the state `(q, v)`.
     pub fn observe(&self, q: &[f64], v: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.observables.len()];

@@ -1,0 +1,3 @@
+//! Andrews squeezing mechanism (in progress).
+
+pub fn andrews() {}

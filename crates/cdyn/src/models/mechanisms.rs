@@ -1,0 +1,1 @@
+//! Built-in mechanisms with their references (in progress).
