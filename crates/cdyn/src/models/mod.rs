@@ -1,7 +1,7 @@
 //! Built-in systems, each with its initial state and, where one exists,
 //! its reference solution. Tests, benchmarks and the command line share them.
 
-mod andrews;
+pub mod andrews;
 mod mechanisms;
 mod pendulum;
 
