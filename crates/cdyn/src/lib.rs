@@ -1,5 +1,6 @@
 #![doc = include_str!("../../../README.md")]
 
+pub mod assemble;
 pub mod constraint;
 pub mod control;
 pub mod diagnostics;

@@ -153,9 +153,10 @@ impl ModelBuilder {
         }
         let m = pattern.start.len() - 1;
         let n = self.mass.len();
-        if m >= n {
+        // m = n is allowed: a fully driven (kinematic) mechanism.
+        if m > n {
             return Err(Error::InvalidModel(format!(
-                "{m} constraints on {n} coordinates leave no motion"
+                "{m} constraints on {n} coordinates: more constraints than coordinates"
             )));
         }
         Ok(Model {
