@@ -1,6 +1,8 @@
 //! `cdyn`: constrained dynamics with gradient-feedback stabilization,
 //! from the command line.
 
+mod compare;
+mod mechanism_spec;
 mod paper;
 mod plot;
 mod report;
@@ -31,6 +33,14 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Run one model under every stabilization method of `cdyn paper`.
+    Compare {
+        /// The scenario (TOML); its [method] gains, if any, are used, else target rates 0.4/h.
+        scenario: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Run a scenario file.
     Run {
         /// The scenario (TOML).
@@ -52,8 +62,7 @@ fn main() -> ExitCode {
 }
 
 fn output_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create output directory {}", dir.display()))
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -63,34 +72,42 @@ fn run(cli: Cli) -> Result<()> {
             let results = paper::run(&out)?;
             print!("{}", report::table(&results));
             println!("wrote {}", out.display());
-            if let Some(e) = results.iter().find_map(|r| r.error.as_ref()) {
-                bail!("{e}");
-            }
+            fail_on_error(&results, &out)
         }
         Command::Run { scenario, out } => {
             let case = scenario::load(&scenario)?.case(&scenario)?;
-            case.check().map_err(|e| match e {
-                cdyn::Error::InconsistentInitialState { .. } => anyhow::anyhow!(
-                    "{}: [initial]: {e}; set off_constraint = true to start there anyway",
-                    scenario.display()
-                ),
-                e => anyhow::anyhow!("{}: {e}", scenario.display()),
-            })?;
+            case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
+            if let Some(a) = &case.assembly {
+                println!("{}", report::assembly_line(a));
+            }
             output_dir(&out)?;
-            let result = runner::run_case(&case, &out)?;
-            let results = [result];
-            report::write_summary(
-                &out,
-                &results,
-                serde_json::json!({ "scenario": scenario.display().to_string() }),
-            )?;
-            report::write_figures(&out, &results[0].name, &results)?;
+            let results = [runner::run_case(&case, &out)?];
+            let extra = serde_json::json!({
+                "scenario": scenario.display().to_string(),
+                "assembly": case.assembly.as_ref().map(report::assembly_json),
+            });
+            report::write_summary(&out, &results, extra)?;
+            report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
             print!("{}", report::table(&results));
             println!("wrote {}", out.display());
-            if let Some(e) = &results[0].error {
-                bail!("{e} (output up to that point is in {})", out.display());
-            }
+            fail_on_error(&results, &out)
+        }
+        Command::Compare { scenario, out } => {
+            let parsed = scenario::load(&scenario)?;
+            let cases = compare::cases(&parsed, &scenario)?;
+            output_dir(&out)?;
+            let results = compare::run(&cases, &scenario, &out)?;
+            print!("{}", report::table(&results));
+            println!("wrote {}", out.display());
+            fail_on_error(&results, &out)
         }
     }
-    Ok(())
+}
+
+/// A run that failed part-way still wrote its output; say where, and fail.
+fn fail_on_error(results: &[runner::CaseResult], out: &Path) -> Result<()> {
+    match results.iter().find_map(|r| r.error.as_ref()) {
+        Some(e) => bail!("{e} (output up to that point is in {})", out.display()),
+        None => Ok(()),
+    }
 }

@@ -26,6 +26,7 @@ pub fn cases() -> Result<Vec<Case>> {
             settings: Settings::new(Scheme::AdamsBashforth3, H, control),
             t_end: T_END,
             every: 1,
+            assembly: None,
         });
     }
     for (name, control) in independent_cases(&gains) {
@@ -36,6 +37,7 @@ pub fn cases() -> Result<Vec<Case>> {
             settings: Settings::new(Scheme::AdamsBashforth3, H, control),
             t_end: T_END,
             every: 1,
+            assembly: None,
         });
     }
     Ok(cases)
@@ -44,16 +46,13 @@ pub fn cases() -> Result<Vec<Case>> {
 /// Runs every case into `dir`, writes the summary and figures, and returns
 /// the results (failed cases carry their error).
 pub fn run(dir: &Path) -> Result<Vec<CaseResult>> {
-    let results = cases()?
-        .iter()
-        .map(|c| run_case(c, dir))
-        .collect::<Result<Vec<_>>>()?;
+    let results = cases()?.iter().map(|c| run_case(c, dir)).collect::<Result<Vec<_>>>()?;
     let setup = json!({
         "problem": "Example 1: unit pendulum in Cartesian coordinates, X(0)=1, Y(0)=0, VX(0)=0, VY(0)=2, g=1",
         "scheme": "ab3 (rk4 start-up)", "h": H, "t_end": T_END,
         "gains": { "zeta": 20.0, "alpha_e": 40.0, "rho_q": 0.0, "baumgarte_alpha": 2.0 * 40f64.sqrt(), "baumgarte_beta": 40.0 },
     });
     report::write_summary(dir, &results, json!({ "setup": setup }))?;
-    report::write_figures(dir, "Example 1 [AB-3, h = 0.01]", &results)?;
+    report::write_figures(dir, "Example 1 [AB-3, h = 0.01]", &results, report::PAPER_FIGURES)?;
     Ok(results)
 }

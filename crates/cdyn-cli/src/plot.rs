@@ -46,10 +46,8 @@ const TICKS: usize = 10;
 /// Magnitudes at or beyond this count as non-finite: spans and logs of them overflow.
 const HUGE: f64 = 1e300;
 /// Tableau 10: ten hues that stay apart from each other on screen and in print.
-const PALETTE: [u32; 10] = [
-    0x1f77b4, 0xff7f0e, 0x2ca02c, 0xd62728, 0x9467bd, 0x8c564b, 0xe377c2, 0x7f7f7f, 0xbcbd22,
-    0x17becf,
-];
+const PALETTE: [u32; 10] =
+    [0x1f77b4, 0xff7f0e, 0x2ca02c, 0xd62728, 0x9467bd, 0x8c564b, 0xe377c2, 0x7f7f7f, 0xbcbd22, 0x17becf];
 
 /// Writes `<stem>.png` (1200x800) and `<stem>.svg`. `stem` is a path without extension.
 pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
@@ -59,12 +57,8 @@ pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
     }
     let data = prepare(fig);
     let (png, svg) = (with_ext(stem, "png"), with_ext(stem, "svg"));
-    render(
-        BitMapBackend::new(&png, SIZE).into_drawing_area(),
-        fig,
-        &data,
-    )
-    .with_context(|| format!("writing figure {}", png.display()))?;
+    render(BitMapBackend::new(&png, SIZE).into_drawing_area(), fig, &data)
+        .with_context(|| format!("writing figure {}", png.display()))?;
     render(SVGBackend::new(&svg, SIZE).into_drawing_area(), fig, &data)
         .with_context(|| format!("writing figure {}", svg.display()))
 }
@@ -111,35 +105,19 @@ fn prepare(fig: &Figure) -> Data {
             .flatten()
             .flatten()
             .map(f)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            })
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
     };
     let (x, (ylo, yhi)) = (pad(extent(|p| p.0), 0.0), extent(|p| p.1));
     if !log {
-        return Data {
-            y: pad((ylo, yhi), 0.05),
-            x,
-            runs,
-            shift: 0,
-        };
+        return Data { y: pad((ylo, yhi), 0.05), x, runs, shift: 0 };
     }
     // Whole decades, so the axis always has labelled powers of ten.
-    let (lo, hi) = if ylo > yhi {
-        (-1.0, 1.0)
-    } else {
-        (ylo.floor(), yhi.ceil().max(ylo.floor() + 1.0))
-    };
+    let (lo, hi) = if ylo > yhi { (-1.0, 1.0) } else { (ylo.floor(), yhi.ceil().max(ylo.floor() + 1.0)) };
     let shift = lo.max(hi - 300.0);
     for p in runs.iter_mut().flatten().flatten() {
         p.1 = 10f64.powf((p.1 - shift).max(0.0));
     }
-    Data {
-        runs,
-        x,
-        y: (10f64.powf((lo - shift).max(0.0)), 10f64.powf(hi - shift)),
-        shift: shift as i32,
-    }
+    Data { runs, x, y: (10f64.powf((lo - shift).max(0.0)), 10f64.powf(hi - shift)), shift: shift as i32 }
 }
 
 /// Widens a range by `frac` of its span each side. A flat range (all values equal, up to
@@ -169,11 +147,7 @@ fn ticks((lo, hi): (f64, f64)) -> impl Fn(&f64) -> String {
     let k = (step.log10() + 1e-9).floor(); // decade of the step (a 1, 2 or 5 times 10^k)
     let sci_axis = !(1e-3..1e5).contains(&lo.abs().max(hi.abs()));
     move |&v| {
-        let v = if v.abs() < 10f64.powf(k) / 2.0 {
-            0.0
-        } else {
-            v
-        };
+        let v = if v.abs() < 10f64.powf(k) / 2.0 { 0.0 } else { v };
         match (sci_axis, v == 0.0) {
             (true, true) => "0".into(),
             (true, false) => sci(v, (v.abs().log10().floor() - k).clamp(0.0, 15.0) as usize),
@@ -211,17 +185,11 @@ fn log_tick(v: f64, shift: i32, (lo, hi): (f64, f64)) -> String {
 fn style(i: usize) -> (ShapeStyle, Option<(u32, u32)>) {
     let c = PALETTE[i % 10];
     let color = RGBColor((c >> 16) as u8, (c >> 8) as u8, c as u8);
-    (
-        color.stroke_width(2),
-        [None, Some((12, 6)), Some((2, 5))][(i / 10) % 3],
-    )
+    (color.stroke_width(2), [None, Some((12, 6)), Some((2, 5))][(i / 10) % 3])
 }
 
 /// Width in pixels of the widest of `texts` in the 18 px label font.
-fn widest<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    texts: impl Iterator<Item = String>,
-) -> Result<u32> {
+fn widest<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, texts: impl Iterator<Item = String>) -> Result<u32> {
     let font = TextStyle::from((FONT, 18));
     let mut w = 0;
     for t in texts {
@@ -238,10 +206,7 @@ fn de<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow:
 /// the plot, the legend can list many series without ever covering data.
 fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Data) -> Result<()> {
     root.fill(&WHITE).map_err(de)?;
-    let root = root
-        .margin(12, 0, 0, 0)
-        .titled(fig.title, (FONT, 30))
-        .map_err(de)?;
+    let root = root.margin(12, 0, 0, 0).titled(fig.title, (FONT, 30)).map_err(de)?;
     let labels: Vec<String> = fig
         .series
         .iter()
@@ -274,14 +239,9 @@ fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Da
     let n = labels.len().max(1) as i32;
     let row = ((h as i32 - 100) / n).clamp(6, 28);
     let frame = [(0, 20), (w as i32 - 20, 20 + row * n + 12)];
-    legend
-        .draw(&Rectangle::new(frame, WHITE.filled()))
-        .map_err(de)?;
-    legend
-        .draw(&Rectangle::new(frame, BLACK.mix(0.4)))
-        .map_err(de)?;
-    let font =
-        TextStyle::from((FONT, (row - 6).clamp(6, 18))).pos(Pos::new(HPos::Left, VPos::Center));
+    legend.draw(&Rectangle::new(frame, WHITE.filled())).map_err(de)?;
+    legend.draw(&Rectangle::new(frame, BLACK.mix(0.4))).map_err(de)?;
+    let font = TextStyle::from((FONT, (row - 6).clamp(6, 18))).pos(Pos::new(HPos::Left, VPos::Center));
     for (i, l) in labels.iter().enumerate() {
         let y = 26 + row * i as i32 + row / 2;
         let (st, dash) = style(i);
@@ -291,9 +251,7 @@ fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Da
             Some((a, b)) => legend.draw(&DashedPathElement::new(sample, a, b, st)),
         }
         .map_err(de)?;
-        legend
-            .draw(&Text::new(l.as_str(), (62, y), font.clone()))
-            .map_err(de)?;
+        legend.draw(&Text::new(l.as_str(), (62, y), font.clone())).map_err(de)?;
     }
     root.present().map_err(de)
 }
@@ -315,10 +273,7 @@ where
     let y_w = widest(area, keys.iter().map(y_fmt))?;
     let y_desc = match fig.scale {
         Scale::Linear => fig.y_label.to_string(),
-        Scale::LogAbs => format!(
-            "|{}|",
-            Some(fig.y_label).filter(|l| !l.is_empty()).unwrap_or("y")
-        ),
+        Scale::LogAbs => format!("|{}|", Some(fig.y_label).filter(|l| !l.is_empty()).unwrap_or("y")),
     };
     let mut ch = ChartBuilder::on(area)
         .margin(20)
@@ -368,33 +323,18 @@ mod tests {
 
     /// A fresh directory per test, so parallel tests and earlier runs never collide.
     fn temp_dir(name: &str) -> PathBuf {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap()
-            .as_nanos();
-        let dir =
-            std::env::temp_dir().join(format!("cdyn-plot-{}-{name}-{nanos}", std::process::id()));
+        let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos();
+        let dir = std::env::temp_dir().join(format!("cdyn-plot-{}-{name}-{nanos}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir
     }
 
     fn fig<'a>(series: &'a [Series], scale: Scale) -> Figure<'a> {
-        Figure {
-            title: "Test figure",
-            x_label: "time t",
-            y_label: "error",
-            scale,
-            series,
-        }
+        Figure { title: "Test figure", x_label: "time t", y_label: "error", scale, series }
     }
 
     fn wave(label: &str, f: impl Fn(f64) -> f64) -> Series {
-        Series {
-            label: label.into(),
-            points: (0..2000)
-                .map(|i| (i as f64 * 0.01, f(i as f64 * 0.01)))
-                .collect(),
-        }
+        Series { label: label.into(), points: (0..2000).map(|i| (i as f64 * 0.01, f(i as f64 * 0.01))).collect() }
     }
 
     #[test]
@@ -409,27 +349,14 @@ mod tests {
             write_figure(&dir.join(name), &fig(&series, scale)).unwrap();
             let png = std::fs::read(dir.join(format!("{name}.png"))).unwrap();
             let svg = std::fs::read_to_string(dir.join(format!("{name}.svg"))).unwrap();
-            assert!(
-                png.len() > 20_000 && svg.len() > 20_000,
-                "{} {}",
-                png.len(),
-                svg.len()
-            );
+            assert!(png.len() > 20_000 && svg.len() > 20_000, "{} {}", png.len(), svg.len());
             assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
-            for label in [
-                "energy drift",
-                "constraint violation",
-                "momentum &amp; &lt;error&gt;",
-                "Test figure",
-                "time t",
-            ] {
+            for label in
+                ["energy drift", "constraint violation", "momentum &amp; &lt;error&gt;", "Test figure", "time t"]
+            {
                 assert!(svg.contains(label), "{name}.svg lacks {label}");
             }
-            assert!(svg.contains(if name == "log" {
-                "\n|error|\n"
-            } else {
-                "\nerror\n"
-            }));
+            assert!(svg.contains(if name == "log" { "\n|error|\n" } else { "\nerror\n" }));
         }
         std::fs::remove_dir_all(dir).unwrap();
     }
@@ -441,36 +368,15 @@ mod tests {
             vec![],
             vec![Series {
                 label: "bad".into(),
-                points: vec![
-                    (0.0, f64::NAN),
-                    (f64::INFINITY, 1.0),
-                    (1.0, f64::NEG_INFINITY),
-                ],
+                points: vec![(0.0, f64::NAN), (f64::INFINITY, 1.0), (1.0, f64::NEG_INFINITY)],
             }],
             vec![wave("flat", |_| 3.0), wave("zero", |_| 0.0)],
             vec![wave("zero", |_| 0.0)],
-            vec![Series {
-                label: "one point".into(),
-                points: vec![(1.0, 2.0)],
-            }],
-            vec![wave("gaps", |t| {
-                if (t * 10.0) as i32 % 2 == 0 {
-                    f64::NAN
-                } else {
-                    t
-                }
-            })],
-            vec![
-                wave("huge", |t| 1e299 * t),
-                wave("subnormal", |t| 5e-324 * t),
-            ],
-            vec![Series {
-                label: "x".repeat(200),
-                points: vec![(0.0, 1.0), (1.0, 1.0 + 1e-14)],
-            }],
-            (0..30)
-                .map(|k| wave(&format!("s{k}"), |t| t * k as f64))
-                .collect(),
+            vec![Series { label: "one point".into(), points: vec![(1.0, 2.0)] }],
+            vec![wave("gaps", |t| if (t * 10.0) as i32 % 2 == 0 { f64::NAN } else { t })],
+            vec![wave("huge", |t| 1e299 * t), wave("subnormal", |t| 5e-324 * t)],
+            vec![Series { label: "x".repeat(200), points: vec![(0.0, 1.0), (1.0, 1.0 + 1e-14)] }],
+            (0..30).map(|k| wave(&format!("s{k}"), |t| t * k as f64)).collect(),
         ];
         for (i, series) in cases.iter().enumerate() {
             for (scale, tag) in [(Scale::Linear, "lin"), (Scale::LogAbs, "log")] {
@@ -484,9 +390,7 @@ mod tests {
 
     #[test]
     fn unwritable_path_names_the_file() {
-        let stem = std::env::temp_dir()
-            .join("cdyn-plot-no-such-dir")
-            .join("fig");
+        let stem = std::env::temp_dir().join("cdyn-plot-no-such-dir").join("fig");
         let err = write_figure(&stem, &fig(&[], Scale::Linear)).unwrap_err();
         assert!(format!("{err:#}").contains("fig.png"), "{err:#}");
     }
@@ -494,10 +398,7 @@ mod tests {
     #[test]
     fn tick_labels_are_compact() {
         let f = ticks((-1e-8, 1e-8));
-        assert_eq!(
-            (f(&5e-9), f(&-1e-8), f(&1e-25)),
-            ("5e-9".into(), "-1e-8".into(), "0".into())
-        );
+        assert_eq!((f(&5e-9), f(&-1e-8), f(&1e-25)), ("5e-9".into(), "-1e-8".into(), "0".into()));
         let f = ticks((0.0, 10.0));
         assert_eq!((f(&2.0), f(&0.0)), ("2".into(), "0".into()));
         assert_eq!(ticks((0.0, 1.0))(&0.30000000000000004), "0.3");

@@ -27,13 +27,7 @@ pub enum Quantity {
 }
 
 /// Writes one figure (PNG and SVG) of a quantity for every case that has it.
-pub fn write_figure(
-    dir: &Path,
-    stem: &str,
-    title: &str,
-    quantity: Quantity,
-    cases: &[CaseResult],
-) -> Result<()> {
+pub fn write_figure(dir: &Path, stem: &str, title: &str, quantity: Quantity, cases: &[CaseResult]) -> Result<()> {
     let series: Vec<plot::Series> = cases
         .iter()
         .filter_map(|c| {
@@ -44,53 +38,30 @@ pub fn write_figure(
                 Quantity::Err => &s.err,
             };
             let points: Vec<(f64, f64)> = s.t.iter().copied().zip(y.iter().copied()).collect();
-            (points.iter().any(|p| p.1 != 0.0)).then(|| plot::Series {
-                label: c.name.clone(),
-                points,
-            })
+            (points.iter().any(|p| p.1 != 0.0)).then(|| plot::Series { label: c.name.clone(), points })
         })
         .collect();
     let y_label = match quantity {
         Quantity::Phi => "Φ (largest constraint violation)",
         Quantity::Psi => "Ψ (energy constraint violation)",
-        Quantity::Err => "X − X* (error against the exact solution)",
+        Quantity::Err => "error of the first observable against the reference",
     };
-    plot::write_figure(
-        &dir.join(stem),
-        &Figure {
-            title,
-            x_label: "t",
-            y_label,
-            scale: Scale::LogAbs,
-            series: &series,
-        },
-    )
+    plot::write_figure(&dir.join(stem), &Figure { title, x_label: "t", y_label, scale: Scale::LogAbs, series: &series })
 }
 
-/// The three figures of the paper (Figs. 3–5) for these cases.
-pub fn write_figures(dir: &Path, title: &str, cases: &[CaseResult]) -> Result<()> {
-    write_figure(
-        dir,
-        "fig3_phi",
-        &format!("{title}: geometric constraint violation"),
-        Quantity::Phi,
-        cases,
-    )?;
-    write_figure(
-        dir,
-        "fig4_psi",
-        &format!("{title}: energy constraint violation"),
-        Quantity::Psi,
-        cases,
-    )?;
-    if cases.iter().any(|c| !c.series.err.is_empty()) {
-        write_figure(
-            dir,
-            "fig5_err_x",
-            &format!("{title}: error in X"),
-            Quantity::Err,
-            cases,
-        )?;
+/// File stems of the three figures (Φ, Ψ, error).
+pub type Stems = [&'static str; 3];
+/// The paper's Figs. 3–5.
+pub const PAPER_FIGURES: Stems = ["fig3_phi", "fig4_psi", "fig5_err_x"];
+/// Figures of `run` and `compare`.
+pub const RUN_FIGURES: Stems = ["phi", "psi", "err"];
+
+/// The violation and error figures for these cases.
+pub fn write_figures(dir: &Path, title: &str, cases: &[CaseResult], stems: Stems) -> Result<()> {
+    write_figure(dir, stems[0], &format!("{title}: geometric constraint violation"), Quantity::Phi, cases)?;
+    write_figure(dir, stems[1], &format!("{title}: energy constraint violation"), Quantity::Psi, cases)?;
+    if let Some(c) = cases.iter().find(|c| !c.series.err.is_empty()) {
+        write_figure(dir, stems[2], &format!("{title}: error in {}", c.error_observable), Quantity::Err, cases)?;
     }
     Ok(())
 }
@@ -112,10 +83,29 @@ pub fn table(cases: &[CaseResult]) -> String {
             opt(c.err_x_final),
             c.steps,
             c.rhs_evals,
-            c.error
-                .as_ref()
-                .map_or(String::new(), |e| format!("  FAILED: {e}")),
+            c.error.as_ref().map_or(String::new(), |e| format!("  FAILED: {e}")),
         );
     }
     out
+}
+
+/// The assembly report as JSON.
+pub fn assembly_json(a: &cdyn::assemble::Assembly) -> serde_json::Value {
+    json!({
+        "newton_iterations": a.newton_iterations,
+        "max_abs_phi_before": a.phi_before,
+        "max_abs_phi_after": a.phi_after,
+        "max_abs_phi_dot_before": a.phi_dot_before,
+        "max_abs_phi_dot_after": a.phi_dot_after,
+        "max_abs_dq": a.max_dq,
+        "max_abs_dv": a.max_dv,
+    })
+}
+
+/// One line saying what the assembly did.
+pub fn assembly_line(a: &cdyn::assemble::Assembly) -> String {
+    format!(
+        "assembly: {} Newton iterations, max |Φ| {:.2e} → {:.2e}, max |Φ̇| {:.2e} → {:.2e}, max |Δq| = {:.2e}, max |Δv| = {:.2e}",
+        a.newton_iterations, a.phi_before, a.phi_after, a.phi_dot_before, a.phi_dot_after, a.max_dq, a.max_dv
+    )
 }

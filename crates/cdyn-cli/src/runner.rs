@@ -18,18 +18,14 @@ pub struct Case {
     pub t_end: f64,
     /// Write a sample every this many steps.
     pub every: u64,
+    /// What projecting the initial state onto the constraints changed, if it was done.
+    pub assembly: Option<cdyn::assemble::Assembly>,
 }
 
 impl Case {
     /// Checks that the case can start: settings valid, initial state consistent.
     pub fn check(&self) -> cdyn::Result<()> {
-        Simulation::new(
-            &self.example.model,
-            self.settings,
-            &self.example.q0,
-            &self.example.v0,
-        )
-        .map(|_| ())
+        Simulation::new(&self.example.model, self.settings, &self.example.q0, &self.example.v0).map(|_| ())
     }
 }
 
@@ -37,6 +33,8 @@ impl Case {
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
     pub name: String,
+    /// The observable whose error against the reference is reported.
+    pub error_observable: String,
     pub scheme: &'static str,
     pub h: f64,
     pub max_abs_phi: f64,
@@ -87,6 +85,7 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     let ex = &case.example;
     let mut result = CaseResult {
         name: case.name.clone(),
+        error_observable: ex.observables[0].clone(),
         scheme: case.settings.scheme.info().name,
         h: case.settings.h,
         max_abs_phi: 0.0,
@@ -102,12 +101,9 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
         error: None,
         series: Series::default(),
     };
-    let outcome = Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0)
-        .map_err(anyhow::Error::from)
-        .and_then(|mut sim| {
-            let run = sim.run(case.t_end, case.every, |s| {
-                record(s, ex, &mut csv, &mut result)
-            });
+    let outcome =
+        Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0).map_err(anyhow::Error::from).and_then(|mut sim| {
+            let run = sim.run(case.t_end, case.every, |s| record(s, ex, &mut csv, &mut result));
             result.steps = sim.steps();
             result.t_final = sim.t();
             result.rhs_evals = sim.evaluations();
@@ -115,8 +111,7 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
             result.v_end = sim.v().to_vec();
             run
         });
-    csv.flush()
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
     if let Err(e) = outcome {
         if e.downcast_ref::<cdyn::Error>().is_none() {
             return Err(e.context(format!("cannot write {}", path.display())));
@@ -126,12 +121,7 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     Ok(result)
 }
 
-fn record(
-    sim: &mut Simulation,
-    ex: &Example,
-    csv: &mut impl Write,
-    r: &mut CaseResult,
-) -> Result<()> {
+fn record(sim: &mut Simulation, ex: &Example, csv: &mut impl Write, r: &mut CaseResult) -> Result<()> {
     let m = sim.measure();
     let (t, q, v) = (sim.t(), sim.q(), sim.v());
     let err = ex.error(q, v, t);

@@ -2,8 +2,11 @@
 //! integrator and the output sampling, in TOML. Every mistake becomes one
 //! line naming the file and the key.
 
+use crate::mechanism_spec::{BodySpec, ElementSpec, MechanismSpec};
 use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
+use cdyn::assemble::assemble;
+use cdyn::methods::MethodGains;
 use cdyn::models::{Example, PendulumParams, cartesian_pendulum, theta_pendulum};
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings};
 use serde::Deserialize;
@@ -20,6 +23,14 @@ pub struct Scenario {
     pub integrator: IntegratorSpec,
     #[serde(default)]
     pub output: OutputSpec,
+    #[serde(default)]
+    pub bodies: Vec<BodySpec>,
+    #[serde(default)]
+    pub joints: Vec<ElementSpec>,
+    #[serde(default)]
+    pub drives: Vec<ElementSpec>,
+    #[serde(default)]
+    pub forces: Vec<ElementSpec>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq)]
@@ -27,6 +38,16 @@ pub struct Scenario {
 pub enum ModelKind {
     Pendulum,
     PendulumTheta,
+    Mechanism,
+    Andrews,
+}
+
+/// `gravity`: a magnitude for the pendulums, a vector for mechanisms.
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(untagged)]
+pub enum GravitySpec {
+    Magnitude(f64),
+    Vector([f64; 2]),
 }
 
 #[derive(Debug, Deserialize)]
@@ -35,7 +56,7 @@ pub struct ModelSpec {
     pub kind: ModelKind,
     pub mass: Option<f64>,
     pub length: Option<f64>,
-    pub gravity: Option<f64>,
+    pub gravity: Option<GravitySpec>,
     pub theta0: Option<f64>,
     pub omega0: Option<f64>,
 }
@@ -48,6 +69,8 @@ pub struct InitialSpec {
     /// Start even if the initial state violates the constraints.
     #[serde(default)]
     pub off_constraint: bool,
+    /// Project the initial state onto the constraints first (default: on for mechanisms).
+    pub assemble: Option<bool>,
     pub tolerance: Option<f64>,
 }
 
@@ -146,11 +169,7 @@ pub fn load(path: &Path) -> Result<Scenario> {
 fn check(file: &str, key: &str, value: f64, positive: bool) -> Result<f64> {
     let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
     if !ok {
-        let what = if positive {
-            "finite and positive"
-        } else {
-            "finite and not negative"
-        };
+        let what = if positive { "finite and positive" } else { "finite and not negative" };
         bail!("{file}: {key} = {value}: must be {what}");
     }
     Ok(value)
@@ -165,10 +184,7 @@ impl Scenario {
         let h = check(file, "[integrator] h", i.h, true)?;
         let t_end = check(file, "[integrator] t_end", i.t_end, true)?;
         if t_end / h > 1e9 {
-            bail!(
-                "{file}: [integrator] t_end / h = {:e} steps is more than 1e9",
-                t_end / h
-            );
+            bail!("{file}: [integrator] t_end / h = {:e} steps is more than 1e9", t_end / h);
         }
         let scheme = match i.scheme {
             SchemeName::Euler => Scheme::Euler,
@@ -184,11 +200,8 @@ impl Scenario {
         if init.off_constraint {
             settings.consistency_tolerance = None;
         }
-        let mut example = self.example(file)?;
-        for (key, given, default) in [
-            ("q", &init.q, &mut example.q0),
-            ("v", &init.v, &mut example.v0),
-        ] {
+        let (mut example, rows) = self.example(file)?;
+        for (key, given, default) in [("q", &init.q, &mut example.q0), ("v", &init.v, &mut example.v0)] {
             if let Some(given) = given {
                 if given.len() != default.len() {
                     bail!(
@@ -203,61 +216,167 @@ impl Scenario {
                 default.clone_from(given);
             }
         }
+        let assembly = if init.assemble.unwrap_or(self.model.kind == ModelKind::Mechanism) {
+            let tolerance = settings.consistency_tolerance.unwrap_or(1e-9).min(1e-10);
+            let Example { model, q0, v0, .. } = &mut example;
+            Some(
+                assemble(model, q0, v0, 0.0, tolerance)
+                    .map_err(|e| anyhow!("{file}: [initial]: {e}{}", worst_entry(&example, &rows)))?,
+            )
+        } else {
+            None
+        };
+        if let Some(tolerance) = settings.consistency_tolerance {
+            let mut probe = cdyn::diagnostics::Probe::new(&example.model);
+            let m = probe.measure(&example.model, &example.q0, &example.v0, 0.0, 0.0, 0.0);
+            if m.phi.abs() > tolerance || m.phi_dot > tolerance {
+                bail!(
+                    "{file}: [initial]: the initial state violates the constraints: max |Φ| = {:.3e}, max |Φ̇| = {:.3e} (tolerance {tolerance:.1e}){}; set assemble = true to project it, or off_constraint = true to start there anyway",
+                    m.phi.abs(),
+                    m.phi_dot,
+                    worst_entry(&example, &rows)
+                );
+            }
+        }
         let every = match self.output.every {
             None => 1,
             Some(e) if e >= 1 => e as u64,
             Some(e) => bail!("{file}: [output] every = {e}: must be at least 1"),
         };
         let name = match &self.output.name {
-            Some(n)
-                if !n.is_empty()
-                    && n.chars()
-                        .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) =>
-            {
-                n.clone()
-            }
+            Some(n) if !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) => n.clone(),
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
-            None => path
-                .file_stem()
-                .map_or("run".into(), |s| s.to_string_lossy().into_owned()),
+            None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        Ok(Case {
-            name,
-            example,
-            settings,
-            t_end,
-            every,
-        })
+        Ok(Case { name, example, settings, t_end, every, assembly })
     }
 
-    fn example(&self, file: &str) -> Result<Example> {
+    /// The model with its initial state, and for mechanisms the entry
+    /// (`joints[2] (revolute)`) behind every constraint row.
+    fn example(&self, file: &str) -> Result<(Example, Vec<String>)> {
         let m = &self.model;
-        let d = PendulumParams::default();
-        let p = PendulumParams {
-            mass: check(file, "[model] mass", m.mass.unwrap_or(d.mass), true)?,
-            length: check(file, "[model] length", m.length.unwrap_or(d.length), true)?,
-            gravity: check(
-                file,
-                "[model] gravity",
-                m.gravity.unwrap_or(d.gravity),
-                false,
-            )?,
-            theta0: m.theta0.unwrap_or(d.theta0),
-            omega0: m.omega0.unwrap_or(d.omega0),
-        };
-        for (key, x) in [("theta0", p.theta0), ("omega0", p.omega0)] {
-            if !x.is_finite() {
-                bail!("{file}: [model] {key} = {x}: must be finite");
+        let mechanism_tables =
+            !(self.bodies.is_empty() && self.joints.is_empty() && self.drives.is_empty() && self.forces.is_empty());
+        if mechanism_tables && m.kind != ModelKind::Mechanism {
+            bail!("{file}: [[bodies]], [[joints]], [[drives]] and [[forces]] need [model] kind = \"mechanism\"");
+        }
+        let pendulum = matches!(m.kind, ModelKind::Pendulum | ModelKind::PendulumTheta);
+        for (key, set) in [
+            ("mass", m.mass.is_some()),
+            ("length", m.length.is_some()),
+            ("theta0", m.theta0.is_some()),
+            ("omega0", m.omega0.is_some()),
+        ] {
+            if set && !pendulum {
+                bail!("{file}: [model] {key} is only used by the pendulum models");
             }
         }
-        Ok(match m.kind {
-            ModelKind::Pendulum => cartesian_pendulum(p)?,
-            ModelKind::PendulumTheta => theta_pendulum(p)?,
-        })
+        match m.kind {
+            ModelKind::Pendulum | ModelKind::PendulumTheta => {
+                let d = PendulumParams::default();
+                let gravity = match m.gravity {
+                    None => d.gravity,
+                    Some(GravitySpec::Magnitude(g)) => check(file, "[model] gravity", g, false)?,
+                    Some(GravitySpec::Vector(_)) => {
+                        bail!("{file}: [model] gravity: the pendulum takes a magnitude (gravity acts along −Y)")
+                    }
+                };
+                let p = PendulumParams {
+                    mass: check(file, "[model] mass", m.mass.unwrap_or(d.mass), true)?,
+                    length: check(file, "[model] length", m.length.unwrap_or(d.length), true)?,
+                    gravity,
+                    theta0: m.theta0.unwrap_or(d.theta0),
+                    omega0: m.omega0.unwrap_or(d.omega0),
+                };
+                for (key, x) in [("theta0", p.theta0), ("omega0", p.omega0)] {
+                    if !x.is_finite() {
+                        bail!("{file}: [model] {key} = {x}: must be finite");
+                    }
+                }
+                let example = if m.kind == ModelKind::Pendulum { cartesian_pendulum(p)? } else { theta_pendulum(p)? };
+                Ok((example, Vec::new()))
+            }
+            ModelKind::Andrews => {
+                if m.gravity.is_some() {
+                    bail!("{file}: [model] gravity: Andrews' mechanism is defined without gravity");
+                }
+                Ok((cdyn::models::andrews()?, Vec::new()))
+            }
+            ModelKind::Mechanism => {
+                let gravity = match m.gravity {
+                    None => [0.0, 0.0],
+                    Some(GravitySpec::Vector(g)) if g.iter().all(|x| x.is_finite()) => g,
+                    Some(g) => bail!("{file}: [model] gravity = {g:?}: a mechanism takes a finite vector [gx, gy]"),
+                };
+                let spec = MechanismSpec {
+                    gravity,
+                    bodies: &self.bodies,
+                    joints: &self.joints,
+                    drives: &self.drives,
+                    forces: &self.forces,
+                };
+                let (mechanism, entries) = spec.build(file)?;
+                let built =
+                    mechanism.build().map_err(|e| anyhow!("{file}: {}", name_entry(&e.to_string(), &entries)))?;
+                let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
+                Ok((Example::from_mechanism(built, None), rows))
+            }
+        }
     }
 }
 
+/// Replaces the library's `element K (kind)` by the scenario's entry name.
+fn name_entry(message: &str, entries: &[String]) -> String {
+    for (k, entry) in entries.iter().enumerate().rev() {
+        let kind = entry.split_once(" (").map_or("", |(_, kind)| kind.trim_end_matches(')'));
+        let lib = format!("element {k} ({kind})");
+        if message.contains(&lib) {
+            return message.replace(&lib, entry);
+        }
+    }
+    message.to_string()
+}
+
+/// The entry behind the worst-violated constraint row, if known.
+fn worst_entry(example: &Example, rows: &[String]) -> String {
+    let model = &example.model;
+    let mut phi = vec![0.0; model.m()];
+    model.constraint_values(&example.q0, 0.0, &mut phi);
+    let worst = (0..phi.len()).max_by(|&a, &b| phi[a].abs().total_cmp(&phi[b].abs()));
+    worst.and_then(|r| rows.get(r)).map_or(String::new(), |e| format!(" (worst: {e})"))
+}
+
 impl MethodSpec {
+    /// Gains for `cdyn compare`: those the scenario gives, else target
+    /// rates `α_g = α_e = 0.4/h` (the paper's `hα = 0.4`) and Baumgarte
+    /// `β = 0.4/h`, critically damped.
+    pub fn gains(&self, file: &str, h: f64) -> Result<MethodGains> {
+        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
+        let rate = 0.4 / h;
+        let cvsgf = match (self.zeta, self.alpha_g) {
+            (Some(_), Some(_)) => bail!("{file}: [method] give zeta or alpha_g, not both"),
+            (Some(z), None) => Gain::Fixed(num("zeta", z)?),
+            (None, Some(a)) => Gain::Rate(num("alpha_g", a)?),
+            (None, None) => Gain::Rate(rate),
+        };
+        let energy = match (self.alpha_e, self.rho_q, self.rho_v) {
+            (Some(a), None, None) => EnergyGain::Rate { alpha_e: num("alpha_e", a)? },
+            (None, q, Some(v)) => EnergyGain::Fixed { rho_q: num("rho_q", q.unwrap_or(0.0))?, rho_v: num("rho_v", v)? },
+            (None, None, None) => EnergyGain::Rate { alpha_e: rate },
+            _ => bail!("{file}: [method] give alpha_e, or rho_v (and rho_q), not both"),
+        };
+        let (alpha, beta) = match (self.alpha, self.beta, self.omega, self.damping_ratio) {
+            (Some(a), Some(b), None, None) => (num("alpha", a)?, num("beta", b)?),
+            (None, None, Some(w), ratio) => {
+                let w = check(file, "[method] omega", w, true)?;
+                (2.0 * num("damping_ratio", ratio.unwrap_or(1.0))? * w, w * w)
+            }
+            (None, None, None, None) => (2.0 * rate.sqrt(), rate),
+            _ => bail!("{file}: [method] Baumgarte needs alpha and beta, or omega (and damping_ratio)"),
+        };
+        Ok(MethodGains { cvsgf, energy, baumgarte_alpha: alpha, baumgarte_beta: beta })
+    }
+
     /// The control law, refusing gains that the chosen methods do not use.
     fn control(&self, file: &str) -> Result<Control> {
         let used = |key: &str, value: Option<f64>, by: bool, method: &str| -> Result<()> {
@@ -267,50 +386,18 @@ impl MethodSpec {
             Ok(())
         };
         let g = self.geometric;
-        used(
-            "zeta",
-            self.zeta,
-            g == GeometricKind::Cvsgf,
-            "geometric = \"cvsgf\"",
-        )?;
-        used(
-            "alpha_g",
-            self.alpha_g,
-            g == GeometricKind::Cvsgf,
-            "geometric = \"cvsgf\"",
-        )?;
-        for (key, value) in [
-            ("alpha", self.alpha),
-            ("beta", self.beta),
-            ("omega", self.omega),
-            ("damping_ratio", self.damping_ratio),
-        ] {
-            used(
-                key,
-                value,
-                g == GeometricKind::Baumgarte,
-                "geometric = \"baumgarte\"",
-            )?;
+        used("zeta", self.zeta, g == GeometricKind::Cvsgf, "geometric = \"cvsgf\"")?;
+        used("alpha_g", self.alpha_g, g == GeometricKind::Cvsgf, "geometric = \"cvsgf\"")?;
+        for (key, value) in
+            [("alpha", self.alpha), ("beta", self.beta), ("omega", self.omega), ("damping_ratio", self.damping_ratio)]
+        {
+            used(key, value, g == GeometricKind::Baumgarte, "geometric = \"baumgarte\"")?;
         }
         let e = self.energy;
-        for (key, value) in [
-            ("alpha_e", self.alpha_e),
-            ("rho_q", self.rho_q),
-            ("rho_v", self.rho_v),
-        ] {
-            used(
-                key,
-                value,
-                e == EnergyKind::Gradient,
-                "energy = \"gradient\"",
-            )?;
+        for (key, value) in [("alpha_e", self.alpha_e), ("rho_q", self.rho_q), ("rho_v", self.rho_v)] {
+            used(key, value, e == EnergyKind::Gradient, "energy = \"gradient\"")?;
         }
-        used(
-            "eta",
-            self.eta,
-            e == EnergyKind::Baumgarte,
-            "energy = \"baumgarte\"",
-        )?;
+        used("eta", self.eta, e == EnergyKind::Baumgarte, "energy = \"baumgarte\"")?;
         let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
 
         let geometric = match g {
@@ -318,45 +405,34 @@ impl MethodSpec {
             GeometricKind::Cvsgf => match (self.zeta, self.alpha_g) {
                 (Some(z), None) => Geometric::Gradient(Gain::Fixed(num("zeta", z)?)),
                 (None, Some(a)) => Geometric::Gradient(Gain::Rate(num("alpha_g", a)?)),
+                _ => bail!("{file}: [method] geometric = \"cvsgf\" needs exactly one of zeta, alpha_g"),
+            },
+            GeometricKind::Baumgarte => match (self.alpha, self.beta, self.omega, self.damping_ratio) {
+                (Some(a), Some(b), None, None) => {
+                    Geometric::Baumgarte { alpha: num("alpha", a)?, beta: num("beta", b)? }
+                }
+                (None, None, Some(w), ratio) => {
+                    let w = check(file, "[method] omega", w, true)?;
+                    Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)?
+                }
                 _ => bail!(
-                    "{file}: [method] geometric = \"cvsgf\" needs exactly one of zeta, alpha_g"
+                    "{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega (and damping_ratio, default 1)"
                 ),
             },
-            GeometricKind::Baumgarte => {
-                match (self.alpha, self.beta, self.omega, self.damping_ratio) {
-                    (Some(a), Some(b), None, None) => Geometric::Baumgarte {
-                        alpha: num("alpha", a)?,
-                        beta: num("beta", b)?,
-                    },
-                    (None, None, Some(w), ratio) => {
-                        let w = check(file, "[method] omega", w, true)?;
-                        Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)?
-                    }
-                    _ => bail!(
-                        "{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega (and damping_ratio, default 1)"
-                    ),
-                }
-            }
         };
         let energy = match e {
             EnergyKind::None => Energy::None,
             EnergyKind::Baumgarte => match self.eta {
-                Some(eta) => Energy::Baumgarte {
-                    eta: num("eta", eta)?,
-                },
+                Some(eta) => Energy::Baumgarte { eta: num("eta", eta)? },
                 None => bail!("{file}: [method] energy = \"baumgarte\" needs eta"),
             },
             EnergyKind::Gradient => match (self.alpha_e, self.rho_q, self.rho_v) {
-                (Some(a), None, None) => Energy::Gradient(EnergyGain::Rate {
-                    alpha_e: num("alpha_e", a)?,
-                }),
+                (Some(a), None, None) => Energy::Gradient(EnergyGain::Rate { alpha_e: num("alpha_e", a)? }),
                 (None, q, Some(v)) => Energy::Gradient(EnergyGain::Fixed {
                     rho_q: num("rho_q", q.unwrap_or(0.0))?,
                     rho_v: num("rho_v", v)?,
                 }),
-                _ => bail!(
-                    "{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q, default 0)"
-                ),
+                _ => bail!("{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q, default 0)"),
             },
         };
         let application = match self.apply {
@@ -364,10 +440,6 @@ impl MethodSpec {
             Apply::ForwardEuler => Application::ForwardEuler,
             Apply::BackwardEuler => Application::BackwardEuler,
         };
-        Ok(Control {
-            geometric,
-            energy,
-            application,
-        })
+        Ok(Control { geometric, energy, application })
     }
 }

@@ -126,6 +126,11 @@ impl ModelBuilder {
         self
     }
 
+    /// Constraint rows added so far.
+    pub fn rows(&self) -> usize {
+        self.constraints.iter().map(|b| b.rows()).sum()
+    }
+
     pub fn build(self) -> Result<Model> {
         if let Some(e) = self.error {
             return Err(e);

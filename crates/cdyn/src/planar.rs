@@ -134,6 +134,8 @@ pub struct Built {
     pub names: Vec<String>,
     /// Index of each body's first coordinate.
     pub offsets: Vec<usize>,
+    /// For every constraint row, the index of the element it comes from.
+    pub row_elements: Vec<usize>,
 }
 
 impl Mechanism {
@@ -250,18 +252,14 @@ impl Mechanism {
                 builder = builder.potential(Gravity { w }, [offsets[i], offsets[i] + 1]);
             }
         }
+        let mut row_elements = Vec::new();
         for (k, e) in self.elements.iter().enumerate() {
             builder = self
                 .add_element(builder, e, &offsets)
                 .map_err(|why| Error::InvalidModel(format!("element {k} ({}): {why}", e.kind())))?;
+            row_elements.resize(builder.rows(), k);
         }
-        Ok(Built {
-            model: builder.build()?,
-            q0,
-            v0,
-            names,
-            offsets,
-        })
+        Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements })
     }
 
     /// Where a body's coordinates are and what it is, for one end of an element.
