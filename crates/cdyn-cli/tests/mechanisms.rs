@@ -1,0 +1,125 @@
+//! Mechanism scenario files: the shipped Andrews file reproduces the test
+//! set, `compare` runs every method, and mistakes name the entry.
+
+use cdyn::models::andrews::{body_angles, constants, test_set_angles};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
+}
+
+fn cdyn(args: &[&str], scenario: &Path, out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cdyn")).args(args).arg(scenario).arg("--out").arg(out).output().unwrap()
+}
+
+fn summary(dir: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+#[test]
+fn the_andrews_scenario_file_reproduces_the_published_positions() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = cdyn(&["run"], &examples().join("andrews.toml"), dir.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = summary(dir.path());
+    let q = floats(&s["cases"][0]["q_end"]);
+    let angles = test_set_angles(body_angles(&q));
+    for (i, (a, b)) in angles.iter().zip(constants::Q_REF_003).enumerate() {
+        assert!(((a - b) / b).abs() < 1e-6, "angle {i}: {a} vs published {b}");
+    }
+}
+
+#[test]
+fn compare_runs_every_method_and_reports_final_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = cdyn(&["compare"], &examples().join("four_bar.toml"), dir.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = summary(dir.path());
+    let names: Vec<&str> = s["cases"].as_array().unwrap().iter().map(|c| c["name"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        ["none", "baumgarte", "cvsgf", "energy", "baumgarte_energy", "cvsgf_energy", "cvsgf_energy_backward"]
+    );
+    for c in s["cases"].as_array().unwrap() {
+        assert_eq!(floats(&c["q_end"]).len(), 9);
+        assert_eq!(floats(&c["v_end"]).len(), 9);
+        assert!(c["max_abs_phi"].as_f64().unwrap().is_finite());
+        assert!(dir.path().join(format!("{}.csv", c["name"].as_str().unwrap())).exists());
+    }
+    // The gains used are recorded, and the assembly.
+    assert_eq!(s["methods"].as_array().unwrap().len(), 7);
+    assert!(s["assembly"]["max_abs_phi_after"].as_f64().unwrap() < 1e-10);
+    for fig in ["phi.png", "psi.svg"] {
+        assert!(dir.path().join(fig).exists());
+    }
+}
+
+const CRANK: &str = r#"
+[model]
+kind = "mechanism"
+gravity = [0.0, -9.81]
+[integrator]
+scheme = "rk4"
+h = 0.001
+t_end = 0.1
+[[bodies]]
+name = "crank"
+mass = 1.0
+inertia = 0.1
+position = [0.5, 0.0]
+[[joints]]
+kind = "revolute"
+a = "ground"
+b = "crank"
+point_b = [-0.5, 0.0]
+"#;
+
+fn error_of(text: &str) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mech.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = cdyn(&["run"], &path, &dir.path().join("out"));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!out.status.success(), "expected failure:\n{text}");
+    assert!(!stderr.contains("panicked") && stderr.trim_end().lines().count() == 1, "{stderr}");
+    assert!(stderr.contains("mech.toml"), "{stderr}");
+    stderr
+}
+
+#[test]
+fn a_good_mechanism_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mech.toml");
+    std::fs::write(&path, CRANK).unwrap();
+    let out = cdyn(&["run"], &path, &dir.path().join("out"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("assembly:"));
+}
+
+#[test]
+fn mechanism_mistakes_name_the_entry() {
+    let cases: Vec<(String, &[&str])> = vec![
+        (CRANK.replace("b = \"crank\"", "b = \"crunk\""), &["joints[0] (revolute)", "crunk"]),
+        (CRANK.replace("mass = 1.0", "mass = 0.0"), &["bodies[0] (crank)", "mass"]),
+        (CRANK.replace("mass = 1.0\n", ""), &["mass"]),
+        (CRANK.replace("kind = \"revolute\"", "kind = \"hinge\""), &["joints[0]", "hinge", "revolute"]),
+        (CRANK.replace("point_b = [-0.5, 0.0]", "point_b = [-0.5, 0.0]\nlength = 2.0"), &["joints[0] (revolute)", "length"]),
+        (CRANK.replace("inertia = 0.1\n", "inertia = 0.1\nangle = nan\n"), &["bodies[0] (crank)", "NaN"]),
+        (format!("{CRANK}[[joints]]\nkind = \"distance\"\na = \"ground\"\nb = \"crank\"\nlength = 3.0\n"), &["[initial]", "joints[1] (distance)"]),
+        (format!("{CRANK}[[forces]]\nkind = \"spring\"\na = \"crank\"\nb = \"crank\"\nstiffness = 1.0\n"), &["forces[0] (spring)", "itself"]),
+        (CRANK.replace("gravity = [0.0, -9.81]", "gravity = 9.81"), &["gravity"]),
+        (CRANK.replace("kind = \"mechanism\"", "kind = \"pendulum\""), &["mechanism"]),
+    ];
+    for (text, needles) in cases {
+        let line = error_of(&text);
+        for n in needles {
+            assert!(line.contains(n), "{line:?} should mention {n:?} for:\n{text}");
+        }
+    }
+}
