@@ -1,8 +1,8 @@
 //! What the system does, uncontrolled: `Φ`, `Φ_q`, `γ`, the multipliers
 //! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
 
-pub use crate::linalg::Breakdown;
-use crate::linalg::DenseSchur;
+pub use crate::linalg::{Breakdown, LinearSolver};
+use crate::linalg::Schur;
 use crate::model::{Model, Pattern};
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
@@ -28,11 +28,16 @@ pub struct Dynamics {
     pub lambda: Vec<f64>,
     /// `A = M⁻¹ (G − Φ_qᵀ λ)` of Eq. 8.
     pub acc: Vec<f64>,
-    schur: DenseSchur,
+    schur: Schur,
 }
 
 impl Dynamics {
     pub fn new(model: &Model) -> Self {
+        Self::with_solver(model, LinearSolver::Auto)
+    }
+
+    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ`.
+    pub fn with_solver(model: &Model, solver: LinearSolver) -> Self {
         let (n, m) = (model.n(), model.m());
         Self {
             phi: vec![0.0; m],
@@ -45,7 +50,7 @@ impl Dynamics {
             force_power: 0.0,
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
-            schur: DenseSchur::new(model.pattern(), n),
+            schur: Schur::new(model.pattern(), n, solver),
         }
     }
 

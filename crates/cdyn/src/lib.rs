@@ -17,6 +17,7 @@ pub mod planar;
 pub mod reference;
 pub mod scalar;
 pub mod simulate;
+mod sparse;
 pub mod system;
 pub mod timefn;
 

@@ -5,6 +5,7 @@
 //! seen every step before it.
 
 use crate::control::Control;
+use crate::dynamics::LinearSolver;
 use crate::diagnostics::{Measures, Probe};
 use crate::error::{Error, Result, positive};
 use crate::integrate::{Integrator, Rhs, Scheme};
@@ -21,6 +22,8 @@ pub struct Settings {
     pub consistency_tolerance: Option<f64>,
     /// Stop when `max |Φ|` exceeds this.
     pub violation_limit: f64,
+    /// Dense or sparse factorization of `Φ_q M⁻¹ Φ_qᵀ` (default: by size).
+    pub solver: LinearSolver,
 }
 
 impl Settings {
@@ -31,6 +34,7 @@ impl Settings {
             control,
             consistency_tolerance: Some(1e-9),
             violation_limit: f64::INFINITY,
+            solver: LinearSolver::Auto,
         }
     }
 
@@ -100,7 +104,7 @@ impl<'m> Simulation<'m> {
                 });
             }
         }
-        let system = ControlledSystem::new(model, settings.control, e0);
+        let system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
         let integrator = Integrator::new(
             settings.scheme,
             settings.control.application,

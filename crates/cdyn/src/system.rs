@@ -2,7 +2,7 @@
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
 use crate::control::Control;
-use crate::dynamics::{Breakdown, Dynamics};
+use crate::dynamics::{Breakdown, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::Rhs;
 use crate::model::Model;
@@ -36,10 +36,15 @@ pub struct ControlledSystem<'m> {
 
 impl<'m> ControlledSystem<'m> {
     pub fn new(model: &'m Model, control: Control, e0: f64) -> Self {
+        Self::with_solver(model, control, e0, LinearSolver::Auto)
+    }
+
+    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ`.
+    pub fn with_solver(model: &'m Model, control: Control, e0: f64, solver: LinearSolver) -> Self {
         Self {
             model,
             control,
-            dynamics: Dynamics::new(model),
+            dynamics: Dynamics::with_solver(model, solver),
             e0,
             scratch: vec![0.0; model.m()],
             evaluations: 0,

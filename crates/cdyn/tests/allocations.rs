@@ -3,7 +3,10 @@
 //! Example 1 and on a mechanism with every kind of element.
 
 use cdyn::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
-use cdyn::models::{PendulumParams, andrews, cartesian_pendulum};
+use cdyn::dynamics::LinearSolver;
+use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum};
+use cdyn::planar::{Coordinate, Element, Mechanism};
+use cdyn::timefn::TimeFn;
 use cdyn::{Scheme, Settings, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -29,6 +32,28 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
+/// A chain of point masses on rods with a damper and a driven support: every
+/// kind of element on the sparse path.
+fn hanging_chain(n: usize) -> Example {
+    let mut m = Mechanism::new([0.0, -9.81]);
+    let support = m.rigid("support", 1.0, 0.1, [0.0, 0.0], 0.0);
+    // Everything starts moving with the support: ẋ = 0.3 at t = 0.
+    m.bodies[0].velocity = [0.3, 0.0];
+    m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::X, f: TimeFn { polynomial: vec![], sines: vec![[0.1, 3.0, 0.0]] } });
+    m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::Y, f: TimeFn::constant(0.0) });
+    m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::Angle, f: TimeFn::constant(0.0) });
+    let mut prev = support;
+    for i in 0..n {
+        let body = m.point(&format!("m{i}"), 1.0, [0.0, -0.1 * (i + 1) as f64]);
+        m.bodies[i + 1].velocity = [0.3, 0.0];
+        m.add(Element::Distance { a: prev, pa: [0.0; 2], b: body, pb: [0.0; 2], length: 0.1 });
+        m.add(Element::Damper { a: prev, pa: [0.0; 2], b: body, pb: [0.0; 2], damping: 0.1 });
+        prev = body;
+    }
+    m.add(Element::AppliedForce { body: prev, point: [0.0; 2], fx: TimeFn::linear(0.0, 1.0), fy: TimeFn::constant(0.0) });
+    Example::from_mechanism(m.build().unwrap(), None)
+}
+
 fn controls() -> Vec<Control> {
     let mut out = Vec::new();
     for geometric in [Geometric::None, Geometric::Baumgarte { alpha: 12.6, beta: 40.0 }, Geometric::Gradient(Gain::Rate(40.0))] {
@@ -42,7 +67,7 @@ fn controls() -> Vec<Control> {
 }
 
 /// Allocations during `steps` steps (and samples) after `warm_up` steps.
-fn allocations_per_run(ex: &cdyn::models::Example, settings: Settings, warm_up: usize, steps: usize) -> usize {
+fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: usize) -> usize {
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
     for _ in 0..warm_up {
         sim.step().unwrap();
@@ -62,18 +87,26 @@ fn steps_do_not_allocate() {
     let before = ALLOCATIONS.load(Ordering::SeqCst);
     let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
     let andrews = andrews().unwrap();
+    let chain = hanging_chain(64);
     assert!(ALLOCATIONS.load(Ordering::SeqCst) > before);
     for scheme in Scheme::ALL {
         for control in controls() {
             let n = allocations_per_run(&pendulum, Settings::new(scheme, 0.01, control), 5, 200);
             assert_eq!(n, 0, "pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
-        let control = Control {
-            geometric: Geometric::Gradient(Gain::Rate(4e4)),
-            energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 4e4 }),
+        // Rates with hα = 0.4, as in the paper.
+        let control = |h: f64| Control {
+            geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
+            energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
             application: Application::ForwardEuler,
         };
-        let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, control), 5, 200);
+        let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, control(1e-5)), 5, 200);
         assert_eq!(n, 0, "andrews, {scheme:?}: {n} allocations in 200 steps");
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut settings = Settings::new(scheme, 1e-3, control(1e-3));
+            settings.solver = solver;
+            let n = allocations_per_run(&chain, settings, 5, 200);
+            assert_eq!(n, 0, "chain, {scheme:?}, {solver:?}: {n} allocations in 200 steps");
+        }
     }
 }
