@@ -1,6 +1,8 @@
 //! `cdyn`: constrained dynamics with gradient-feedback stabilization,
 //! from the command line.
 
+mod alloc_count;
+mod bench;
 mod compare;
 mod mechanism_spec;
 mod paper;
@@ -13,6 +15,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+#[global_allocator]
+static ALLOCATOR: alloc_count::Counting = alloc_count::Counting;
 
 #[derive(Parser)]
 #[command(
@@ -40,6 +45,15 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
+    Bench {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// A quick smoke run with few steps (for CI; the numbers mean little).
+        #[arg(long)]
+        light: bool,
     },
     /// Run a scenario file.
     Run {
@@ -91,6 +105,16 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", report::table(&results));
             println!("wrote {}", out.display());
             fail_on_error(&results, &out)
+        }
+        Command::Bench { out, light } => {
+            output_dir(&out)?;
+            let report = bench::run(light)?;
+            let path = out.join("bench.json");
+            std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            print!("{}", bench::table(&report));
+            println!("wrote {}", path.display());
+            Ok(())
         }
         Command::Compare { scenario, out } => {
             let parsed = scenario::load(&scenario)?;

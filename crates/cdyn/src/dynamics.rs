@@ -1,7 +1,7 @@
 //! What the system does, uncontrolled: `Φ`, `Φ_q`, `γ`, the multipliers
 //! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
 
-pub use crate::linalg::{Breakdown, LinearSolver};
+pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
 use crate::linalg::Schur;
 use crate::model::{Model, Pattern};
 

@@ -1,6 +1,7 @@
 #![doc = include_str!("../../../README.md")]
 
 pub mod assemble;
+pub mod baseline;
 pub mod constraint;
 pub mod control;
 pub mod diagnostics;

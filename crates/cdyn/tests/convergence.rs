@@ -77,3 +77,23 @@ fn cartesian_and_angle_models_agree_for_other_parameters() {
         assert!(e < 1e-9, "n = {}: max |X − X*| = {e:e}", ex.model.n());
     }
 }
+
+#[test]
+fn the_hand_written_baseline_follows_cdyn_step_for_step() {
+    // The benchmark compares cdyn with this baseline: it must compute the same thing.
+    use cdyn::baseline::HandWritten;
+    use cdyn::methods::{MethodGains, redundant_cases};
+    let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
+    let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
+    let mut sim = Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
+    let mut hand = HandWritten::new([1.0, 0.0, 0.0, 2.0], 0.01, 20.0, 40.0);
+    for step in 0..2000 {
+        sim.step().unwrap();
+        hand.step();
+        let (q, v) = (sim.q(), sim.v());
+        let cdyn = [q[0], q[1], v[0], v[1]];
+        for i in 0..4 {
+            assert!((cdyn[i] - hand.x[i]).abs() < 1e-12, "step {step}, component {i}: {} vs {}", cdyn[i], hand.x[i]);
+        }
+    }
+}
