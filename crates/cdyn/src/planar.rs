@@ -696,6 +696,7 @@ enum End {
 
 impl End {
     /// World position of the point.
+    #[inline(always)]
     fn position<D: Scalar>(&self, x: &[D]) -> [D; 2] {
         match *self {
             End::Ground { point } => [D::from(point[0]), D::from(point[1])],
@@ -711,6 +712,7 @@ impl End {
     }
 
     /// World velocity of the point.
+    #[inline(always)]
     fn velocity<D: Scalar>(&self, x: &[D], xd: &[D]) -> [D; 2] {
         match *self {
             End::Ground { .. } => [D::from(0.0); 2],
@@ -727,6 +729,7 @@ impl End {
     }
 
     /// Adds the generalized force of a world force `f` applied at the point.
+    #[inline(always)]
     fn apply<D: Scalar>(&self, x: &[D], f: [D; 2], out: &mut [D]) {
         match *self {
             End::Ground { .. } => {}
@@ -748,6 +751,7 @@ impl End {
     }
 
     /// The angle of the end's body (0 for the ground).
+    #[inline(always)]
     fn angle<D: Scalar>(&self, x: &[D]) -> D {
         match *self {
             End::Rigid { at, .. } => x[at + 2],
@@ -756,6 +760,7 @@ impl End {
     }
 }
 
+#[inline(always)]
 fn angle_of<D: Scalar>(at: Option<usize>, x: &[D]) -> D {
     at.map_or(D::from(0.0), |i| x[i])
 }

@@ -18,7 +18,7 @@ use std::cell::RefCell;
 
 pub(crate) struct SparseSchur {
     m: usize,
-    /// Lower triangle of `S` in compressed columns.
+    /// Upper triangle of `S` in compressed columns.
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     values: Vec<f64>,
@@ -36,14 +36,16 @@ impl SparseSchur {
     pub fn new(pattern: &Pattern, n: usize) -> Self {
         let m = pattern.start.len() - 1;
         let mut products = products(pattern, n);
-        // Column-major lower triangle: sort by (column b, row a).
-        products.sort_by_key(|&(a, b, ..)| (b, a));
+        // Upper triangle by columns (entry (b, a), b ≤ a, in column a): the
+        // layout faer's simplicial factorization works in, so an unpermuted
+        // factorization reads it as it is.
+        products.sort_by_key(|&(a, b, ..)| (a, b));
         let (mut col_ptr, mut row_idx, mut terms) = (vec![0; m + 1], Vec::new(), Vec::new());
         let mut last = None;
         for &(a, b, ja, jb, col) in &products {
             if last != Some((a, b)) {
-                row_idx.push(a);
-                col_ptr[b + 1] += 1;
+                row_idx.push(b);
+                col_ptr[a + 1] += 1;
                 last = Some((a, b));
             }
             terms.push((row_idx.len() - 1, ja, jb, col));
@@ -51,15 +53,21 @@ impl SparseSchur {
         for j in 0..m {
             col_ptr[j + 1] += col_ptr[j];
         }
-        let diag_slot = (0..m).map(|j| col_ptr[j]).collect::<Vec<_>>();
+        let diag_slot = (0..m).map(|j| col_ptr[j + 1] - 1).collect::<Vec<_>>();
         let structure = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
         let params = CholeskySymbolicParams {
             // Simplicial: chains and trees have narrow fronts, and its factor's layout is plain CSC.
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_cholesky(structure, Side::Lower, SymmetricOrdering::Amd, params)
-            .expect("symbolic Cholesky of a valid pattern");
+        // AMD, unless the natural order fills no more: chains and trees are
+        // often already ordered, and then the per-step permutation is saved.
+        let analyse = |ordering| {
+            factorize_symbolic_cholesky(structure, Side::Upper, ordering, params).expect("symbolic Cholesky of a valid pattern")
+        };
+        let amd = analyse(SymmetricOrdering::Amd);
+        let natural = analyse(SymmetricOrdering::Identity);
+        let symbolic = if natural.len_val() <= amd.len_val() { natural } else { amd };
         let l_diag = match symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => (0..m)
                 .map(|j| {
@@ -104,7 +112,7 @@ impl SparseSchur {
         match self.symbolic.factorize_numeric_llt(
             &mut self.l_values,
             s,
-            Side::Lower,
+            Side::Upper,
             LltRegularization::default(),
             Par::Seq,
             MemStack::new(stack),
