@@ -119,7 +119,8 @@ impl SparseSchur {
             Default::default(),
         ) {
             Ok(_) => {}
-            Err(LltError::NonPositivePivot { index }) => return Err(Breakdown::Singular(original(index))),
+            // faer counts the pivot from 1.
+            Err(LltError::NonPositivePivot { index }) => return Err(Breakdown::Singular(original(index - 1))),
         }
         // faer only refuses non-positive pivots; a dependent row leaves a
         // round-off-sized one. Apply the dense solver's relative test.

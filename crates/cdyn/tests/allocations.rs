@@ -9,22 +9,29 @@ use cdyn::planar::{Coordinate, Element, Mechanism};
 use cdyn::timefn::TimeFn;
 use cdyn::{Scheme, Settings, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Allocations made by this thread: other threads of the test harness do not count.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -72,23 +79,23 @@ fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: 
     for _ in 0..warm_up {
         sim.step().unwrap();
     }
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = count();
     for _ in 0..steps {
         sim.step().unwrap();
         std::hint::black_box(sim.measure());
     }
-    ALLOCATIONS.load(Ordering::SeqCst) - before
+    count() - before
 }
 
 // One test function, so no other test thread allocates while we count.
 #[test]
 fn steps_do_not_allocate() {
     // The counter does count: building the models allocates.
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = count();
     let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
     let andrews = andrews().unwrap();
     let chain = hanging_chain(64);
-    assert!(ALLOCATIONS.load(Ordering::SeqCst) > before);
+    assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
             let n = allocations_per_run(&pendulum, Settings::new(scheme, 0.01, control), 5, 200);
