@@ -3,6 +3,7 @@
 
 mod alloc_count;
 mod bench;
+mod builtin_spec;
 mod compare;
 mod mechanism_spec;
 mod paper;
@@ -40,7 +41,7 @@ enum Command {
     },
     /// Run one model under every stabilization method of `cdyn paper`.
     Compare {
-        /// The scenario (TOML); its [method] gains, if any, are used, else target rates 0.4/h.
+        /// The scenario (TOML); its [method] gains, if any, are used, else target rates 0.2/h.
         scenario: PathBuf,
         /// Output directory (created if missing).
         #[arg(long)]

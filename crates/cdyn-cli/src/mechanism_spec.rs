@@ -62,7 +62,7 @@ pub enum FunctionSpec {
 }
 
 impl FunctionSpec {
-    fn time_fn(&self) -> TimeFn {
+    pub fn time_fn(&self) -> TimeFn {
         match self {
             FunctionSpec::Constant(c) => TimeFn::constant(*c),
             FunctionSpec::Terms { polynomial, sine } => TimeFn { polynomial: polynomial.clone(), sines: sine.clone() },

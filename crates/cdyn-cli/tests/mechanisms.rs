@@ -115,6 +115,8 @@ fn mechanism_mistakes_name_the_entry() {
         (format!("{CRANK}[[forces]]\nkind = \"spring\"\na = \"crank\"\nb = \"crank\"\nstiffness = 1.0\n"), &["forces[0] (spring)", "itself"]),
         (CRANK.replace("gravity = [0.0, -9.81]", "gravity = 9.81"), &["gravity"]),
         (CRANK.replace("kind = \"mechanism\"", "kind = \"pendulum\""), &["mechanism"]),
+        ("[model]\nkind = \"chain\"\n[model.parameters]\nlinks = 3\n[integrator]\nscheme = \"rk4\"\nh = 0.01\nt_end = 1.0\n".into(), &["[model.parameters]", "links", "n, mass"]),
+        ("[model]\nkind = \"chain\"\n[model.parameters]\nn = 2.5\n[integrator]\nscheme = \"rk4\"\nh = 0.01\nt_end = 1.0\n".into(), &["n = 2.5"]),
     ];
     for (text, needles) in cases {
         let line = error_of(&text);

@@ -206,6 +206,9 @@ impl Mechanism {
     /// The model, its initial state and coordinate names. Errors name the
     /// body or element (by position, from 0) at fault.
     pub fn build(&self) -> Result<Built> {
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err(Error::InvalidModel(format!("gravity {:?} must be finite", self.gravity)));
+        }
         let mut mass = Vec::new();
         let (mut q0, mut v0, mut names, mut offsets) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
