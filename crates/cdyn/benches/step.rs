@@ -1,0 +1,61 @@
+//! Cost of one step: Example 1 (cdyn against the hand-written baseline) and
+//! the N-link chain. `cargo bench -p cdyn` measures; `cargo test --benches`
+//! (CI) runs each benchmark once as a smoke test. Set `CDYN_BENCH_FULL=1`
+//! to add the 10 000-body chain. `cdyn bench` reports the same quantities
+//! as JSON.
+
+use cdyn::baseline::HandWritten;
+use cdyn::methods::{MethodGains, redundant_cases};
+use cdyn::models::{ChainParams, PendulumParams, cartesian_pendulum, chain};
+use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+
+fn example1(c: &mut Criterion) {
+    let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
+    let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
+    let mut group = c.benchmark_group("example1_cvsgf_energy_ab3");
+    let mut sim = Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
+    group.bench_function("cdyn", |b| b.iter(|| sim.step().unwrap()));
+    let mut hand = HandWritten::new([1.0, 0.0, 0.0, 2.0], 0.01, 20.0, 40.0);
+    group.bench_function("hand_written", |b| {
+        b.iter(|| {
+            hand.step();
+            black_box(&hand.x);
+        })
+    });
+    group.finish();
+}
+
+fn chains(c: &mut Criterion) {
+    let mut sizes = vec![10, 100, 1000];
+    if std::env::var_os("CDYN_BENCH_FULL").is_some() {
+        sizes.push(10_000);
+    }
+    let h = 1e-3;
+    let control = Control {
+        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
+        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
+        application: Application::ForwardEuler,
+    };
+    let mut group = c.benchmark_group("chain_cvsgf_energy_ab3");
+    for n in sizes {
+        let ex = chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 }).unwrap();
+        let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
+        let start = || Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+        let mut sim = start();
+        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| {
+                // Restart after 10 s of motion, the interval the chain is known to behave over.
+                if sim.steps() == 10_000 {
+                    sim = start();
+                }
+                sim.step().unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, example1, chains);
+criterion_main!(benches);
