@@ -139,7 +139,8 @@ fn fitted_exponent(points: &[(f64, f64)]) -> Option<f64> {
 /// Runs every measurement; `light` for a quick smoke run (CI), not for numbers.
 pub fn run(light: bool) -> Result<Report> {
     let example1 = example1(light)?;
-    let (sizes, t_end): (&[usize], f64) = if light { (&[10, 100, 1000], 0.05) } else { (&[10, 100, 1000, 10_000], 10.0) };
+    let (sizes, t_end): (&[usize], f64) =
+        if light { (&[10, 100, 1000], 0.05) } else { (&[10, 100, 1000, 10_000], 10.0) };
     let chain = sizes.iter().map(|&n| chain_run(n, t_end)).collect::<Result<Vec<_>>>()?;
     let fit: Vec<(f64, f64)> = chain.iter().filter(|c| c.n >= 100).map(|c| (c.n as f64, c.us_per_step)).collect();
     let max_allocations_per_step =
@@ -157,7 +158,8 @@ pub fn table(r: &Report) -> String {
     out += "N-link chain, CVSGF + energy, AB-3, h = 1e-3:\n";
     out += &format!("  {:>6} {:>8} {:>12} {:>12} {:>8}\n", "N", "steps", "µs/step", "max|Φ|", "solver");
     for c in &r.chain {
-        out += &format!("  {:>6} {:>8} {:>12.2} {:>12.3e} {:>8}\n", c.n, c.steps, c.us_per_step, c.max_abs_phi, c.solver);
+        out +=
+            &format!("  {:>6} {:>8} {:>12.2} {:>12.3e} {:>8}\n", c.n, c.steps, c.us_per_step, c.max_abs_phi, c.solver);
     }
     if let Some(p) = r.chain_cost_exponent {
         out += &format!("  cost exponent (N ≥ 100): {p:.3}\n");

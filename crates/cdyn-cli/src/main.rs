@@ -5,12 +5,14 @@ mod alloc_count;
 mod bench;
 mod builtin_spec;
 mod compare;
+mod heatmap;
 mod mechanism_spec;
 mod paper;
 mod plot;
 mod report;
 mod runner;
 mod scenario;
+mod sweep;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -55,6 +57,29 @@ enum Command {
         /// A quick smoke run with few steps (for CI; the numbers mean little).
         #[arg(long)]
         light: bool,
+    },
+    /// Run a grid over gains and step sizes (the scenario's [sweep] table) in parallel; writes sweep.json and heat maps.
+    Sweep {
+        /// The scenario (TOML) with a [sweep] table, e.g. alpha_g = [10, 20, 40].
+        scenario: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Run only shard I of N (grid points with index % N == I); join shards with `cdyn merge`.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Worker threads (default: one per core). Results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Join the sweep.json files of the shards of one sweep into the complete result.
+    Merge {
+        /// Shard output directories (or their sweep.json files).
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Run a scenario file.
     Run {
@@ -115,6 +140,36 @@ fn run(cli: Cli) -> Result<()> {
                 .with_context(|| format!("cannot write {}", path.display()))?;
             print!("{}", bench::table(&report));
             println!("wrote {}", path.display());
+            Ok(())
+        }
+        Command::Sweep { scenario, out, shard, threads } => {
+            let parsed = scenario::load(&scenario)?;
+            let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
+            if threads == Some(0) {
+                bail!("--threads 0: need at least one thread");
+            }
+            let result = sweep::run(&parsed, &scenario, shard, threads)?;
+            output_dir(&out)?;
+            sweep::write(&result, &out)?;
+            print!("{}", sweep::table(&result));
+            println!("wrote {}", out.join("sweep.json").display());
+            Ok(())
+        }
+        Command::Merge { parts, out } => {
+            let parts = parts
+                .iter()
+                .map(|p| {
+                    let file = if p.is_dir() { p.join("sweep.json") } else { p.clone() };
+                    let text =
+                        std::fs::read_to_string(&file).with_context(|| format!("cannot read {}", file.display()))?;
+                    serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let merged = sweep::merge(parts)?;
+            output_dir(&out)?;
+            sweep::write(&merged, &out)?;
+            print!("{}", sweep::table(&merged));
+            println!("wrote {}", out.join("sweep.json").display());
             Ok(())
         }
         Command::Compare { scenario, out } => {

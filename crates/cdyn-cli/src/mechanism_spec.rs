@@ -7,7 +7,7 @@ use cdyn::planar::{Body, BodyId, Coordinate, Element, Mechanism};
 use cdyn::timefn::TimeFn;
 use serde::Deserialize;
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
@@ -24,7 +24,7 @@ pub struct BodySpec {
 }
 
 /// A joint, drive or force entry: one flat table whose keys depend on `kind`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct ElementSpec {
     pub kind: String,

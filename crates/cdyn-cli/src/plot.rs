@@ -25,6 +25,7 @@ pub struct Series {
 
 /// How the y axis maps values.
 pub enum Scale {
+    #[allow(dead_code)] // the figures cdyn writes are all logarithmic today
     Linear,
     /// log10 of |y|; points with y == 0 or non-finite are skipped
     LogAbs,
@@ -51,10 +52,7 @@ const PALETTE: [u32; 10] =
 
 /// Writes `<stem>.png` (1200x800) and `<stem>.svg`. `stem` is a path without extension.
 pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
-    static FONT_OK: OnceLock<bool> = OnceLock::new();
-    if !*FONT_OK.get_or_init(|| register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok()) {
-        bail!("the embedded DejaVuSans.ttf could not be loaded");
-    }
+    ensure_font()?;
     let data = prepare(fig);
     let (png, svg) = (with_ext(stem, "png"), with_ext(stem, "svg"));
     render(BitMapBackend::new(&png, SIZE).into_drawing_area(), fig, &data)
@@ -63,8 +61,17 @@ pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
         .with_context(|| format!("writing figure {}", svg.display()))
 }
 
+/// Registers the shipped font once; every figure needs it (there are no system fonts).
+pub fn ensure_font() -> Result<()> {
+    static FONT_OK: OnceLock<bool> = OnceLock::new();
+    if !*FONT_OK.get_or_init(|| register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok()) {
+        bail!("the embedded DejaVuSans.ttf could not be loaded");
+    }
+    Ok(())
+}
+
 /// Appends the extension rather than replacing one, so a stem like `run.v2` stays intact.
-fn with_ext(stem: &Path, ext: &str) -> PathBuf {
+pub fn with_ext(stem: &Path, ext: &str) -> PathBuf {
     let mut s = stem.as_os_str().to_owned();
     s.push(format!(".{ext}"));
     s.into()

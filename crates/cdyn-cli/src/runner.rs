@@ -82,6 +82,19 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut csv = BufWriter::new(file);
     writeln!(csv, "{}", header(&case.example))?;
+    let result = simulate(case, &mut csv);
+    csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
+    result.map_err(|e| e.context(format!("cannot write {}", path.display())))
+}
+
+/// Runs `case` keeping only its statistics (for sweeps).
+pub fn run_case_quietly(case: &Case) -> CaseResult {
+    simulate(case, &mut std::io::sink()).expect("writing to a sink cannot fail")
+}
+
+/// Runs `case`, writing CSV rows to `csv`; simulation errors are recorded in
+/// the result, write errors returned.
+fn simulate(case: &Case, csv: &mut impl Write) -> Result<CaseResult> {
     let ex = &case.example;
     let mut result = CaseResult {
         name: case.name.clone(),
@@ -103,7 +116,7 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     };
     let outcome =
         Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0).map_err(anyhow::Error::from).and_then(|mut sim| {
-            let run = sim.run(case.t_end, case.every, |s| record(s, ex, &mut csv, &mut result));
+            let run = sim.run(case.t_end, case.every, |s| record(s, ex, csv, &mut result));
             result.steps = sim.steps();
             result.t_final = sim.t();
             result.rhs_evals = sim.evaluations();
@@ -111,10 +124,9 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
             result.v_end = sim.v().to_vec();
             run
         });
-    csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
     if let Err(e) = outcome {
         if e.downcast_ref::<cdyn::Error>().is_none() {
-            return Err(e.context(format!("cannot write {}", path.display())));
+            return Err(e);
         }
         result.error = Some(format!("case {}: {e}", case.name));
     }

@@ -12,7 +12,7 @@ use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Se
 use serde::Deserialize;
 use std::path::Path;
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
     pub model: ModelSpec,
@@ -31,6 +31,8 @@ pub struct Scenario {
     pub drives: Vec<ElementSpec>,
     #[serde(default)]
     pub forces: Vec<ElementSpec>,
+    /// Axes of a parameter sweep (`cdyn sweep`): key → values.
+    pub sweep: Option<toml::Table>,
 }
 
 #[derive(Debug, Deserialize, serde::Serialize, Clone, Copy, PartialEq)]
@@ -56,7 +58,7 @@ pub enum GravitySpec {
     Vector([f64; 2]),
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     pub kind: ModelKind,
@@ -69,7 +71,7 @@ pub struct ModelSpec {
     pub parameters: Option<toml::Table>,
 }
 
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
     pub q: Option<Vec<f64>>,
@@ -109,7 +111,7 @@ pub enum Apply {
     BackwardEuler,
 }
 
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct MethodSpec {
     #[serde(default)]
@@ -139,7 +141,7 @@ pub enum SchemeName {
     Rk4,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
     pub scheme: SchemeName,
@@ -147,7 +149,7 @@ pub struct IntegratorSpec {
     pub t_end: f64,
 }
 
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Write a sample every this many steps (default 1).
@@ -270,7 +272,9 @@ impl Scenario {
         }
         let pendulum = matches!(m.kind, ModelKind::Pendulum | ModelKind::PendulumTheta);
         if m.parameters.is_some() && (pendulum || matches!(m.kind, ModelKind::Mechanism | ModelKind::Andrews)) {
-            bail!("{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none");
+            bail!(
+                "{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none"
+            );
         }
         for (key, set) in [
             ("mass", m.mass.is_some()),

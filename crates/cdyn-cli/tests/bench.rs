@@ -8,7 +8,8 @@ use std::process::Command;
 #[test]
 fn light_bench_writes_a_complete_report() {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_cdyn")).args(["bench", "--light", "--out"]).arg(dir.path()).output().unwrap();
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_cdyn")).args(["bench", "--light", "--out"]).arg(dir.path()).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("bench.json")).unwrap()).unwrap();
     let e = &r["example1"];

@@ -34,11 +34,7 @@ fn error_of(text: &str) -> (String, PathBuf) {
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(!out.status.success(), "expected failure for:\n{text}");
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(
-        stderr.trim_end().lines().count(),
-        1,
-        "not one line: {stderr}"
-    );
+    assert_eq!(stderr.trim_end().lines().count(), 1, "not one line: {stderr}");
     assert!(stderr.starts_with("error: "), "{stderr}");
     (stderr, dir)
 }
@@ -49,14 +45,8 @@ fn a_good_scenario_runs() {
     let path = dir.path().join("good.toml");
     std::fs::write(&path, GOOD).unwrap();
     let out = cdyn(&["run"], Some(&path), &dir.path().join("out"));
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        dir.path().join("out/good.csv").exists() && dir.path().join("out/summary.json").exists()
-    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(dir.path().join("out/good.csv").exists() && dir.path().join("out/summary.json").exists());
 }
 
 #[test]
@@ -64,81 +54,33 @@ fn bad_scenarios_get_one_line_naming_the_problem() {
     let cases: Vec<(String, &[&str])> = vec![
         (String::new(), &["bad.toml", "empty"]),
         ("[model\nkind=".into(), &["bad.toml:1"]),
-        (
-            GOOD.replace("kind = \"pendulum\"", "kind = \"pendulumm\""),
-            &["bad.toml", "pendulumm"],
-        ),
-        (
-            GOOD.replace("t_end = 1.0", "t_end = 1.0\nsteps = 3"),
-            &["bad.toml", "steps"],
-        ),
+        (GOOD.replace("kind = \"pendulum\"", "kind = \"pendulumm\""), &["bad.toml", "pendulumm"]),
+        (GOOD.replace("t_end = 1.0", "t_end = 1.0\nsteps = 3"), &["bad.toml", "steps"]),
         (GOOD.replace("h = 0.01", "h = 0.0"), &["bad.toml", "h", "0"]),
+        (GOOD.replace("h = 0.01", "h = -0.01"), &["bad.toml", "h", "-0.01"]),
+        (GOOD.replace("h = 0.01", "h = nan"), &["bad.toml", "h", "NaN"]),
+        (GOOD.replace("t_end = 1.0", "t_end = inf"), &["bad.toml", "t_end", "inf"]),
+        (GOOD.replace("zeta = 20.0", "zeta = -1.0"), &["bad.toml", "zeta", "-1"]),
+        (GOOD.replace("zeta = 20.0", "zeta = 1.0\nalpha_g = 3.0"), &["bad.toml", "zeta", "alpha_g"]),
+        (GOOD.replace("zeta = 20.0", "zeta = 1.0\neta = 3.0"), &["bad.toml", "eta"]),
+        (GOOD.replace("geometric = \"cvsgf\"", "geometric = \"magic\""), &["bad.toml", "magic"]),
+        (GOOD.replace("scheme = \"ab3\"", "scheme = \"rk45\""), &["bad.toml", "rk45"]),
         (
-            GOOD.replace("h = 0.01", "h = -0.01"),
-            &["bad.toml", "h", "-0.01"],
-        ),
-        (
-            GOOD.replace("h = 0.01", "h = nan"),
-            &["bad.toml", "h", "NaN"],
-        ),
-        (
-            GOOD.replace("t_end = 1.0", "t_end = inf"),
-            &["bad.toml", "t_end", "inf"],
-        ),
-        (
-            GOOD.replace("zeta = 20.0", "zeta = -1.0"),
-            &["bad.toml", "zeta", "-1"],
-        ),
-        (
-            GOOD.replace("zeta = 20.0", "zeta = 1.0\nalpha_g = 3.0"),
-            &["bad.toml", "zeta", "alpha_g"],
-        ),
-        (
-            GOOD.replace("zeta = 20.0", "zeta = 1.0\neta = 3.0"),
-            &["bad.toml", "eta"],
-        ),
-        (
-            GOOD.replace("geometric = \"cvsgf\"", "geometric = \"magic\""),
-            &["bad.toml", "magic"],
-        ),
-        (
-            GOOD.replace("scheme = \"ab3\"", "scheme = \"rk45\""),
-            &["bad.toml", "rk45"],
-        ),
-        (
-            GOOD.replace(
-                "[model]\nkind = \"pendulum\"",
-                "[model]\nkind = \"pendulum\"\nlength = -2",
-            ),
+            GOOD.replace("[model]\nkind = \"pendulum\"", "[model]\nkind = \"pendulum\"\nlength = -2"),
             &["bad.toml", "length", "-2"],
         ),
+        (GOOD.replace("[method]", "[initial]\nq = [1.2, 0.0]\n[method]"), &["bad.toml", "constraints"]),
+        (GOOD.replace("[method]", "[initial]\nq = [1.0]\n[method]"), &["bad.toml", "q"]),
         (
-            GOOD.replace("[method]", "[initial]\nq = [1.2, 0.0]\n[method]"),
-            &["bad.toml", "constraints"],
-        ),
-        (
-            GOOD.replace("[method]", "[initial]\nq = [1.0]\n[method]"),
-            &["bad.toml", "q"],
-        ),
-        (
-            GOOD.replace(
-                "[method]",
-                "[initial]\nq = [0.0, 0.0]\nv = [0.0, 0.0]\noff_constraint = true\n[method]",
-            ),
+            GOOD.replace("[method]", "[initial]\nq = [0.0, 0.0]\nv = [0.0, 0.0]\noff_constraint = true\n[method]"),
             &["singular", "step 0"],
         ),
-        (
-            GOOD.replace("t_end = 1.0", "t_end = 1.0\n[output]\nevery = 0"),
-            &["bad.toml", "every"],
-        ),
+        (GOOD.replace("t_end = 1.0", "t_end = 1.0\n[output]\nevery = 0"), &["bad.toml", "every"]),
     ];
     for (text, needles) in cases {
         let (line, _) = error_of(&text);
         for n in needles {
-            assert!(
-                line.contains(n),
-                "error {line:?} should mention {n:?} for:\n{text}"
-            );
+            assert!(line.contains(n), "error {line:?} should mention {n:?} for:\n{text}");
         }
     }
 }
@@ -149,15 +91,10 @@ fn missing_file_and_bad_command_fail_cleanly() {
     let out = cdyn(&["run"], Some(&dir.path().join("nope.toml")), dir.path());
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
-        !out.status.success()
-            && stderr.contains("nope.toml")
-            && stderr.trim_end().lines().count() == 1,
+        !out.status.success() && stderr.contains("nope.toml") && stderr.trim_end().lines().count() == 1,
         "{stderr}"
     );
-    let out = Command::new(env!("CARGO_BIN_EXE_cdyn"))
-        .arg("fly")
-        .output()
-        .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cdyn")).arg("fly").output().unwrap();
     assert!(!out.status.success());
 }
 
@@ -178,28 +115,14 @@ h = 0.01
 t_end = 20.0
 "#;
     let (line, dir) = error_of(text);
-    assert!(
-        line.contains("diverged at step") && line.contains("t = "),
-        "{line}"
-    );
+    assert!(line.contains("diverged at step") && line.contains("t = "), "{line}");
     let csv = std::fs::read_to_string(dir.join("out/bad.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert!(rows.len() > 2, "rows before the failure are kept");
-    assert!(
-        rows[1..]
-            .iter()
-            .all(|r| r.split(',').all(|x| x.parse::<f64>().is_ok())),
-        "every kept row is readable"
-    );
+    assert!(rows[1..].iter().all(|r| r.split(',').all(|x| x.parse::<f64>().is_ok())), "every kept row is readable");
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
-            .unwrap();
-    assert!(
-        summary["cases"][0]["error"]
-            .as_str()
-            .unwrap()
-            .contains("diverged")
-    );
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap()).unwrap();
+    assert!(summary["cases"][0]["error"].as_str().unwrap().contains("diverged"));
 }
 
 #[test]
@@ -210,12 +133,7 @@ fn shipped_examples_run() {
         if path.extension().is_some_and(|e| e == "toml") {
             let dir = tempfile::tempdir().unwrap();
             let out = cdyn(&["run"], Some(&path), dir.path());
-            assert!(
-                out.status.success(),
-                "{}: {}",
-                path.display(),
-                String::from_utf8_lossy(&out.stderr)
-            );
+            assert!(out.status.success(), "{}: {}", path.display(), String::from_utf8_lossy(&out.stderr));
         }
     }
 }

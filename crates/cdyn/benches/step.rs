@@ -15,7 +15,8 @@ fn example1(c: &mut Criterion) {
     let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
     let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
     let mut group = c.benchmark_group("example1_cvsgf_energy_ab3");
-    let mut sim = Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
+    let mut sim =
+        Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
     group.bench_function("cdyn", |b| b.iter(|| sim.step().unwrap()));
     let mut hand = HandWritten::new([1.0, 0.0, 0.0, 2.0], 0.01, 20.0, 40.0);
     group.bench_function("hand_written", |b| {

@@ -13,22 +13,11 @@ fn main() {
         ),
         (
             "baumgarte",
-            Control {
-                geometric: Geometric::Baumgarte {
-                    alpha: 2.0 * 40f64.sqrt(),
-                    beta: 40.0,
-                },
-                ..Control::none()
-            },
+            Control { geometric: Geometric::Baumgarte { alpha: 2.0 * 40f64.sqrt(), beta: 40.0 }, ..Control::none() },
         ),
     ] {
-        let mut sim = Simulation::new(
-            &ex.model,
-            Settings::new(Scheme::AdamsBashforth3, 0.01, control),
-            &ex.q0,
-            &ex.v0,
-        )
-        .unwrap();
+        let mut sim =
+            Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
         let (mut mphi, mut mpsi) = (0.0f64, 0.0f64);
         sim.run::<Error>(20.0, 1, |s| {
             let m = s.measure();

@@ -39,9 +39,9 @@ pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: 
     let mut correction = vec![0.0; model.n()];
     let mut rhs = vec![0.0; model.m()];
     let singular = |b: Breakdown, iterations: usize| match b {
-        Breakdown::Singular(row) => {
-            Error::InvalidModel(format!("assembly: the constraints are singular at the given positions (row {row}, iteration {iterations})"))
-        }
+        Breakdown::Singular(row) => Error::InvalidModel(format!(
+            "assembly: the constraints are singular at the given positions (row {row}, iteration {iterations})"
+        )),
         Breakdown::NonFinite => Error::InvalidModel("assembly: the positions are not finite".into()),
     };
     loop {

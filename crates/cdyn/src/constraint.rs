@@ -42,9 +42,7 @@ pub(crate) struct ConstraintGroup<C, const K: usize, const R: usize> {
     pub items: Vec<(C, [usize; K])>,
 }
 
-impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock
-    for ConstraintGroup<C, K, R>
-{
+impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for ConstraintGroup<C, K, R> {
     fn rows(&self) -> usize {
         self.items.len() * R
     }
@@ -63,13 +61,11 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock
 
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
         for (e, (c, idx)) in self.items.iter().enumerate() {
-            let grad: [DualSVec64<K>; K] =
-                std::array::from_fn(|j| DualSVec64::<K>::from_re(q[idx[j]]).derivative(j));
+            let grad: [DualSVec64<K>; K] = std::array::from_fn(|j| DualSVec64::<K>::from_re(q[idx[j]]).derivative(j));
             let rows = c.eval(grad, DualSVec64::from_re(t));
             // Second directional derivative of s ↦ Φ(q + s v, t + s): Φ̈ at zero
             // acceleration, which is −γ.
-            let path: [Dual2_64; K] =
-                std::array::from_fn(|j| Dual2_64::new(q[idx[j]], v[idx[j]], 0.0));
+            let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(q[idx[j]], v[idx[j]], 0.0));
             let along = c.eval(path, Dual2_64::new(t, 1.0, 0.0));
             for r in 0..R {
                 let row = e * R + r;

@@ -33,10 +33,7 @@ impl Geometric {
     pub fn baumgarte_from(omega: f64, damping_ratio: f64) -> Result<Self> {
         let omega = positive("omega", omega)?;
         let ratio = non_negative("damping_ratio", damping_ratio)?;
-        Ok(Geometric::Baumgarte {
-            alpha: 2.0 * ratio * omega,
-            beta: omega * omega,
-        })
+        Ok(Geometric::Baumgarte { alpha: 2.0 * ratio * omega, beta: omega * omega })
     }
 }
 
@@ -189,8 +186,7 @@ impl Control {
                 if two_t > REST {
                     let mut num = eta * psi - e_dot;
                     for i in 0..v.len() {
-                        num += model.mass()[i] * v[i] * (d.acc[i] + u_v[i])
-                            + d.grad_potential[i] * v[i];
+                        num += model.mass()[i] * v[i] * (d.acc[i] + u_v[i]) + d.grad_potential[i] * v[i];
                     }
                     let mu = num / two_t;
                     for (u, v) in u_v.iter_mut().zip(v) {

@@ -39,40 +39,18 @@ impl Probe {
     }
 
     /// Measures the violations at `(q, v, e, t)` for initial energy `e0`.
-    pub fn measure(
-        &mut self,
-        model: &Model,
-        q: &[f64],
-        v: &[f64],
-        e: f64,
-        t: f64,
-        e0: f64,
-    ) -> Measures {
-        model.constraints(
-            q,
-            v,
-            t,
-            &mut self.phi,
-            &mut self.phi_dot,
-            &mut self.gamma,
-            &mut self.jac,
-        );
+    pub fn measure(&mut self, model: &Model, q: &[f64], v: &[f64], e: f64, t: f64, e0: f64) -> Measures {
+        model.constraints(q, v, t, &mut self.phi, &mut self.phi_dot, &mut self.gamma, &mut self.jac);
         self.grad.fill(0.0);
         let potential = model.potential(q, Some(&mut self.grad));
         let pattern = model.pattern();
-        let mut out = Measures {
-            psi: energy::psi(model, v, potential, e, e0),
-            ..Measures::default()
-        };
+        let mut out = Measures { psi: energy::psi(model, v, potential, e, e0), ..Measures::default() };
         for r in 0..model.m() {
             if self.phi[r].abs() > out.phi.abs() {
                 out.phi = self.phi[r];
             }
             out.phi_dot = out.phi_dot.max(self.phi_dot[r].abs());
-            let y: f64 = pattern
-                .row(r)
-                .map(|j| self.grad[pattern.cols[j]] * self.jac[j])
-                .sum();
+            let y: f64 = pattern.row(r).map(|j| self.grad[pattern.cols[j]] * self.jac[j]).sum();
             out.coupling = out.coupling.max(y.abs());
         }
         out

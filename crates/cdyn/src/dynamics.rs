@@ -1,8 +1,8 @@
 //! What the system does, uncontrolled: `Φ`, `Φ_q`, `γ`, the multipliers
 //! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
 
-pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
 use crate::linalg::Schur;
+pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
 use crate::model::{Model, Pattern};
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
@@ -56,22 +56,8 @@ impl Dynamics {
 
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the
     /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
-    pub fn evaluate(
-        &mut self,
-        model: &Model,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-    ) -> Result<(), Breakdown> {
-        model.constraints(
-            q,
-            v,
-            t,
-            &mut self.phi,
-            &mut self.phi_dot,
-            &mut self.gamma,
-            &mut self.jac,
-        );
+    pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
+        model.constraints(q, v, t, &mut self.phi, &mut self.phi_dot, &mut self.gamma, &mut self.jac);
         self.grad_potential.fill(0.0);
         self.potential = model.potential(q, Some(&mut self.grad_potential));
         for (f, g) in self.force.iter_mut().zip(&self.grad_potential) {
@@ -94,14 +80,7 @@ impl Dynamics {
         }
         self.schur.solve(&mut self.lambda);
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        add_weighted_jt(
-            model.pattern(),
-            &self.jac,
-            &self.lambda,
-            w,
-            -1.0,
-            &mut self.acc,
-        );
+        add_weighted_jt(model.pattern(), &self.jac, &self.lambda, w, -1.0, &mut self.acc);
         Ok(())
     }
 
@@ -123,14 +102,7 @@ pub fn jac_mul(pattern: &Pattern, jac: &[f64], x: &[f64], out: &mut [f64]) {
 }
 
 /// `out += scale · diag(weight) Φ_qᵀ y`
-pub fn add_weighted_jt(
-    pattern: &Pattern,
-    jac: &[f64],
-    y: &[f64],
-    weight: &[f64],
-    scale: f64,
-    out: &mut [f64],
-) {
+pub fn add_weighted_jt(pattern: &Pattern, jac: &[f64], y: &[f64], weight: &[f64], scale: f64, out: &mut [f64]) {
     for (r, &yr) in y.iter().enumerate() {
         let s = scale * yr;
         for j in pattern.row(r) {

@@ -29,10 +29,5 @@ pub fn energy_input(model: &Model, d: &Dynamics, v: &[f64]) -> f64 {
 
 /// `|Ψ_v|² = |M v|²`.
 pub fn psi_v_norm2(model: &Model, v: &[f64]) -> f64 {
-    model
-        .mass()
-        .iter()
-        .zip(v)
-        .map(|(m, v)| (m * v) * (m * v))
-        .sum()
+    model.mass().iter().zip(v).map(|(m, v)| (m * v) * (m * v)).sum()
 }

@@ -22,11 +22,7 @@ pub enum Formula {
     /// `x_{k+1} = x_k + h Σ_j w_j F_{k−j}`
     Multistep(&'static [f64]),
     /// An explicit Butcher tableau: `a` is strictly lower-triangular, row by row.
-    RungeKutta {
-        a: &'static [&'static [f64]],
-        b: &'static [f64],
-        c: &'static [f64],
-    },
+    RungeKutta { a: &'static [&'static [f64]], b: &'static [f64], c: &'static [f64] },
 }
 
 /// Everything that distinguishes one scheme from another.
@@ -48,12 +44,7 @@ const RK4_B: &[f64] = &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
 const RK4_C: &[f64] = &[0.0, 0.5, 0.5, 1.0];
 
 impl Scheme {
-    pub const ALL: [Scheme; 4] = [
-        Scheme::Euler,
-        Scheme::AdamsBashforth2,
-        Scheme::AdamsBashforth3,
-        Scheme::RungeKutta4,
-    ];
+    pub const ALL: [Scheme; 4] = [Scheme::Euler, Scheme::AdamsBashforth2, Scheme::AdamsBashforth3, Scheme::RungeKutta4];
 
     pub fn info(self) -> SchemeInfo {
         match self {
@@ -87,11 +78,7 @@ impl Scheme {
                 evaluations: 4,
                 history: 1,
                 startup: None,
-                formula: Formula::RungeKutta {
-                    a: RK4_A,
-                    b: RK4_B,
-                    c: RK4_C,
-                },
+                formula: Formula::RungeKutta { a: RK4_A, b: RK4_B, c: RK4_C },
             },
         }
     }
@@ -110,13 +97,7 @@ pub trait Rhs {
     /// Whether `U` can be non-zero.
     fn has_control(&self) -> bool;
     /// Writes `f(x, t)` and, when `u` is given, `U(x, t)`.
-    fn eval(
-        &mut self,
-        x: &[f64],
-        t: f64,
-        f: &mut [f64],
-        u: Option<&mut [f64]>,
-    ) -> Result<(), Self::Error>;
+    fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), Self::Error>;
 }
 
 /// Steps a state with one scheme and one way of applying the control.
@@ -169,21 +150,11 @@ impl Integrator {
     /// The scheme the next step uses: the start-up one until enough history exists.
     pub fn active_scheme(&self) -> Scheme {
         let info = self.scheme.info();
-        if self.filled + 1 < info.history {
-            info.startup.unwrap_or(self.scheme)
-        } else {
-            self.scheme
-        }
+        if self.filled + 1 < info.history { info.startup.unwrap_or(self.scheme) } else { self.scheme }
     }
 
     /// Advances `x` from `t` to `t + h`.
-    pub fn step<R: Rhs>(
-        &mut self,
-        rhs: &mut R,
-        x: &mut [f64],
-        t: f64,
-        h: f64,
-    ) -> Result<(), R::Error> {
+    pub fn step<R: Rhs>(&mut self, rhs: &mut R, x: &mut [f64], t: f64, h: f64) -> Result<(), R::Error> {
         let active = self.active_scheme().info();
         let control = rhs.has_control();
         let split = control && self.application != Application::InRhs;
@@ -236,13 +207,7 @@ impl Integrator {
         Ok(())
     }
 
-    fn evaluate_first<R: Rhs>(
-        &mut self,
-        rhs: &mut R,
-        x: &[f64],
-        t: f64,
-        control: bool,
-    ) -> Result<(), R::Error> {
+    fn evaluate_first<R: Rhs>(&mut self, rhs: &mut R, x: &[f64], t: f64, control: bool) -> Result<(), R::Error> {
         let f = &mut self.history[0];
         match (control, self.application) {
             (false, _) | (true, Application::BackwardEuler) => rhs.eval(x, t, f, None),

@@ -64,8 +64,10 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
 impl DenseSchur {
     pub fn new(pattern: &Pattern, n: usize) -> Self {
         let m = pattern.start.len() - 1;
-        let mut terms: Vec<Term> =
-            products(pattern, n).into_iter().map(|(ra, rb, ja, jb, col)| Term { s: ra * m + rb, ja, jb, col }).collect();
+        let mut terms: Vec<Term> = products(pattern, n)
+            .into_iter()
+            .map(|(ra, rb, ja, jb, col)| Term { s: ra * m + rb, ja, jb, col })
+            .collect();
         terms.sort_by_key(|t| t.s);
         Self { m, terms, a: vec![0.0; m * m], diag: vec![0.0; m] }
     }

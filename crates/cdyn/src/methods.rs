@@ -33,17 +33,10 @@ impl MethodGains {
 /// right-hand side, CVSGF + energy (Eq. 51) with forward and with backward
 /// Euler control.
 pub fn redundant_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
-    let baumgarte = Geometric::Baumgarte {
-        alpha: g.baumgarte_alpha,
-        beta: g.baumgarte_beta,
-    };
+    let baumgarte = Geometric::Baumgarte { alpha: g.baumgarte_alpha, beta: g.baumgarte_beta };
     let cvsgf = Geometric::Gradient(g.cvsgf);
     let energy = Energy::Gradient(g.energy);
-    let c = |geometric, energy, application| Control {
-        geometric,
-        energy,
-        application,
-    };
+    let c = |geometric, energy, application| Control { geometric, energy, application };
     vec![
         ("none", Control::none()),
         ("baumgarte", c(baumgarte, Energy::None, Application::InRhs)),
@@ -51,10 +44,7 @@ pub fn redundant_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
         ("energy", c(Geometric::None, energy, Application::InRhs)),
         ("baumgarte_energy", c(baumgarte, energy, Application::InRhs)),
         ("cvsgf_energy", c(cvsgf, energy, Application::ForwardEuler)),
-        (
-            "cvsgf_energy_backward",
-            c(cvsgf, energy, Application::BackwardEuler),
-        ),
+        ("cvsgf_energy_backward", c(cvsgf, energy, Application::BackwardEuler)),
     ]
 }
 
@@ -63,12 +53,6 @@ pub fn redundant_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
 pub fn independent_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
     vec![
         ("theta", Control::none()),
-        (
-            "theta_energy",
-            Control {
-                energy: Energy::Gradient(g.energy),
-                ..Control::none()
-            },
-        ),
+        ("theta_energy", Control { energy: Energy::Gradient(g.energy), ..Control::none() }),
     ]
 }

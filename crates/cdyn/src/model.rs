@@ -55,15 +55,12 @@ impl ModelBuilder {
         let n = self.mass.len();
         for (j, &i) in at.iter().enumerate() {
             if i >= n {
-                self.error = Some(Error::InvalidModel(format!(
-                    "{what} reads coordinate {i}, but the model has only {n}"
-                )));
+                self.error =
+                    Some(Error::InvalidModel(format!("{what} reads coordinate {i}, but the model has only {n}")));
                 return false;
             }
             if at[..j].contains(&i) {
-                self.error = Some(Error::InvalidModel(format!(
-                    "{what} reads coordinate {i} twice"
-                )));
+                self.error = Some(Error::InvalidModel(format!("{what} reads coordinate {i} twice")));
                 return false;
             }
         }
@@ -71,22 +68,12 @@ impl ModelBuilder {
     }
 
     /// Adds `R` constraint rows reading the coordinates `at`.
-    pub fn constrain<C: Constraint<K, R>, const K: usize, const R: usize>(
-        mut self,
-        c: C,
-        at: [usize; K],
-    ) -> Self {
+    pub fn constrain<C: Constraint<K, R>, const K: usize, const R: usize>(mut self, c: C, at: [usize; K]) -> Self {
         if self.check_indices("a constraint", &at) {
             let item = (c, at);
-            match self
-                .constraints
-                .last_mut()
-                .and_then(|b| b.as_any_mut().downcast_mut::<ConstraintGroup<C, K, R>>())
-            {
+            match self.constraints.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<ConstraintGroup<C, K, R>>()) {
                 Some(g) => g.items.push(item),
-                None => self
-                    .constraints
-                    .push(Box::new(ConstraintGroup { items: vec![item] })),
+                None => self.constraints.push(Box::new(ConstraintGroup { items: vec![item] })),
             }
         }
         self
@@ -96,15 +83,9 @@ impl ModelBuilder {
     pub fn potential<P: Potential<K>, const K: usize>(mut self, p: P, at: [usize; K]) -> Self {
         if self.check_indices("a potential", &at) {
             let item = (p, at);
-            match self
-                .potentials
-                .last_mut()
-                .and_then(|b| b.as_any_mut().downcast_mut::<PotentialGroup<P, K>>())
-            {
+            match self.potentials.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<PotentialGroup<P, K>>()) {
                 Some(g) => g.items.push(item),
-                None => self
-                    .potentials
-                    .push(Box::new(PotentialGroup { items: vec![item] })),
+                None => self.potentials.push(Box::new(PotentialGroup { items: vec![item] })),
             }
         }
         self
@@ -114,11 +95,7 @@ impl ModelBuilder {
     pub fn force<F: Force<K>, const K: usize>(mut self, f: F, at: [usize; K]) -> Self {
         if self.check_indices("a force", &at) {
             let item = (f, at);
-            match self
-                .forces
-                .last_mut()
-                .and_then(|b| b.as_any_mut().downcast_mut::<ForceGroup<F, K>>())
-            {
+            match self.forces.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<ForceGroup<F, K>>()) {
                 Some(g) => g.items.push(item),
                 None => self.forces.push(Box::new(ForceGroup { items: vec![item] })),
             }
@@ -136,17 +113,12 @@ impl ModelBuilder {
             return Err(e);
         }
         if self.mass.is_empty() {
-            return Err(Error::InvalidModel(
-                "a model needs at least one coordinate".into(),
-            ));
+            return Err(Error::InvalidModel("a model needs at least one coordinate".into()));
         }
         for &m in &self.mass {
             crate::error::positive("mass", m)?;
         }
-        let mut pattern = Pattern {
-            start: vec![0],
-            cols: Vec::new(),
-        };
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
         let mut offsets = Vec::with_capacity(self.constraints.len());
         for b in &self.constraints {
             offsets.push((pattern.start.len() - 1, pattern.cols.len()));
@@ -179,13 +151,7 @@ impl ModelBuilder {
 impl Model {
     /// Starts a model whose coordinates have these (diagonal) masses.
     pub fn builder(mass: Vec<f64>) -> ModelBuilder {
-        ModelBuilder {
-            mass,
-            constraints: Vec::new(),
-            potentials: Vec::new(),
-            forces: Vec::new(),
-            error: None,
-        }
+        ModelBuilder { mass, constraints: Vec::new(), potentials: Vec::new(), forces: Vec::new(), error: None }
     }
 
     /// Number of coordinates `n`.
@@ -247,11 +213,7 @@ impl Model {
     /// Potential energy; adds `∇V` into `grad` when given.
     pub fn potential(&self, q: &[f64], grad: Option<&mut [f64]>) -> f64 {
         match grad {
-            Some(g) => self
-                .potentials
-                .iter()
-                .map(|p| p.energy_and_gradient(q, g))
-                .sum(),
+            Some(g) => self.potentials.iter().map(|p| p.energy_and_gradient(q, g)).sum(),
             None => self.potentials.iter().map(|p| p.energy(q)).sum(),
         }
     }

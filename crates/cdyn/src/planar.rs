@@ -45,73 +45,29 @@ pub enum Coordinate {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Element {
     /// Points `pa` on `a` and `pb` on `b` coincide.
-    Revolute {
-        a: BodyId,
-        pa: [f64; 2],
-        b: BodyId,
-        pb: [f64; 2],
-    },
+    Revolute { a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2] },
     /// Point `pb` on `b` slides along the line through `pa` on `a` with
     /// direction `axis` (in `a`'s frame); the relative angle stays fixed
     /// when both have one.
-    Prismatic {
-        a: BodyId,
-        pa: [f64; 2],
-        b: BodyId,
-        pb: [f64; 2],
-        axis: [f64; 2],
-    },
+    Prismatic { a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2], axis: [f64; 2] },
     /// A massless rod of this length between two points.
-    Distance {
-        a: BodyId,
-        pa: [f64; 2],
-        b: BodyId,
-        pb: [f64; 2],
-        length: f64,
-    },
+    Distance { a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2], length: f64 },
     /// `φ_b − φ_a = angle`.
     FixedAngle { a: BodyId, b: BodyId, angle: f64 },
     /// A coordinate of a body follows `f(t)`.
-    DriveCoordinate {
-        body: BodyId,
-        coordinate: Coordinate,
-        f: TimeFn,
-    },
+    DriveCoordinate { body: BodyId, coordinate: Coordinate, f: TimeFn },
     /// `φ_b − φ_a = f(t)`.
     DriveAngle { a: BodyId, b: BodyId, f: TimeFn },
     /// Linear spring between two points.
-    Spring {
-        a: BodyId,
-        pa: [f64; 2],
-        b: BodyId,
-        pb: [f64; 2],
-        stiffness: f64,
-        rest_length: f64,
-    },
+    Spring { a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2], stiffness: f64, rest_length: f64 },
     /// Torsional spring on the relative angle `φ_b − φ_a`.
-    TorsionSpring {
-        a: BodyId,
-        b: BodyId,
-        stiffness: f64,
-        rest_angle: f64,
-    },
+    TorsionSpring { a: BodyId, b: BodyId, stiffness: f64, rest_angle: f64 },
     /// Linear damper between two points: force `c` times the rate of change of their distance.
-    Damper {
-        a: BodyId,
-        pa: [f64; 2],
-        b: BodyId,
-        pb: [f64; 2],
-        damping: f64,
-    },
+    Damper { a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2], damping: f64 },
     /// Rotary damper on the relative angle.
     RotaryDamper { a: BodyId, b: BodyId, damping: f64 },
     /// A force `(f_x(t), f_y(t))` in world axes applied at a point of a body.
-    AppliedForce {
-        body: BodyId,
-        point: [f64; 2],
-        fx: TimeFn,
-        fy: TimeFn,
-    },
+    AppliedForce { body: BodyId, point: [f64; 2], fx: TimeFn, fy: TimeFn },
     /// A torque `τ(t)` applied to a body.
     AppliedTorque { body: BodyId, f: TimeFn },
 }
@@ -140,21 +96,11 @@ pub struct Built {
 
 impl Mechanism {
     pub fn new(gravity: [f64; 2]) -> Self {
-        Self {
-            gravity,
-            ..Self::default()
-        }
+        Self { gravity, ..Self::default() }
     }
 
     /// Adds a rigid body at `position` with angle `angle`, at rest.
-    pub fn rigid(
-        &mut self,
-        name: &str,
-        mass: f64,
-        inertia: f64,
-        position: [f64; 2],
-        angle: f64,
-    ) -> BodyId {
+    pub fn rigid(&mut self, name: &str, mass: f64, inertia: f64, position: [f64; 2], angle: f64) -> BodyId {
         self.push(Body {
             name: name.into(),
             mass,
@@ -210,28 +156,17 @@ impl Mechanism {
             return Err(Error::InvalidModel(format!("gravity {:?} must be finite", self.gravity)));
         }
         let mut mass = Vec::new();
-        let (mut q0, mut v0, mut names, mut offsets) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut q0, mut v0, mut names, mut offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (i, b) in self.bodies.iter().enumerate() {
             let bad = |what: &str, x: f64| {
-                Error::InvalidModel(format!(
-                    "body {i} ({}): {what} = {x} must be finite and positive",
-                    b.name
-                ))
+                Error::InvalidModel(format!("body {i} ({}): {what} = {x} must be finite and positive", b.name))
             };
             if !(b.mass.is_finite() && b.mass > 0.0) {
                 return Err(bad("mass", b.mass));
             }
-            let state = b
-                .position
-                .iter()
-                .chain(&b.velocity)
-                .chain([&b.angle, &b.angular_velocity]);
+            let state = b.position.iter().chain(&b.velocity).chain([&b.angle, &b.angular_velocity]);
             if let Some(x) = state.clone().find(|x| !x.is_finite()) {
-                return Err(Error::InvalidModel(format!(
-                    "body {i} ({}): initial state contains {x}",
-                    b.name
-                )));
+                return Err(Error::InvalidModel(format!("body {i} ({}): initial state contains {x}", b.name)));
             }
             offsets.push(mass.len());
             mass.extend([b.mass, b.mass]);
@@ -266,23 +201,14 @@ impl Mechanism {
     }
 
     /// Where a body's coordinates are and what it is, for one end of an element.
-    fn attach(
-        &self,
-        id: BodyId,
-        point: [f64; 2],
-        offsets: &[usize],
-        idx: &mut Vec<usize>,
-    ) -> Result<End, String> {
+    fn attach(&self, id: BodyId, point: [f64; 2], offsets: &[usize], idx: &mut Vec<usize>) -> Result<End, String> {
         if !point.iter().all(|p| p.is_finite()) {
             return Err(format!("point {point:?} must be finite"));
         }
         match id {
             BodyId::Ground => Ok(End::Ground { point }),
             BodyId::Body(i) => {
-                let b = self
-                    .bodies
-                    .get(i)
-                    .ok_or_else(|| format!("body {i} does not exist"))?;
+                let b = self.bodies.get(i).ok_or_else(|| format!("body {i} does not exist"))?;
                 let at = idx.len();
                 let first = offsets[i];
                 match b.inertia {
@@ -294,29 +220,18 @@ impl Mechanism {
                         idx.extend([first, first + 1]);
                         Ok(End::Point { at })
                     }
-                    None => Err(format!(
-                        "body {} is a point mass: its only point is [0, 0]",
-                        b.name
-                    )),
+                    None => Err(format!("body {} is a point mass: its only point is [0, 0]", b.name)),
                 }
             }
         }
     }
 
     /// The angle coordinate of a body, for elements on relative angles.
-    fn attach_angle(
-        &self,
-        id: BodyId,
-        offsets: &[usize],
-        idx: &mut Vec<usize>,
-    ) -> Result<Option<usize>, String> {
+    fn attach_angle(&self, id: BodyId, offsets: &[usize], idx: &mut Vec<usize>) -> Result<Option<usize>, String> {
         match id {
             BodyId::Ground => Ok(None),
             BodyId::Body(i) => {
-                let b = self
-                    .bodies
-                    .get(i)
-                    .ok_or_else(|| format!("body {i} does not exist"))?;
+                let b = self.bodies.get(i).ok_or_else(|| format!("body {i} does not exist"))?;
                 if b.inertia.is_none() {
                     return Err(format!("body {} is a point mass and has no angle", b.name));
                 }
@@ -326,105 +241,41 @@ impl Mechanism {
         }
     }
 
-    fn add_element(
-        &self,
-        builder: ModelBuilder,
-        e: &Element,
-        offsets: &[usize],
-    ) -> Result<ModelBuilder, String> {
+    fn add_element(&self, builder: ModelBuilder, e: &Element, offsets: &[usize]) -> Result<ModelBuilder, String> {
         let mut idx = Vec::new();
         let same = |a: &BodyId, b: &BodyId| {
-            if a == b {
-                Err(format!("connects {a:?} to itself"))
-            } else {
-                Ok(())
-            }
+            if a == b { Err(format!("connects {a:?} to itself")) } else { Ok(()) }
         };
         let positive = |name: &str, x: f64| {
-            if x.is_finite() && x > 0.0 {
-                Ok(x)
-            } else {
-                Err(format!("{name} = {x} must be finite and positive"))
-            }
+            if x.is_finite() && x > 0.0 { Ok(x) } else { Err(format!("{name} = {x} must be finite and positive")) }
         };
         let non_negative = |name: &str, x: f64| {
-            if x.is_finite() && x >= 0.0 {
-                Ok(x)
-            } else {
-                Err(format!("{name} = {x} must be finite and not negative"))
-            }
+            if x.is_finite() && x >= 0.0 { Ok(x) } else { Err(format!("{name} = {x} must be finite and not negative")) }
         };
         let finite_fn = |f: &TimeFn| {
-            if f.is_finite() {
-                Ok(())
-            } else {
-                Err("time function has a non-finite coefficient".to_string())
-            }
+            if f.is_finite() { Ok(()) } else { Err("time function has a non-finite coefficient".to_string()) }
         };
         Ok(match e {
             Element::Revolute { a, pa, b, pb } => {
                 same(a, b)?;
-                let (ea, eb) = (
-                    self.attach(*a, *pa, offsets, &mut idx)?,
-                    self.attach(*b, *pb, offsets, &mut idx)?,
-                );
-                with_k!(
-                    idx,
-                    K,
-                    builder.constrain(Revolute::<K> { a: ea, b: eb }, idx_array(&idx))
-                )
+                let (ea, eb) = (self.attach(*a, *pa, offsets, &mut idx)?, self.attach(*b, *pb, offsets, &mut idx)?);
+                with_k!(idx, K, builder.constrain(Revolute::<K> { a: ea, b: eb }, idx_array(&idx)))
             }
-            Element::Distance {
-                a,
-                pa,
-                b,
-                pb,
-                length,
-            } => {
+            Element::Distance { a, pa, b, pb, length } => {
                 same(a, b)?;
                 let length = positive("length", *length)?;
-                let (ea, eb) = (
-                    self.attach(*a, *pa, offsets, &mut idx)?,
-                    self.attach(*b, *pb, offsets, &mut idx)?,
-                );
-                with_k!(
-                    idx,
-                    K,
-                    builder.constrain(
-                        Distance::<K> {
-                            a: ea,
-                            b: eb,
-                            length
-                        },
-                        idx_array(&idx)
-                    )
-                )
+                let (ea, eb) = (self.attach(*a, *pa, offsets, &mut idx)?, self.attach(*b, *pb, offsets, &mut idx)?);
+                with_k!(idx, K, builder.constrain(Distance::<K> { a: ea, b: eb, length }, idx_array(&idx)))
             }
             Element::Prismatic { a, pa, b, pb, axis } => {
                 same(a, b)?;
                 let norm = axis[0].hypot(axis[1]);
                 positive("|axis|", norm)?;
                 let normal = [-axis[1] / norm, axis[0] / norm];
-                let (ea, eb) = (
-                    self.attach(*a, *pa, offsets, &mut idx)?,
-                    self.attach(*b, *pb, offsets, &mut idx)?,
-                );
-                let builder = with_k!(
-                    idx,
-                    K,
-                    builder.constrain(
-                        OnLine::<K> {
-                            a: ea,
-                            b: eb,
-                            normal
-                        },
-                        idx_array(&idx)
-                    )
-                );
+                let (ea, eb) = (self.attach(*a, *pa, offsets, &mut idx)?, self.attach(*b, *pb, offsets, &mut idx)?);
+                let builder = with_k!(idx, K, builder.constrain(OnLine::<K> { a: ea, b: eb, normal }, idx_array(&idx)));
                 // No relative rotation, when both ends can rotate or one is the ground.
-                let both_angles = [a, b]
-                    .iter()
-                    .all(|id| self.body(**id).is_none_or(|b| b.inertia.is_some()));
+                let both_angles = [a, b].iter().all(|id| self.body(**id).is_none_or(|b| b.inertia.is_some()));
                 if both_angles {
                     self.relative_angle(
                         builder,
@@ -449,19 +300,12 @@ impl Mechanism {
                 finite_fn(f)?;
                 self.relative_angle(builder, *a, *b, f.clone(), offsets)?
             }
-            Element::DriveCoordinate {
-                body,
-                coordinate,
-                f,
-            } => {
+            Element::DriveCoordinate { body, coordinate, f } => {
                 finite_fn(f)?;
                 let BodyId::Body(i) = *body else {
                     return Err("the ground cannot be driven".into());
                 };
-                let b = self
-                    .bodies
-                    .get(i)
-                    .ok_or_else(|| format!("body {i} does not exist"))?;
+                let b = self.bodies.get(i).ok_or_else(|| format!("body {i} does not exist"))?;
                 let k = match coordinate {
                     Coordinate::X => 0,
                     Coordinate::Y => 1,
@@ -472,122 +316,41 @@ impl Mechanism {
                 };
                 builder.constrain(Prescribed { f: f.clone() }, [offsets[i] + k])
             }
-            Element::Spring {
-                a,
-                pa,
-                b,
-                pb,
-                stiffness,
-                rest_length,
-            } => {
+            Element::Spring { a, pa, b, pb, stiffness, rest_length } => {
                 same(a, b)?;
-                let (k, l0) = (
-                    non_negative("stiffness", *stiffness)?,
-                    non_negative("rest_length", *rest_length)?,
-                );
-                let (ea, eb) = (
-                    self.attach(*a, *pa, offsets, &mut idx)?,
-                    self.attach(*b, *pb, offsets, &mut idx)?,
-                );
-                with_k!(
-                    idx,
-                    K,
-                    builder.potential(
-                        Spring::<K> {
-                            a: ea,
-                            b: eb,
-                            k,
-                            l0
-                        },
-                        idx_array(&idx)
-                    )
-                )
+                let (k, l0) = (non_negative("stiffness", *stiffness)?, non_negative("rest_length", *rest_length)?);
+                let (ea, eb) = (self.attach(*a, *pa, offsets, &mut idx)?, self.attach(*b, *pb, offsets, &mut idx)?);
+                with_k!(idx, K, builder.potential(Spring::<K> { a: ea, b: eb, k, l0 }, idx_array(&idx)))
             }
-            Element::TorsionSpring {
-                a,
-                b,
-                stiffness,
-                rest_angle,
-            } => {
+            Element::TorsionSpring { a, b, stiffness, rest_angle } => {
                 same(a, b)?;
                 let k = non_negative("stiffness", *stiffness)?;
                 if !rest_angle.is_finite() {
                     return Err(format!("rest_angle = {rest_angle} must be finite"));
                 }
-                let (ia, ib) = (
-                    self.attach_angle(*a, offsets, &mut idx)?,
-                    self.attach_angle(*b, offsets, &mut idx)?,
-                );
-                with_k!(
-                    idx,
-                    K,
-                    builder.potential(
-                        Torsion::<K> {
-                            a: ia,
-                            b: ib,
-                            k,
-                            rest: *rest_angle
-                        },
-                        idx_array(&idx)
-                    )
-                )
+                let (ia, ib) = (self.attach_angle(*a, offsets, &mut idx)?, self.attach_angle(*b, offsets, &mut idx)?);
+                with_k!(idx, K, builder.potential(Torsion::<K> { a: ia, b: ib, k, rest: *rest_angle }, idx_array(&idx)))
             }
-            Element::Damper {
-                a,
-                pa,
-                b,
-                pb,
-                damping,
-            } => {
+            Element::Damper { a, pa, b, pb, damping } => {
                 same(a, b)?;
                 let c = non_negative("damping", *damping)?;
-                let (ea, eb) = (
-                    self.attach(*a, *pa, offsets, &mut idx)?,
-                    self.attach(*b, *pb, offsets, &mut idx)?,
-                );
-                with_k!(
-                    idx,
-                    K,
-                    builder.force(Damper::<K> { a: ea, b: eb, c }, idx_array(&idx))
-                )
+                let (ea, eb) = (self.attach(*a, *pa, offsets, &mut idx)?, self.attach(*b, *pb, offsets, &mut idx)?);
+                with_k!(idx, K, builder.force(Damper::<K> { a: ea, b: eb, c }, idx_array(&idx)))
             }
             Element::RotaryDamper { a, b, damping } => {
                 same(a, b)?;
                 let c = non_negative("damping", *damping)?;
-                let (ia, ib) = (
-                    self.attach_angle(*a, offsets, &mut idx)?,
-                    self.attach_angle(*b, offsets, &mut idx)?,
-                );
-                with_k!(
-                    idx,
-                    K,
-                    builder.force(RotaryDamper::<K> { a: ia, b: ib, c }, idx_array(&idx))
-                )
+                let (ia, ib) = (self.attach_angle(*a, offsets, &mut idx)?, self.attach_angle(*b, offsets, &mut idx)?);
+                with_k!(idx, K, builder.force(RotaryDamper::<K> { a: ia, b: ib, c }, idx_array(&idx)))
             }
-            Element::AppliedForce {
-                body,
-                point,
-                fx,
-                fy,
-            } => {
+            Element::AppliedForce { body, point, fx, fy } => {
                 finite_fn(fx)?;
                 finite_fn(fy)?;
                 if *body == BodyId::Ground {
                     return Err("a force on the ground does nothing".into());
                 }
                 let end = self.attach(*body, *point, offsets, &mut idx)?;
-                with_k!(
-                    idx,
-                    K,
-                    builder.force(
-                        PointLoad::<K> {
-                            end,
-                            fx: fx.clone(),
-                            fy: fy.clone()
-                        },
-                        idx_array(&idx)
-                    )
-                )
+                with_k!(idx, K, builder.force(PointLoad::<K> { end, fx: fx.clone(), fy: fy.clone() }, idx_array(&idx)))
             }
             Element::AppliedTorque { body, f } => {
                 finite_fn(f)?;
@@ -609,15 +372,8 @@ impl Mechanism {
         offsets: &[usize],
     ) -> Result<ModelBuilder, String> {
         let mut idx = Vec::new();
-        let (ia, ib) = (
-            self.attach_angle(a, offsets, &mut idx)?,
-            self.attach_angle(b, offsets, &mut idx)?,
-        );
-        Ok(with_k!(
-            idx,
-            K,
-            builder.constrain(RelativeAngle::<K> { a: ia, b: ib, f }, idx_array(&idx))
-        ))
+        let (ia, ib) = (self.attach_angle(a, offsets, &mut idx)?, self.attach_angle(b, offsets, &mut idx)?);
+        Ok(with_k!(idx, K, builder.constrain(RelativeAngle::<K> { a: ia, b: ib, f }, idx_array(&idx))))
     }
 
     fn initial_relative_angle(&self, a: BodyId, b: BodyId) -> f64 {
@@ -675,11 +431,7 @@ macro_rules! with_k {
                 const $k: usize = 6;
                 $body
             }
-            n => {
-                return Err(format!(
-                    "reads {n} coordinates; between 1 and 6 are supported"
-                ))
-            }
+            n => return Err(format!("reads {n} coordinates; between 1 and 6 are supported")),
         }
     };
 }
@@ -704,10 +456,7 @@ impl End {
         match *self {
             End::Ground { point } => [D::from(point[0]), D::from(point[1])],
             End::Point { at } => [x[at], x[at + 1]],
-            End::Rigid {
-                at,
-                local: [lx, ly],
-            } => {
+            End::Rigid { at, local: [lx, ly] } => {
                 let (s, c) = (x[at + 2].sin(), x[at + 2].cos());
                 [x[at] + c * lx - s * ly, x[at + 1] + s * lx + c * ly]
             }
@@ -720,10 +469,7 @@ impl End {
         match *self {
             End::Ground { .. } => [D::from(0.0); 2],
             End::Point { at } => [xd[at], xd[at + 1]],
-            End::Rigid {
-                at,
-                local: [lx, ly],
-            } => {
+            End::Rigid { at, local: [lx, ly] } => {
                 let (s, c) = (x[at + 2].sin(), x[at + 2].cos());
                 let (rx, ry) = (c * lx - s * ly, s * lx + c * ly);
                 [xd[at] - xd[at + 2] * ry, xd[at + 1] + xd[at + 2] * rx]
@@ -740,10 +486,7 @@ impl End {
                 out[at] += f[0];
                 out[at + 1] += f[1];
             }
-            End::Rigid {
-                at,
-                local: [lx, ly],
-            } => {
+            End::Rigid { at, local: [lx, ly] } => {
                 let (s, c) = (x[at + 2].sin(), x[at + 2].cos());
                 let (rx, ry) = (c * lx - s * ly, s * lx + c * ly);
                 out[at] += f[0];
@@ -931,8 +674,7 @@ struct PointLoad<const K: usize> {
 impl<const K: usize> Force<K> for PointLoad<K> {
     fn force<D: Scalar>(&self, x: [D; K], _xd: [D; K], t: D) -> [D; K] {
         let mut out = [D::from(0.0); K];
-        self.end
-            .apply(&x, [self.fx.eval(t), self.fy.eval(t)], &mut out);
+        self.end.apply(&x, [self.fx.eval(t), self.fy.eval(t)], &mut out);
         out
     }
 }

@@ -59,11 +59,7 @@ pub mod elliptic {
 
     impl fmt::Debug for Modulus {
         fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-            f.debug_struct("Modulus")
-                .field("k", &self.k)
-                .field("kc", &self.kc)
-                .field("big_k", &self.big_k)
-                .finish()
+            f.debug_struct("Modulus").field("k", &self.k).field("kc", &self.kc).field("big_k", &self.big_k).finish()
         }
     }
 
@@ -85,15 +81,7 @@ pub mod elliptic {
                 c[n + 1] = c[n] * c[n] / (4.0 * a[n + 1]);
                 n += 1;
             }
-            Self {
-                k,
-                kc,
-                a,
-                b,
-                c,
-                n_max: n,
-                big_k: FRAC_PI_2 / a[n],
-            }
+            Self { k, kc, a, b, c, n_max: n, big_k: FRAC_PI_2 / a[n] }
         }
 
         /// Modulus from k alone, for the public wrappers; None unless |k| < 1.
@@ -156,8 +144,7 @@ pub mod elliptic {
         let (mut x, mut y, mut z) = (x, y, z);
         let a0 = (x + y + z) / 3.0;
         let mut a = a0;
-        let q = (3.0 * RF_TOL).powf(-1.0 / 6.0)
-            * (a0 - x0).abs().max((a0 - y0).abs()).max((a0 - z0).abs());
+        let q = (3.0 * RF_TOL).powf(-1.0 / 6.0) * (a0 - x0).abs().max((a0 - y0).abs()).max((a0 - z0).abs());
         // scale = 4^{-n}
         let mut scale = 1.0;
         // The iteration count is logarithmic in the spread of x, y, z; the cap
@@ -204,11 +191,7 @@ pub mod elliptic {
             Some(m) => m.incomplete_f(phi),
             None if k.abs() == 1.0 => {
                 let n = (phi / PI).round();
-                if n == 0.0 {
-                    (phi - n * PI).sin().atanh()
-                } else {
-                    f64::INFINITY.copysign(n)
-                }
+                if n == 0.0 { (phi - n * PI).sin().atanh() } else { f64::INFINITY.copysign(n) }
             }
             None => f64::NAN,
         }
@@ -251,10 +234,9 @@ pub enum ReferenceError {
 impl fmt::Display for ReferenceError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Separatrix => write!(
-                f,
-                "pendulum energy lies on the separatrix (just reaches the top); no elliptic closed form"
-            ),
+            Self::Separatrix => {
+                write!(f, "pendulum energy lies on the separatrix (just reaches the top); no elliptic closed form")
+            }
             Self::InvalidParameter { name, value } => {
                 let why = match *name {
                     "w2" => "must be finite and positive",
@@ -363,13 +345,7 @@ impl PendulumExact {
             (modulus, Regime::Rotating { sigma, inv_k }, u0)
         };
 
-        let mut this = Self {
-            w,
-            modulus,
-            regime,
-            u0,
-            offset: 0.0,
-        };
+        let mut this = Self { w, modulus, regime, u0, offset: 0.0 };
         this.offset = theta0 - this.model(0.0).0;
         Ok(this)
     }
@@ -404,11 +380,7 @@ mod tests {
     use std::f64::consts::PI;
 
     fn close(a: f64, b: f64, tol: f64, what: &str) {
-        assert!(
-            (a - b).abs() <= tol,
-            "{what}: {a} vs {b}, diff {:e} > {tol:e}",
-            (a - b).abs()
-        );
+        assert!((a - b).abs() <= tol, "{what}: {a} vs {b}, diff {:e} > {tol:e}", (a - b).abs());
     }
 
     /// Gauss–Legendre nodes and weights on [−1, 1] by Newton on P_n.
@@ -444,11 +416,7 @@ mod tests {
         (0..pieces)
             .map(|p| {
                 let mid = a + (p as f64 + 0.5) * h;
-                gl.iter()
-                    .map(|&(x, wt)| wt * f(mid + 0.5 * h * x))
-                    .sum::<f64>()
-                    * 0.5
-                    * h
+                gl.iter().map(|&(x, wt)| wt * f(mid + 0.5 * h * x)).sum::<f64>() * 0.5 * h
             })
             .sum()
     }
@@ -490,36 +458,22 @@ mod tests {
         fine.iter()
             .zip(&coarse)
             .enumerate()
-            .map(|(i, (f, c))| {
-                (
-                    i as f64 * 0.1,
-                    (16.0 * f.0 - c.0) / 15.0,
-                    (16.0 * f.1 - c.1) / 15.0,
-                )
-            })
+            .map(|(i, (f, c))| (i as f64 * 0.1, (16.0 * f.0 - c.0) / 15.0, (16.0 * f.1 - c.1) / 15.0))
             .collect()
     }
 
     /// Max |Δθ|, |Δθ̇| between the closed form and RK4+Richardson on [0, t_end].
     fn max_diff_vs_rk4(w2: f64, th0: f64, om0: f64, t_end: f64) -> (f64, f64) {
         let p = PendulumExact::new(w2, th0, om0).unwrap();
-        rk4_richardson(w2, th0, om0, t_end).iter().fold(
-            (0.0f64, 0.0f64),
-            |(dt, dw), &(t, th, om)| {
-                let (e, eo) = p.angle(t);
-                (dt.max((e - th).abs()), dw.max((eo - om).abs()))
-            },
-        )
+        rk4_richardson(w2, th0, om0, t_end).iter().fold((0.0f64, 0.0f64), |(dt, dw), &(t, th, om)| {
+            let (e, eo) = p.angle(t);
+            (dt.max((e - th).abs()), dw.max((eo - om).abs()))
+        })
     }
 
     #[test]
     fn complete_k_known_values() {
-        close(
-            complete_k((PI / 4.0).sin()),
-            1.854074677301372,
-            2e-15,
-            "K(sin 45°)",
-        );
+        close(complete_k((PI / 4.0).sin()), 1.854074677301372, 2e-15, "K(sin 45°)");
         close(complete_k(0.0), PI / 2.0, 1e-16, "K(0)");
         // mpmath 1.3 ellipk(m = k²), 30 digits.
         close(complete_k(0.5), 1.685_750_354_812_596, 2e-15, "K(0.5)");
@@ -527,12 +481,7 @@ mod tests {
         close(complete_k(0.99), 3.356_600_523_361_192_4, 4e-15, "K(0.99)");
         // With k' supplied exactly, K keeps full accuracy near k = 1.
         let m = Modulus::new((1.0 - 1e-12f64).sqrt(), 1e-6);
-        close(
-            m.complete_k(),
-            15.201_804_919_087_715,
-            1e-13,
-            "K(k' = 1e-6)",
-        );
+        close(m.complete_k(), 15.201_804_919_087_715, 1e-13, "K(k' = 1e-6)");
         assert_eq!(complete_k(1.0), f64::INFINITY);
         assert!(complete_k(1.5).is_nan() && complete_k(f64::NAN).is_nan());
     }
@@ -540,41 +489,15 @@ mod tests {
     #[test]
     fn incomplete_f_known_values_and_quadrature() {
         // mpmath 1.3 ellipf(φ, m = k²).
-        close(
-            incomplete_f(1.0, 0.8),
-            1.114_267_714_667_189_8,
-            2e-15,
-            "F(1, .8)",
-        );
-        close(
-            incomplete_f(-2.5, 0.3),
-            -2.570_801_298_635_130_5,
-            4e-15,
-            "F(-2.5, .3)",
-        );
-        close(
-            incomplete_f(10.0, 0.9),
-            14.285_668_680_442_342,
-            2e-14,
-            "F(10, .9)",
-        );
+        close(incomplete_f(1.0, 0.8), 1.114_267_714_667_189_8, 2e-15, "F(1, .8)");
+        close(incomplete_f(-2.5, 0.3), -2.570_801_298_635_130_5, 4e-15, "F(-2.5, .3)");
+        close(incomplete_f(10.0, 0.9), 14.285_668_680_442_342, 2e-14, "F(10, .9)");
         // Independent check: direct Gauss–Legendre quadrature of the integrand.
         let gl = gauss_legendre(20);
         for &k in &[0.0, 0.3, 0.7, 0.95] {
             for &phi in &[0.2, 1.0, 1.5, 2.0, 4.0, -3.0, 7.5] {
-                let q = integrate(
-                    |t| 1.0 / (1.0 - (k * t.sin()).powi(2)).sqrt(),
-                    0.0,
-                    phi,
-                    40,
-                    &gl,
-                );
-                close(
-                    incomplete_f(phi, k),
-                    q,
-                    1e-14 * (1.0 + q.abs()),
-                    "F vs quadrature",
-                );
+                let q = integrate(|t| 1.0 / (1.0 - (k * t.sin()).powi(2)).sqrt(), 0.0, phi, 40, &gl);
+                close(incomplete_f(phi, k), q, 1e-14 * (1.0 + q.abs()), "F vs quadrature");
             }
         }
         // Quasi-periodicity F(φ + nπ) = F(φ) + 2nK.
@@ -588,12 +511,7 @@ mod tests {
                 "F quasi-periodicity",
             );
         }
-        close(
-            incomplete_f(0.5, 1.0),
-            0.5f64.sin().atanh(),
-            1e-16,
-            "F(φ, 1)",
-        );
+        close(incomplete_f(0.5, 1.0), 0.5f64.sin().atanh(), 1e-16, "F(φ, 1)");
         assert!(incomplete_f(2.0, 1.0).is_infinite() && incomplete_f(1.0, 1.1).is_nan());
     }
 
@@ -601,33 +519,9 @@ mod tests {
     fn jacobi_known_values() {
         // mpmath 1.3 ellipfun(·, u, m = k²).
         let cases = [
-            (
-                0.7,
-                0.6,
-                [
-                    0.629_917_115_323_486_8,
-                    0.776_662_364_108_456_7,
-                    0.925_825_898_328_683_2,
-                ],
-            ),
-            (
-                -3.3,
-                0.95,
-                [
-                    -0.971_645_022_244_09,
-                    -0.236_444_392_507_587,
-                    0.384_649_347_523_591_1,
-                ],
-            ),
-            (
-                50.0,
-                0.8,
-                [
-                    0.997_511_540_711_747_3,
-                    -0.070_503_376_847_326_93,
-                    0.602_645_222_941_326_2,
-                ],
-            ),
+            (0.7, 0.6, [0.629_917_115_323_486_8, 0.776_662_364_108_456_7, 0.925_825_898_328_683_2]),
+            (-3.3, 0.95, [-0.971_645_022_244_09, -0.236_444_392_507_587, 0.384_649_347_523_591_1]),
+            (50.0, 0.8, [0.997_511_540_711_747_3, -0.070_503_376_847_326_93, 0.602_645_222_941_326_2]),
         ];
         for (u, k, [sn, cn, dn]) in cases {
             let (s, c, d, _) = jacobi(u, k);
@@ -723,21 +617,11 @@ mod tests {
                 let t = 0.05 * f64::from(i) + 0.013;
                 let (th, om) = p.angle(t);
                 // ½θ̇² + w² sin θ = E
-                close(
-                    0.5 * om * om + w2 * th.sin(),
-                    e,
-                    2e-13 * (1.0 + e.abs()),
-                    "energy",
-                );
+                close(0.5 * om * om + w2 * th.sin(), e, 2e-13 * (1.0 + e.abs()), "energy");
                 let (thp, omp) = p.angle(t + h);
                 let (thm, omm) = p.angle(t - h);
                 close((thp - thm) / (2.0 * h), om, 1e-8, "θ' = θ̇");
-                close(
-                    (omp - omm) / (2.0 * h),
-                    -w2 * th.cos(),
-                    1e-8,
-                    "θ̈ = −w² cos θ",
-                );
+                close((omp - omm) / (2.0 * h), -w2 * th.cos(), 1e-8, "θ̈ = −w² cos θ");
             }
         }
     }
@@ -790,9 +674,7 @@ mod tests {
         let d1 = quadrature_max_diff(1.0, 0.0, 2.0, 1);
         let d2 = quadrature_max_diff(1.3, 2.0, -2.5, 1);
         let d3 = quadrature_max_diff(3.0, -FRAC_PI_2, 2.0 * 3f64.sqrt() * (1.0 + 1e-4), 16);
-        println!(
-            "quadrature t(θ), 3 revolutions: max |Δθ| = {d1:e}, {d2:e}, near separatrix {d3:e}"
-        );
+        println!("quadrature t(θ), 3 revolutions: max |Δθ| = {d1:e}, {d2:e}, near separatrix {d3:e}");
         assert!(d1 <= 1e-12 && d2 <= 1e-12, "{d1:e} {d2:e}");
         assert!(d3 <= 1e-10, "{d3:e}");
     }
@@ -827,12 +709,7 @@ mod tests {
             (0.3, 7.0, -2.516_835_480_830_780_4, -0.518_065_732_845_767_6),
             (0.3, 20.0, -1.064_411_584_358_251, -1.194_489_650_017_796_6),
             (-0.3, 7.0, -2.595_612_408_335_209, 0.076_256_669_269_670_72),
-            (
-                -0.3,
-                20.0,
-                -1.528_845_404_607_240_5,
-                -1.387_541_542_782_977_5,
-            ),
+            (-0.3, 20.0, -1.528_845_404_607_240_5, -1.387_541_542_782_977_5),
         ];
         for (om0, t, th, om) in mp {
             let (a, b) = PendulumExact::new(2.0, th0, om0).unwrap().angle(t);
@@ -865,77 +742,19 @@ mod tests {
         // `separatrix_gap`); the naive form was off by 4e-12 at t = 20.
         let sq3 = 2.0 * 3f64.sqrt() * (1.0 + 1e-4);
         let mp = [
-            (
-                1.0,
-                2.0 * (1.0 + 1e-6),
-                10.0,
-                1.581_627_983_964_469_7,
-                0.011_194_804_775_013_172,
-            ),
-            (
-                1.0,
-                2.0 * (1.0 + 1e-6),
-                15.0,
-                3.122_490_707_139_323,
-                1.400_645_005_129_599_5,
-            ),
-            (
-                1.0,
-                2.0 * (1.0 + 1e-6),
-                20.0,
-                7.788_061_636_128_241,
-                0.065_968_725_717_551_1,
-            ),
-            (
-                1.0,
-                2.0 * (1.0 - 1e-6),
-                10.0,
-                1.559_601_572_057_899,
-                -0.010_831_492_455_581_42,
-            ),
-            (
-                1.0,
-                2.0 * (1.0 - 1e-6),
-                15.0,
-                0.019_119_516_605_870_29,
-                -1.400_626_751_315_451,
-            ),
-            (
-                1.0,
-                2.0 * (1.0 - 1e-6),
-                20.0,
-                -4.646_407_100_544_811,
-                -0.065_909_249_792_261_16,
-            ),
-            (
-                3.0,
-                sq3,
-                5.0,
-                1.858_168_347_270_360_3,
-                0.498_445_449_611_088_3,
-            ),
-            (
-                3.0,
-                sq3,
-                15.0,
-                14.005_542_755_114_467,
-                0.233_023_398_191_060_03,
-            ),
-            (
-                3.0,
-                sq3,
-                20.0,
-                18.690_901_614_187_844,
-                2.636_349_269_269_811_3,
-            ),
+            (1.0, 2.0 * (1.0 + 1e-6), 10.0, 1.581_627_983_964_469_7, 0.011_194_804_775_013_172),
+            (1.0, 2.0 * (1.0 + 1e-6), 15.0, 3.122_490_707_139_323, 1.400_645_005_129_599_5),
+            (1.0, 2.0 * (1.0 + 1e-6), 20.0, 7.788_061_636_128_241, 0.065_968_725_717_551_1),
+            (1.0, 2.0 * (1.0 - 1e-6), 10.0, 1.559_601_572_057_899, -0.010_831_492_455_581_42),
+            (1.0, 2.0 * (1.0 - 1e-6), 15.0, 0.019_119_516_605_870_29, -1.400_626_751_315_451),
+            (1.0, 2.0 * (1.0 - 1e-6), 20.0, -4.646_407_100_544_811, -0.065_909_249_792_261_16),
+            (3.0, sq3, 5.0, 1.858_168_347_270_360_3, 0.498_445_449_611_088_3),
+            (3.0, sq3, 15.0, 14.005_542_755_114_467, 0.233_023_398_191_060_03),
+            (3.0, sq3, 20.0, 18.690_901_614_187_844, 2.636_349_269_269_811_3),
         ];
         for (w2, om0, t, th, om) in mp {
             let (a, b) = PendulumExact::new(w2, -FRAC_PI_2, om0).unwrap().angle(t);
-            println!(
-                "w² = {w2}, t = {t}: vs mpmath Δθ = {:e}, Δθ̇ = {:e}",
-                a - th,
-                b - om
-            );
+            println!("w² = {w2}, t = {t}: vs mpmath Δθ = {:e}, Δθ̇ = {:e}", a - th, b - om);
             close(a, th, 2e-14, "θ vs mpmath");
             close(b, om, 2e-14, "θ̇ vs mpmath");
         }
@@ -947,10 +766,7 @@ mod tests {
         assert_eq!(PendulumExact::new(1.0, -FRAC_PI_2, 2.0).map(|_| ()), sep);
         assert_eq!(PendulumExact::new(1.0, -FRAC_PI_2, -2.0).map(|_| ()), sep);
         assert_eq!(PendulumExact::new(1.0, FRAC_PI_2, 0.0).map(|_| ()), sep);
-        assert_eq!(
-            PendulumExact::new(4.0, 0.0, 2.0 * 2f64.sqrt()).map(|_| ()),
-            sep
-        );
+        assert_eq!(PendulumExact::new(4.0, 0.0, 2.0 * 2f64.sqrt()).map(|_| ()), sep);
         assert!(PendulumExact::new(1.0, -FRAC_PI_2, 2.0 * (1.0 + 1e-9)).is_ok());
         for (w2, th, om, name) in [
             (0.0, 0.0, 1.0, "w2"),
@@ -966,11 +782,7 @@ mod tests {
                 other => panic!("expected InvalidParameter({name}), got {other:?}"),
             }
         }
-        let msg = ReferenceError::InvalidParameter {
-            name: "w2",
-            value: -1.0,
-        }
-        .to_string();
+        let msg = ReferenceError::InvalidParameter { name: "w2", value: -1.0 }.to_string();
         assert!(msg.contains("w2") && !msg.contains('\n'));
         assert!(!ReferenceError::Separatrix.to_string().contains('\n'));
     }

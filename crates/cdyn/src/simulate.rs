@@ -5,8 +5,8 @@
 //! seen every step before it.
 
 use crate::control::Control;
-use crate::dynamics::LinearSolver;
 use crate::diagnostics::{Measures, Probe};
+use crate::dynamics::LinearSolver;
 use crate::error::{Error, Result, positive};
 use crate::integrate::{Integrator, Rhs, Scheme};
 use crate::model::Model;
@@ -78,15 +78,8 @@ impl<'m> Simulation<'m> {
                 v0.len()
             )));
         }
-        if let Some((i, &x)) = q0
-            .iter()
-            .chain(v0)
-            .enumerate()
-            .find(|(_, x)| !x.is_finite())
-        {
-            return Err(Error::InvalidModel(format!(
-                "initial state component {i} is {x}"
-            )));
+        if let Some((i, &x)) = q0.iter().chain(v0).enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(Error::InvalidModel(format!("initial state component {i} is {x}")));
         }
         let e0 = model.kinetic(v0) + model.potential(q0, None);
         let mut x = Vec::with_capacity(2 * n + 1);
@@ -97,27 +90,12 @@ impl<'m> Simulation<'m> {
         if let Some(tolerance) = settings.consistency_tolerance {
             let m = probe.measure(model, q0, v0, 0.0, 0.0, e0);
             if m.phi.abs() > tolerance || m.phi_dot > tolerance {
-                return Err(Error::InconsistentInitialState {
-                    phi: m.phi.abs(),
-                    phi_dot: m.phi_dot,
-                    tolerance,
-                });
+                return Err(Error::InconsistentInitialState { phi: m.phi.abs(), phi_dot: m.phi_dot, tolerance });
             }
         }
         let system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
-        let integrator = Integrator::new(
-            settings.scheme,
-            settings.control.application,
-            system.state_len(),
-        );
-        Ok(Self {
-            system,
-            integrator,
-            probe,
-            settings,
-            x,
-            step: 0,
-        })
+        let integrator = Integrator::new(settings.scheme, settings.control.application, system.state_len());
+        Ok(Self { system, integrator, probe, settings, x, step: 0 })
     }
 
     pub fn model(&self) -> &'m Model {
@@ -165,37 +143,19 @@ impl<'m> Simulation<'m> {
     pub fn step(&mut self) -> Result<()> {
         let t = self.t();
         let step = self.step;
-        self.integrator
-            .step(&mut self.system, &mut self.x, t, self.settings.h)
-            .map_err(|e| match e {
-                EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
-                EvalError::NonFinite { .. } => Error::Diverged {
-                    step: step + 1,
-                    t: t + self.settings.h,
-                },
-            })?;
+        self.integrator.step(&mut self.system, &mut self.x, t, self.settings.h).map_err(|e| match e {
+            EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
+            EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t + self.settings.h },
+        })?;
         self.step += 1;
         if self.x.iter().any(|x| !x.is_finite()) {
-            return Err(Error::Diverged {
-                step: self.step,
-                t: self.t(),
-            });
+            return Err(Error::Diverged { step: self.step, t: self.t() });
         }
         // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.
         if self.settings.violation_limit.is_finite() {
-            let phi = self
-                .system
-                .dynamics
-                .phi
-                .iter()
-                .fold(0.0_f64, |a, p| a.max(p.abs()));
+            let phi = self.system.dynamics.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()));
             if phi > self.settings.violation_limit {
-                return Err(Error::ViolationLimit {
-                    step,
-                    t,
-                    phi,
-                    limit: self.settings.violation_limit,
-                });
+                return Err(Error::ViolationLimit { step, t, phi, limit: self.settings.violation_limit });
             }
         }
         Ok(())
@@ -228,11 +188,7 @@ pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
     positive("h", h)?;
     let ratio = t_end / h;
     if ratio > 1e12 {
-        return Err(Error::InvalidParameter {
-            name: "t_end / h",
-            value: ratio,
-            reason: "more than 1e12 steps",
-        });
+        return Err(Error::InvalidParameter { name: "t_end / h", value: ratio, reason: "more than 1e12 steps" });
     }
     Ok((ratio - 1e-9 * ratio.max(1.0)).ceil().max(1.0) as u64)
 }

@@ -7,11 +7,11 @@ use crate::linalg::{Breakdown, PIVOT_TOLERANCE, products};
 use crate::model::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::linalg::solvers::LltError;
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::linalg::solvers::LltError;
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use std::cell::RefCell;
@@ -63,7 +63,8 @@ impl SparseSchur {
         // AMD, unless the natural order fills no more: chains and trees are
         // often already ordered, and then the per-step permutation is saved.
         let analyse = |ordering| {
-            factorize_symbolic_cholesky(structure, Side::Upper, ordering, params).expect("symbolic Cholesky of a valid pattern")
+            factorize_symbolic_cholesky(structure, Side::Upper, ordering, params)
+                .expect("symbolic Cholesky of a valid pattern")
         };
         let amd = analyse(SymmetricOrdering::Amd);
         let natural = analyse(SymmetricOrdering::Identity);
@@ -137,7 +138,11 @@ impl SparseSchur {
     pub fn solve(&self, b: &mut [f64]) {
         let llt = faer::sparse::linalg::cholesky::LltRef::new(&self.symbolic, &self.l_values);
         let stack = &mut *self.stack.borrow_mut();
-        llt.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(b, self.m, 1), Par::Seq, MemStack::new(stack));
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(b, self.m, 1),
+            Par::Seq,
+            MemStack::new(stack),
+        );
     }
 }
-

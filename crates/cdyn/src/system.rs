@@ -71,22 +71,14 @@ impl Rhs for ControlledSystem<'_> {
         self.control.is_active()
     }
 
-    fn eval(
-        &mut self,
-        x: &[f64],
-        t: f64,
-        f: &mut [f64],
-        u: Option<&mut [f64]>,
-    ) -> Result<(), EvalError> {
+    fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
         let n = self.model.n();
         let (q, v, e) = split_state(x, n);
         self.evaluations += 1;
-        self.dynamics
-            .evaluate(self.model, q, v, t)
-            .map_err(|b| match b {
-                Breakdown::Singular(row) => EvalError::Singular { t, row },
-                Breakdown::NonFinite => EvalError::NonFinite { t },
-            })?;
+        self.dynamics.evaluate(self.model, q, v, t).map_err(|b| match b {
+            Breakdown::Singular(row) => EvalError::Singular { t, row },
+            Breakdown::NonFinite => EvalError::NonFinite { t },
+        })?;
         let e_dot = energy::energy_input(self.model, &self.dynamics, v);
         f[..n].copy_from_slice(v);
         f[n..2 * n].copy_from_slice(&self.dynamics.acc);
@@ -96,16 +88,7 @@ impl Rhs for ControlledSystem<'_> {
             let (u_q, rest) = u.split_at_mut(n);
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
-            self.control.terms(
-                self.model,
-                &self.dynamics,
-                v,
-                psi,
-                e_dot,
-                u_q,
-                u_v,
-                &mut self.scratch,
-            );
+            self.control.terms(self.model, &self.dynamics, v, psi, e_dot, u_q, u_v, &mut self.scratch);
         }
         Ok(())
     }

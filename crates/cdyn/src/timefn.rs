@@ -15,18 +15,12 @@ pub struct TimeFn {
 
 impl TimeFn {
     pub fn constant(c: f64) -> Self {
-        Self {
-            polynomial: vec![c],
-            sines: Vec::new(),
-        }
+        Self { polynomial: vec![c], sines: Vec::new() }
     }
 
     /// `c0 + c1 t`.
     pub fn linear(c0: f64, c1: f64) -> Self {
-        Self {
-            polynomial: vec![c0, c1],
-            sines: Vec::new(),
-        }
+        Self { polynomial: vec![c0, c1], sines: Vec::new() }
     }
 
     pub fn eval<D: Scalar>(&self, t: D) -> D {
@@ -43,9 +37,6 @@ impl TimeFn {
 
     /// Whether every coefficient is finite.
     pub fn is_finite(&self) -> bool {
-        self.polynomial
-            .iter()
-            .chain(self.sines.iter().flatten())
-            .all(|c| c.is_finite())
+        self.polynomial.iter().chain(self.sines.iter().flatten()).all(|c| c.is_finite())
     }
 }

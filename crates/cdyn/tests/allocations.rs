@@ -46,7 +46,11 @@ fn hanging_chain(n: usize) -> Example {
     let support = m.rigid("support", 1.0, 0.1, [0.0, 0.0], 0.0);
     // Everything starts moving with the support: ẋ = 0.3 at t = 0.
     m.bodies[0].velocity = [0.3, 0.0];
-    m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::X, f: TimeFn { polynomial: vec![], sines: vec![[0.1, 3.0, 0.0]] } });
+    m.add(Element::DriveCoordinate {
+        body: support,
+        coordinate: Coordinate::X,
+        f: TimeFn { polynomial: vec![], sines: vec![[0.1, 3.0, 0.0]] },
+    });
     m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::Y, f: TimeFn::constant(0.0) });
     m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::Angle, f: TimeFn::constant(0.0) });
     let mut prev = support;
@@ -57,14 +61,23 @@ fn hanging_chain(n: usize) -> Example {
         m.add(Element::Damper { a: prev, pa: [0.0; 2], b: body, pb: [0.0; 2], damping: 0.1 });
         prev = body;
     }
-    m.add(Element::AppliedForce { body: prev, point: [0.0; 2], fx: TimeFn::linear(0.0, 1.0), fy: TimeFn::constant(0.0) });
+    m.add(Element::AppliedForce {
+        body: prev,
+        point: [0.0; 2],
+        fx: TimeFn::linear(0.0, 1.0),
+        fy: TimeFn::constant(0.0),
+    });
     Example::from_mechanism(m.build().unwrap(), None)
 }
 
 fn controls() -> Vec<Control> {
     let mut out = Vec::new();
-    for geometric in [Geometric::None, Geometric::Baumgarte { alpha: 12.6, beta: 40.0 }, Geometric::Gradient(Gain::Rate(40.0))] {
-        for energy in [Energy::None, Energy::Gradient(EnergyGain::Rate { alpha_e: 40.0 }), Energy::Baumgarte { eta: 40.0 }] {
+    for geometric in
+        [Geometric::None, Geometric::Baumgarte { alpha: 12.6, beta: 40.0 }, Geometric::Gradient(Gain::Rate(40.0))]
+    {
+        for energy in
+            [Energy::None, Energy::Gradient(EnergyGain::Rate { alpha_e: 40.0 }), Energy::Baumgarte { eta: 40.0 }]
+        {
             for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
                 out.push(Control { geometric, energy, application });
             }

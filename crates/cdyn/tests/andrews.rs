@@ -14,27 +14,16 @@ fn initial_accelerations_and_multipliers_match_the_test_set() {
     let acc = test_set_angles(body_angles(&d.acc));
     for (i, (a, r)) in acc.iter().zip(constants::ACC0).enumerate() {
         // Zeros are zero only to the round-off of a 1e4-sized solve.
-        assert!(
-            (a - r).abs() <= 1e-12 * 14222.0,
-            "q̈[{i}] = {a} vs published {r}"
-        );
+        assert!((a - r).abs() <= 1e-12 * 14222.0, "q̈[{i}] = {a} vs published {r}");
     }
-    for (i, (l, r)) in d.lambda[CLOSURE_ROWS]
-        .iter()
-        .zip(constants::LAMBDA0)
-        .enumerate()
-    {
-        assert!(
-            (l - r).abs() <= 1e-12 * 98.6,
-            "λ[{i}] = {l} vs published {r}"
-        );
+    for (i, (l, r)) in d.lambda[CLOSURE_ROWS].iter().zip(constants::LAMBDA0).enumerate() {
+        assert!((l - r).abs() <= 1e-12 * 98.6, "λ[{i}] = {l} vs published {r}");
     }
 }
 
 fn angles_at_end(scheme: Scheme, h: f64, control: Control) -> [f64; 7] {
     let ex = andrews().unwrap();
-    let mut sim =
-        Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
+    let mut sim = Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
     sim.run::<Error>(0.03, u64::MAX, |_| Ok(())).unwrap();
     assert!((sim.t() - 0.03).abs() < 1e-15);
     test_set_angles(body_angles(sim.q()))
@@ -42,12 +31,7 @@ fn angles_at_end(scheme: Scheme, h: f64, control: Control) -> [f64; 7] {
 
 fn relative_error(q: [f64; 7]) -> f64 {
     let r = constants::Q_REF_003;
-    let num: f64 = q
-        .iter()
-        .zip(r)
-        .map(|(a, b)| (a - b).powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let num: f64 = q.iter().zip(r).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
     num / r.iter().map(|b| b * b).sum::<f64>().sqrt()
 }
 
@@ -58,17 +42,11 @@ fn positions_at_t_003_match_the_published_reference() {
     // (measured: at most 2.7e-8 relative, on γ; 5e-10 in the norm).
     let q = angles_at_end(Scheme::RungeKutta4, 1e-5, Control::none());
     for (i, (a, b)) in q.iter().zip(constants::Q_REF_003).enumerate() {
-        assert!(
-            ((a - b) / b).abs() < 1e-6,
-            "q[{i}] = {a:.16e}, published {b:.16e}"
-        );
+        assert!(((a - b) / b).abs() < 1e-6, "q[{i}] = {a:.16e}, published {b:.16e}");
     }
     let err = relative_error(q);
     assert!(err < 1e-8, "relative error of the position vector {err:e}");
     // And the error is the scheme's: halving h divides it by about 2⁴.
     let coarse = relative_error(angles_at_end(Scheme::RungeKutta4, 2e-5, Control::none()));
-    assert!(
-        (coarse / err).log2() > 3.5,
-        "errors {coarse:e} (2e-5) and {err:e} (1e-5)"
-    );
+    assert!((coarse / err).log2() > 3.5, "errors {coarse:e} (2e-5) and {err:e} (1e-5)");
 }

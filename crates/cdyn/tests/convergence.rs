@@ -6,8 +6,7 @@ use cdyn::{Control, Error, Scheme, Settings, Simulation};
 
 /// Max |X − X*| over the samples of a run to `t_end` with step `h`.
 fn max_error(ex: &Example, scheme: Scheme, h: f64, control: Control, t_end: f64) -> f64 {
-    let mut sim =
-        Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
+    let mut sim = Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
     let mut worst = 0.0_f64;
     sim.run::<Error>(t_end, 1, |s| {
         worst = worst.max(ex.error(s.q(), s.v(), s.t()).unwrap().abs());
@@ -19,10 +18,9 @@ fn max_error(ex: &Example, scheme: Scheme, h: f64, control: Control, t_end: f64)
 
 #[test]
 fn every_scheme_converges_at_its_order() {
-    for ex in [
-        cartesian_pendulum(PendulumParams::default()).unwrap(),
-        theta_pendulum(PendulumParams::default()).unwrap(),
-    ] {
+    for ex in
+        [cartesian_pendulum(PendulumParams::default()).unwrap(), theta_pendulum(PendulumParams::default()).unwrap()]
+    {
         for scheme in Scheme::ALL {
             let p = scheme.info().order as f64;
             // Steps small enough to be in the asymptotic range, errors far above round-off.
@@ -32,9 +30,8 @@ fn every_scheme_converges_at_its_order() {
                 Scheme::AdamsBashforth3 => 1e-2,
                 Scheme::RungeKutta4 => 4e-2,
             };
-            let errors: Vec<f64> = (0..3)
-                .map(|k| max_error(&ex, scheme, h0 / 2f64.powi(k), Control::none(), 4.0))
-                .collect();
+            let errors: Vec<f64> =
+                (0..3).map(|k| max_error(&ex, scheme, h0 / 2f64.powi(k), Control::none(), 4.0)).collect();
             for w in errors.windows(2) {
                 let observed = (w[0] / w[1]).log2();
                 assert!(
@@ -55,23 +52,14 @@ fn rk4_converges_to_the_exact_solution_over_the_whole_paper_interval() {
     let coarse = max_error(&ex, Scheme::RungeKutta4, 2.5e-3, Control::none(), 20.0);
     let fine = max_error(&ex, Scheme::RungeKutta4, 1.25e-3, Control::none(), 20.0);
     let order = (coarse / fine).log2();
-    assert!(
-        (order - 4.0).abs() < 0.1,
-        "errors {coarse:e}, {fine:e}: order {order}"
-    );
+    assert!((order - 4.0).abs() < 0.1, "errors {coarse:e}, {fine:e}: order {order}");
     assert!(fine < 1e-8, "max |X − X*| = {fine:e}");
 }
 
 #[test]
 fn cartesian_and_angle_models_agree_for_other_parameters() {
     // A librating pendulum, L = 2, g = 9.81, m = 3: both descriptions and the exact solution.
-    let p = PendulumParams {
-        mass: 3.0,
-        length: 2.0,
-        gravity: 9.81,
-        theta0: -1.0,
-        omega0: 0.4,
-    };
+    let p = PendulumParams { mass: 3.0, length: 2.0, gravity: 9.81, theta0: -1.0, omega0: 0.4 };
     for ex in [cartesian_pendulum(p).unwrap(), theta_pendulum(p).unwrap()] {
         let e = max_error(&ex, Scheme::RungeKutta4, 1e-3, Control::none(), 5.0);
         assert!(e < 1e-9, "n = {}: max |X − X*| = {e:e}", ex.model.n());
@@ -85,7 +73,8 @@ fn the_hand_written_baseline_follows_cdyn_step_for_step() {
     use cdyn::methods::{MethodGains, redundant_cases};
     let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
     let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
-    let mut sim = Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
+    let mut sim =
+        Simulation::new(&ex.model, Settings::new(Scheme::AdamsBashforth3, 0.01, control), &ex.q0, &ex.v0).unwrap();
     let mut hand = HandWritten::new([1.0, 0.0, 0.0, 2.0], 0.01, 20.0, 40.0);
     for step in 0..2000 {
         sim.step().unwrap();

@@ -24,11 +24,7 @@ impl Potential<2> for Coupled {
 }
 
 fn model() -> Model {
-    Model::builder(vec![1.0, 2.0, 3.0, 0.5])
-        .constrain(Twisted, [2, 0, 3])
-        .potential(Coupled, [1, 3])
-        .build()
-        .unwrap()
+    Model::builder(vec![1.0, 2.0, 3.0, 0.5]).constrain(Twisted, [2, 0, 3]).potential(Coupled, [1, 3]).build().unwrap()
 }
 
 fn phi(model: &Model, q: &[f64], t: f64) -> Vec<f64> {
@@ -100,20 +96,12 @@ fn accelerations_satisfy_the_constraint_equations() {
     let mut ja = vec![0.0; model.m()];
     cdyn::dynamics::jac_mul(model.pattern(), &d.jac, &d.acc, &mut ja);
     for r in 0..model.m() {
-        assert!(
-            (ja[r] - d.gamma[r]).abs() < 1e-12,
-            "row {r}: Φ_q A = {} vs γ = {}",
-            ja[r],
-            d.gamma[r]
-        );
+        assert!((ja[r] - d.gamma[r]).abs() < 1e-12, "row {r}: Φ_q A = {} vs γ = {}", ja[r], d.gamma[r]);
     }
     let mut jt = vec![0.0; model.n()];
     cdyn::dynamics::add_weighted_jt(model.pattern(), &d.jac, &d.lambda, &[1.0; 4], 1.0, &mut jt);
     for i in 0..model.n() {
         let residual = model.mass()[i] * d.acc[i] + jt[i] - d.force[i];
-        assert!(
-            residual.abs() < 1e-12,
-            "coordinate {i}: residual {residual}"
-        );
+        assert!(residual.abs() < 1e-12, "coordinate {i}: residual {residual}");
     }
 }

@@ -26,12 +26,7 @@ fn states() -> Vec<[f64; 4]> {
     for i in 0..20 {
         let a = i as f64 * 0.37;
         let r = 1.0 + 0.05 * (a * 3.0).sin(); // on and off the circle
-        out.push([
-            r * a.cos(),
-            r * a.sin(),
-            1.3 * (2.0 * a).cos(),
-            -0.7 + a.sin(),
-        ]);
+        out.push([r * a.cos(), r * a.sin(), 1.3 * (2.0 * a).cos(), -0.7 + a.sin()]);
     }
     out
 }
@@ -46,11 +41,7 @@ fn gamma_and_accelerations_match_the_closed_form() {
         assert!((d.gamma[0] + (vx * vx + vy * vy)).abs() < 1e-14);
         assert!((d.jac[0] - x).abs() < 1e-15 && (d.jac[1] - y).abs() < 1e-15);
         let a = closed_form_acc(s);
-        assert!(
-            (d.acc[0] - a[0]).abs() < 1e-13 && (d.acc[1] - a[1]).abs() < 1e-13,
-            "{:?} vs {a:?}",
-            d.acc
-        );
+        assert!((d.acc[0] - a[0]).abs() < 1e-13 && (d.acc[1] - a[1]).abs() < 1e-13, "{:?} vs {a:?}", d.acc);
     }
 }
 
@@ -108,35 +99,21 @@ fn closed_form_control(c: &Control, s @ [x, y, vx, vy]: [f64; 4], e0: f64) -> [f
 fn all_controls() -> Vec<Control> {
     let geometric = [
         Geometric::None,
-        Geometric::Baumgarte {
-            alpha: 3.0,
-            beta: 7.0,
-        },
+        Geometric::Baumgarte { alpha: 3.0, beta: 7.0 },
         Geometric::Gradient(Gain::Fixed(5.0)),
         Geometric::Gradient(Gain::Rate(11.0)),
     ];
     let energy = [
         Energy::None,
         Energy::Gradient(EnergyGain::Rate { alpha_e: 13.0 }),
-        Energy::Gradient(EnergyGain::Fixed {
-            rho_q: 0.7,
-            rho_v: 2.0,
-        }),
+        Energy::Gradient(EnergyGain::Fixed { rho_q: 0.7, rho_v: 2.0 }),
         Energy::Baumgarte { eta: 9.0 },
     ];
     let mut out = Vec::new();
     for g in geometric {
         for e in energy {
-            for a in [
-                Application::InRhs,
-                Application::ForwardEuler,
-                Application::BackwardEuler,
-            ] {
-                out.push(Control {
-                    geometric: g,
-                    energy: e,
-                    application: a,
-                });
+            for a in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
+                out.push(Control { geometric: g, energy: e, application: a });
             }
         }
     }
@@ -158,26 +135,17 @@ fn one_euler_step_of_every_control_matches_the_hand_computation() {
             let a = closed_form_acc(s);
             [s[2], s[3], a[0], a[1]]
         };
-        let plus = |a: [f64; 4], b: [f64; 4], k: f64| {
-            std::array::from_fn::<f64, 4, _>(|i| a[i] + k * b[i])
-        };
+        let plus = |a: [f64; 4], b: [f64; 4], k: f64| std::array::from_fn::<f64, 4, _>(|i| a[i] + k * b[i]);
         let expected = match c.application {
             Application::InRhs => plus(x0, plus(f(x0), closed_form_control(&c, x0, e0), 1.0), h),
-            Application::ForwardEuler => {
-                plus(plus(x0, f(x0), h), closed_form_control(&c, x0, e0), h)
-            }
+            Application::ForwardEuler => plus(plus(x0, f(x0), h), closed_form_control(&c, x0, e0), h),
             Application::BackwardEuler => {
                 let xh = plus(x0, f(x0), h);
                 plus(xh, closed_form_control(&c, xh, e0), h)
             }
         };
         for i in 0..4 {
-            assert!(
-                (x[i] - expected[i]).abs() < 1e-14,
-                "{c:?}: component {i}: {} vs {}",
-                x[i],
-                expected[i]
-            );
+            assert!((x[i] - expected[i]).abs() < 1e-14, "{c:?}: component {i}: {} vs {}", x[i], expected[i]);
         }
     }
 }
@@ -189,21 +157,12 @@ fn control_terms_vanish_on_the_exact_solution() {
     for k in 0..24 {
         let theta = k as f64 * 0.29;
         let omega = (4.0 - 2.0 * theta.sin()).sqrt();
-        let x = [
-            theta.cos(),
-            theta.sin(),
-            -theta.sin() * omega,
-            theta.cos() * omega,
-            0.0,
-        ];
+        let x = [theta.cos(), theta.sin(), -theta.sin() * omega, theta.cos() * omega, 0.0];
         for c in all_controls() {
             let mut sys = ControlledSystem::new(&model, c, e0);
             let (mut f, mut u) = ([0.0; 5], [0.0; 5]);
             sys.eval(&x, 0.0, &mut f, Some(&mut u)).unwrap();
-            assert!(
-                u.iter().all(|u| u.abs() < 1e-13),
-                "{c:?} at θ = {theta}: U = {u:?}"
-            );
+            assert!(u.iter().all(|u| u.abs() < 1e-13), "{c:?} at θ = {theta}: U = {u:?}");
         }
     }
 }
@@ -233,29 +192,20 @@ fn perturbed_run(control: Control, scale_q: f64, scale_v: f64, t_end: f64) -> Ve
 /// The decay rate fitted to `ln|y|` over samples, by least squares.
 fn fitted_rate(samples: &[(f64, f64)]) -> f64 {
     let n = samples.len() as f64;
-    let (st, sy) = samples
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (t, y)| (a + t, b + y.abs().ln()));
+    let (st, sy) = samples.iter().fold((0.0, 0.0), |(a, b), (t, y)| (a + t, b + y.abs().ln()));
     let (mt, my) = (st / n, sy / n);
-    let (num, den) = samples.iter().fold((0.0, 0.0), |(a, b), (t, y)| {
-        (a + (t - mt) * (y.abs().ln() - my), b + (t - mt).powi(2))
-    });
+    let (num, den) =
+        samples.iter().fold((0.0, 0.0), |(a, b), (t, y)| (a + (t - mt) * (y.abs().ln() - my), b + (t - mt).powi(2)));
     -num / den
 }
 
 #[test]
 fn cvsgf_decays_a_perturbation_at_the_target_rate() {
     for alpha_g in [5.0, 20.0] {
-        let c = Control {
-            geometric: Geometric::Gradient(Gain::Rate(alpha_g)),
-            ..Control::none()
-        };
+        let c = Control { geometric: Geometric::Gradient(Gain::Rate(alpha_g)), ..Control::none() };
         let run = perturbed_run(c, 1.0 + 1e-4, 1.0, 0.5);
         let rate = fitted_rate(&run.iter().map(|&(t, phi, _)| (t, phi)).collect::<Vec<_>>());
-        assert!(
-            (rate / alpha_g - 1.0).abs() < 0.01,
-            "α_g = {alpha_g}: fitted {rate}"
-        );
+        assert!((rate / alpha_g - 1.0).abs() < 0.01, "α_g = {alpha_g}: fitted {rate}");
     }
 }
 
@@ -266,21 +216,12 @@ fn gradient_energy_control_decays_psi_at_the_target_rate() {
     // scale v after the start through a perturbed initial velocity and an
     // energy reference of 2 — equivalently, Ψ₀ = 2(s² − 1) at Y = 0.
     for alpha_e in [5.0, 20.0] {
-        let c = Control {
-            energy: Energy::Gradient(EnergyGain::Rate { alpha_e }),
-            ..Control::none()
-        };
+        let c = Control { energy: Energy::Gradient(EnergyGain::Rate { alpha_e }), ..Control::none() };
         let run = energy_perturbed(c, 0.5);
         let rate = fitted_rate(&run);
-        assert!(
-            (rate / alpha_e - 1.0).abs() < 0.01,
-            "α_e = {alpha_e}: fitted {rate}"
-        );
+        assert!((rate / alpha_e - 1.0).abs() < 0.01, "α_e = {alpha_e}: fitted {rate}");
     }
-    let c = Control {
-        energy: Energy::Baumgarte { eta: 10.0 },
-        ..Control::none()
-    };
+    let c = Control { energy: Energy::Baumgarte { eta: 10.0 }, ..Control::none() };
     let rate = fitted_rate(&energy_perturbed(c, 0.5));
     assert!((rate / 10.0 - 1.0).abs() < 0.01, "η = 10: fitted {rate}");
 }
@@ -305,19 +246,13 @@ fn energy_perturbed(control: Control, t_end: f64) -> Vec<(f64, f64)> {
 #[test]
 fn baumgarte_follows_the_critically_damped_response() {
     let omega: f64 = 8.0;
-    let c = Control {
-        geometric: Geometric::baumgarte_from(omega, 1.0).unwrap(),
-        ..Control::none()
-    };
+    let c = Control { geometric: Geometric::baumgarte_from(omega, 1.0).unwrap(), ..Control::none() };
     let run = perturbed_run(c, 1.0 + 1e-4, 1.0, 1.0);
     let phi0 = run[0].1;
     for &(t, phi, _) in &run {
         // Φ̇(0) = 0 for a radial perturbation with tangent velocity.
         let expected = phi0 * (1.0 + omega * t) * (-omega * t).exp();
-        assert!(
-            (phi - expected).abs() < 0.01 * phi0.abs(),
-            "t = {t}: {phi} vs {expected}"
-        );
+        assert!((phi - expected).abs() < 0.01 * phi0.abs(), "t = {t}: {phi} vs {expected}");
     }
 }
 
@@ -335,7 +270,7 @@ fn backward_euler_cvsgf_with_unit_gain_step_is_a_gauss_newton_projection() {
         };
         let mut sys = ControlledSystem::new(&model, c, 2.0);
         let mut integ = Integrator::new(Scheme::Euler, c.application, sys.state_len());
-        let r = (1.0 + 2.0 * eps as f64).sqrt();
+        let r = (1.0 + 2.0 * eps).sqrt();
         let mut x = [r, 0.0, 0.0, 2.0, 0.0];
         let (xh, yh) = (x[0] + h * x[2], x[1] + h * x[3]);
         let phi_hat: f64 = 0.5 * (xh * xh + yh * yh - 1.0);
@@ -356,30 +291,17 @@ fn right_hand_side_evaluations_per_step_are_as_designed() {
     let cvsgf = Geometric::Gradient(Gain::Fixed(20.0));
     let cases = [
         (Scheme::AdamsBashforth3, Application::InRhs, 2 * 4 + 98),
-        (
-            Scheme::AdamsBashforth3,
-            Application::ForwardEuler,
-            2 * 4 + 98,
-        ),
+        (Scheme::AdamsBashforth3, Application::ForwardEuler, 2 * 4 + 98),
         // Backward control evaluates U once more per step, RK4 start-up included.
-        (
-            Scheme::AdamsBashforth3,
-            Application::BackwardEuler,
-            2 * 4 + 98 + 100,
-        ),
+        (Scheme::AdamsBashforth3, Application::BackwardEuler, 2 * 4 + 98 + 100),
         (Scheme::AdamsBashforth2, Application::InRhs, 4 + 99),
         (Scheme::Euler, Application::InRhs, 100),
         (Scheme::RungeKutta4, Application::InRhs, 400),
         (Scheme::RungeKutta4, Application::ForwardEuler, 400),
     ];
     for (scheme, application, expected) in cases {
-        let c = Control {
-            geometric: cvsgf,
-            energy: Energy::None,
-            application,
-        };
-        let mut sim =
-            Simulation::new(&ex.model, Settings::new(scheme, 0.01, c), &ex.q0, &ex.v0).unwrap();
+        let c = Control { geometric: cvsgf, energy: Energy::None, application };
+        let mut sim = Simulation::new(&ex.model, Settings::new(scheme, 0.01, c), &ex.q0, &ex.v0).unwrap();
         sim.run::<Error>(1.0, 1000, |_| Ok(())).unwrap();
         assert_eq!(sim.steps(), 100);
         assert_eq!(sim.evaluations(), expected, "{scheme:?} {application:?}");
@@ -394,11 +316,7 @@ fn redundant_constraints_are_a_typed_error_with_step_and_time() {
             [(x * x + y * y - 1.0) * 0.5]
         }
     }
-    let model = Model::builder(vec![1.0, 1.0, 1.0])
-        .constrain(Rod, [0, 1])
-        .constrain(Rod, [0, 1])
-        .build()
-        .unwrap();
+    let model = Model::builder(vec![1.0, 1.0, 1.0]).constrain(Rod, [0, 1]).constrain(Rod, [0, 1]).build().unwrap();
     let mut sim = Simulation::new(
         &model,
         Settings::new(Scheme::Euler, 0.01, Control::none()),
@@ -406,14 +324,7 @@ fn redundant_constraints_are_a_typed_error_with_step_and_time() {
         &[0.0, 1.0, 0.0],
     )
     .unwrap();
-    assert_eq!(
-        sim.step(),
-        Err(Error::SingularConstraints {
-            step: 0,
-            t: 0.0,
-            row: 1
-        })
-    );
+    assert_eq!(sim.step(), Err(Error::SingularConstraints { step: 0, t: 0.0, row: 1 }));
 }
 
 #[test]
@@ -423,10 +334,7 @@ fn a_diverging_run_stops_with_step_and_time() {
     let mut settings = Settings::new(
         Scheme::Euler,
         0.01,
-        Control {
-            geometric: Geometric::Gradient(Gain::Rate(2e6)),
-            ..Control::none()
-        },
+        Control { geometric: Geometric::Gradient(Gain::Rate(2e6)), ..Control::none() },
     );
     settings.consistency_tolerance = None;
     let mut sim = Simulation::new(&ex.model, settings, &[1.001, 0.0], &[0.0, 2.0]).unwrap();
@@ -451,25 +359,13 @@ fn a_diverging_run_stops_with_step_and_time() {
 fn inconsistent_initial_state_is_refused_unless_allowed() {
     let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
     let settings = Settings::new(Scheme::Euler, 0.01, Control::none());
-    let err = Simulation::new(&ex.model, settings, &[1.1, 0.0], &[0.0, 2.0])
-        .err()
-        .unwrap();
-    assert!(
-        matches!(err, Error::InconsistentInitialState { .. }),
-        "{err:?}"
-    );
-    let err = Simulation::new(&ex.model, settings, &[1.0, 0.0], &[0.5, 2.0])
-        .err()
-        .unwrap();
-    assert!(
-        matches!(err, Error::InconsistentInitialState { .. }),
-        "{err:?}"
-    );
+    let err = Simulation::new(&ex.model, settings, &[1.1, 0.0], &[0.0, 2.0]).err().unwrap();
+    assert!(matches!(err, Error::InconsistentInitialState { .. }), "{err:?}");
+    let err = Simulation::new(&ex.model, settings, &[1.0, 0.0], &[0.5, 2.0]).err().unwrap();
+    assert!(matches!(err, Error::InconsistentInitialState { .. }), "{err:?}");
     let bad_h = Settings::new(Scheme::Euler, -0.01, Control::none());
     assert!(matches!(
-        Simulation::new(&ex.model, bad_h, &ex.q0, &ex.v0)
-            .err()
-            .unwrap(),
+        Simulation::new(&ex.model, bad_h, &ex.q0, &ex.v0).err().unwrap(),
         Error::InvalidParameter { name: "h", .. }
     ));
 }

@@ -15,13 +15,8 @@ fn angle_of(q: &[f64], v: &[f64]) -> (f64, f64) {
 
 fn run(m: &Mechanism, h: f64, t_end: f64) -> Vec<(f64, f64, f64)> {
     let b = m.build().unwrap();
-    let mut sim = Simulation::new(
-        &b.model,
-        Settings::new(Scheme::RungeKutta4, h, Control::none()),
-        &b.q0,
-        &b.v0,
-    )
-    .unwrap();
+    let mut sim =
+        Simulation::new(&b.model, Settings::new(Scheme::RungeKutta4, h, Control::none()), &b.q0, &b.v0).unwrap();
     let mut out = Vec::new();
     sim.run::<Error>(t_end, 10, |s| {
         let (th, om) = angle_of(s.q(), s.v());
@@ -46,36 +41,19 @@ fn point_mass_on_a_rod_and_rigid_body_on_a_pin_are_the_same_pendulum() {
     let body = rigid.rigid("bar", m, inertia, [l * c, l * s], theta0);
     rigid.bodies[0].velocity = [-l * s * omega0, l * c * omega0];
     rigid.bodies[0].angular_velocity = omega0;
-    rigid.add(Element::Revolute {
-        a: BodyId::Ground,
-        pa: [0.0, 0.0],
-        b: body,
-        pb: [-l, 0.0],
-    });
+    rigid.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: body, pb: [-l, 0.0] });
 
     let mut point = Mechanism::new([0.0, -G]);
     let bob = point.point("bob", m, [l_eq * c, l_eq * s]);
     point.bodies[0].velocity = [-l_eq * s * omega0, l_eq * c * omega0];
-    point.add(Element::Distance {
-        a: BodyId::Ground,
-        pa: [0.0, 0.0],
-        b: bob,
-        pb: [0.0, 0.0],
-        length: l_eq,
-    });
+    point.add(Element::Distance { a: BodyId::Ground, pa: [0.0, 0.0], b: bob, pb: [0.0, 0.0], length: l_eq });
 
     let exact = PendulumExact::new(G / l_eq, theta0, omega0).unwrap();
     let (a, b) = (run(&rigid, 1e-3, 5.0), run(&point, 1e-3, 5.0));
     for ((t, th_a, om_a), (_, th_b, om_b)) in a.iter().zip(&b) {
         let (th, om) = exact.angle(*t);
-        assert!(
-            (th_a - th).abs() < 1e-9 && (th_b - th).abs() < 1e-9,
-            "t = {t}: {th_a} {th_b} vs {th}"
-        );
-        assert!(
-            (om_a - om).abs() < 1e-8 && (om_b - om).abs() < 1e-8,
-            "t = {t}: {om_a} {om_b} vs {om}"
-        );
+        assert!((th_a - th).abs() < 1e-9 && (th_b - th).abs() < 1e-9, "t = {t}: {th_a} {th_b} vs {th}");
+        assert!((om_a - om).abs() < 1e-8 && (om_b - om).abs() < 1e-8, "t = {t}: {om_a} {om_b} vs {om}");
     }
 }
 
@@ -83,38 +61,20 @@ fn point_mass_on_a_rod_and_rigid_body_on_a_pin_are_the_same_pendulum() {
 fn bad_descriptions_name_the_element() {
     let mut m = Mechanism::new([0.0, -G]);
     let bob = m.point("bob", 1.0, [1.0, 0.0]);
-    m.add(Element::Revolute {
-        a: BodyId::Ground,
-        pa: [0.0, 0.0],
-        b: BodyId::Body(7),
-        pb: [0.0, 0.0],
-    });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: BodyId::Body(7), pb: [0.0, 0.0] });
     let err = m.build().err().unwrap().to_string();
-    assert!(
-        err.contains("element 0 (revolute)") && err.contains("body 7 does not exist"),
-        "{err}"
-    );
+    assert!(err.contains("element 0 (revolute)") && err.contains("body 7 does not exist"), "{err}");
 
     let mut m = Mechanism::new([0.0, -G]);
     let bob2 = m.point("bob", 1.0, [1.0, 0.0]);
-    m.add(Element::FixedAngle {
-        a: BodyId::Ground,
-        b: bob2,
-        angle: 0.0,
-    });
+    m.add(Element::FixedAngle { a: BodyId::Ground, b: bob2, angle: 0.0 });
     let err = m.build().err().unwrap().to_string();
-    assert!(
-        err.contains("point mass") && err.contains("no angle"),
-        "{err}"
-    );
+    assert!(err.contains("point mass") && err.contains("no angle"), "{err}");
 
     let mut m = Mechanism::new([0.0, -G]);
     m.point("heavy", 0.0, [1.0, 0.0]);
     let err = m.build().err().unwrap().to_string();
-    assert!(
-        err.contains("body 0 (heavy)") && err.contains("mass"),
-        "{err}"
-    );
+    assert!(err.contains("body 0 (heavy)") && err.contains("mass"), "{err}");
     let _ = bob;
 }
 

@@ -30,14 +30,11 @@ use crate::error::Result;
 use crate::planar::{BodyId, Element, Mechanism};
 use crate::timefn::TimeFn;
 
-/// The test set's constants (SI units), from `andrews.f`.
+/// The test set's constants (SI units), from `andrews.f`, with every published digit.
+#[allow(clippy::excessive_precision)]
 pub mod constants {
-    pub const M: [f64; 7] = [
-        0.04325, 0.00365, 0.02373, 0.00706, 0.07050, 0.00706, 0.05498,
-    ];
-    pub const I: [f64; 7] = [
-        2.194e-6, 4.410e-7, 5.255e-6, 5.667e-7, 1.169e-5, 5.667e-7, 1.912e-5,
-    ];
+    pub const M: [f64; 7] = [0.04325, 0.00365, 0.02373, 0.00706, 0.07050, 0.00706, 0.05498];
+    pub const I: [f64; 7] = [2.194e-6, 4.410e-7, 5.255e-6, 5.667e-7, 1.169e-5, 5.667e-7, 1.912e-5];
     pub const XA: f64 = -0.06934;
     pub const YA: f64 = -0.00227;
     pub const XB: f64 = -0.03635;
@@ -78,24 +75,11 @@ pub mod constants {
         1.23054744454982119249735015568,
     ];
     /// Published accelerations `q̈(0)`.
-    pub const ACC0: [f64; 7] = [
-        14222.4439199541138705911625887,
-        -10666.8329399655854029433719415,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-    ];
+    pub const ACC0: [f64; 7] =
+        [14222.4439199541138705911625887, -10666.8329399655854029433719415, 0.0, 0.0, 0.0, 0.0, 0.0];
     /// Published multipliers `λ(0)` of the six loop-closure constraints.
-    pub const LAMBDA0: [f64; 6] = [
-        98.5668703962410896057654982170,
-        -6.12268834425566265503114393122,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-    ];
+    pub const LAMBDA0: [f64; 6] =
+        [98.5668703962410896057654982170, -6.12268834425566265503114393122, 0.0, 0.0, 0.0, 0.0];
     /// Published reference angles at t = 0.03 (PSIDE, tolerance 1e-14).
     pub const Q_REF_003: [f64; 7] = [
         0.1581077119629904e+2,
@@ -143,15 +127,7 @@ pub fn mechanism(q0: [f64; 7]) -> Mechanism {
     let (body6_g, body6_e) = ([-(ZF - FA), 0.0], [FA, 0.0]);
     let (body7_a, body7_g) = (neg(c7), add([0.0, -U], neg(c7)));
 
-    let angles = [
-        beta,
-        beta + theta,
-        gamma,
-        phi + delta,
-        delta,
-        omega + eps,
-        eps,
-    ];
+    let angles = [beta, beta + theta, gamma, phi + delta, delta, omega + eps, eps];
     let p = rot(beta, [RR, 0.0]);
     let f = add(a, rot(delta, [ZT, 0.0]));
     let g = add(a, rot(eps, [0.0, -U]));
@@ -165,9 +141,8 @@ pub fn mechanism(q0: [f64; 7]) -> Mechanism {
         add(a, rot(eps, c7)),
     ];
     let mut m = Mechanism::new([0.0, 0.0]);
-    let ids: Vec<BodyId> = (0..7)
-        .map(|i| m.rigid(&format!("body{}", i + 1), M[i], I[i], centres[i], angles[i]))
-        .collect();
+    let ids: Vec<BodyId> =
+        (0..7).map(|i| m.rigid(&format!("body{}", i + 1), M[i], I[i], centres[i], angles[i])).collect();
     let ground = BodyId::Ground;
     let rev = |a, pa, b, pb| Element::Revolute { a, pa, b, pb };
     m.add(rev(ground, [0.0, 0.0], ids[0], body1_o))
@@ -181,18 +156,8 @@ pub fn mechanism(q0: [f64; 7]) -> Mechanism {
         .add(rev(ground, a, ids[4], body5_a))
         .add(rev(ids[5], body6_g, ids[6], body7_g))
         .add(rev(ground, a, ids[6], body7_a))
-        .add(Element::Spring {
-            a: ids[2],
-            pa: body3_d,
-            b: ground,
-            pb: [XC, YC],
-            stiffness: C0,
-            rest_length: L0,
-        })
-        .add(Element::AppliedTorque {
-            body: ids[0],
-            f: TimeFn::constant(MOM),
-        });
+        .add(Element::Spring { a: ids[2], pa: body3_d, b: ground, pb: [XC, YC], stiffness: C0, rest_length: L0 })
+        .add(Element::AppliedTorque { body: ids[0], f: TimeFn::constant(MOM) });
     m
 }
 
@@ -202,15 +167,7 @@ pub const CLOSURE_ROWS: std::ops::Range<usize> = 4..10;
 /// The test set's angles `(β, Θ, γ, Φ, δ, Ω, ε)` from body angles `φ₁…φ₇`
 /// (or their rates, or accelerations: the map is linear).
 pub fn test_set_angles(phi: [f64; 7]) -> [f64; 7] {
-    [
-        phi[0],
-        phi[1] - phi[0],
-        phi[2],
-        phi[3] - phi[4],
-        phi[4],
-        phi[5] - phi[6],
-        phi[6],
-    ]
+    [phi[0], phi[1] - phi[0], phi[2], phi[3] - phi[4], phi[4], phi[5] - phi[6], phi[6]]
 }
 
 /// The body angles `φ₁…φ₇` of a state of the built model.
@@ -226,9 +183,7 @@ pub fn andrews() -> Result<Example> {
         model: built.model,
         q0: built.q0,
         v0: built.v0,
-        observables: ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"]
-            .map(String::from)
-            .to_vec(),
+        observables: ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"].map(String::from).to_vec(),
         observe: Box::new(|q, _v, out| out.copy_from_slice(&test_set_angles(body_angles(q)))),
         reference: None,
     })

@@ -23,13 +23,7 @@ pub struct PendulumParams {
 impl Default for PendulumParams {
     fn default() -> Self {
         // X(0) = 1, Y(0) = 0, V_X(0) = 0, V_Y(0) = 2 (Eq. 63).
-        Self {
-            mass: 1.0,
-            length: 1.0,
-            gravity: 1.0,
-            theta0: 0.0,
-            omega0: 2.0,
-        }
+        Self { mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.0, omega0: 2.0 }
     }
 }
 
@@ -40,11 +34,7 @@ impl PendulumParams {
         non_negative("gravity", self.gravity)?;
         for (name, x) in [("theta0", self.theta0), ("omega0", self.omega0)] {
             if !x.is_finite() {
-                return Err(crate::Error::InvalidParameter {
-                    name,
-                    value: x,
-                    reason: "must be finite",
-                });
+                return Err(crate::Error::InvalidParameter { name, value: x, reason: "must be finite" });
             }
         }
         Ok(())
@@ -91,12 +81,7 @@ impl Potential<1> for ThetaWeight {
 
 fn tip(length: f64, theta: f64, omega: f64) -> [f64; 4] {
     let (s, c) = theta.sin_cos();
-    [
-        length * c,
-        length * s,
-        -length * s * omega,
-        length * c * omega,
-    ]
+    [length * c, length * s, -length * s * omega, length * c * omega]
 }
 
 fn names() -> Vec<String> {
@@ -108,12 +93,7 @@ pub fn cartesian_pendulum(p: PendulumParams) -> Result<Example> {
     p.validate()?;
     let model = Model::builder(vec![p.mass, p.mass])
         .constrain(Rod { length: p.length }, [0, 1])
-        .potential(
-            Weight {
-                w: p.mass * p.gravity,
-            },
-            [1],
-        )
+        .potential(Weight { w: p.mass * p.gravity }, [1])
         .build()?;
     let [x, y, vx, vy] = tip(p.length, p.theta0, p.omega0);
     let reference = p.exact().map(|exact| -> super::Reference {
@@ -138,12 +118,7 @@ pub fn cartesian_pendulum(p: PendulumParams) -> Result<Example> {
 pub fn theta_pendulum(p: PendulumParams) -> Result<Example> {
     p.validate()?;
     let model = Model::builder(vec![p.mass * p.length * p.length])
-        .potential(
-            ThetaWeight {
-                mgl: p.mass * p.gravity * p.length,
-            },
-            [0],
-        )
+        .potential(ThetaWeight { mgl: p.mass * p.gravity * p.length }, [0])
         .build()?;
     let reference = p.exact().map(|exact| -> super::Reference {
         Box::new(move |t, q, v| {

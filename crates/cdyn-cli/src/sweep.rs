@@ -1,0 +1,277 @@
+//! `cdyn sweep`: a grid over gains and step sizes, run in parallel (rayon),
+//! with a table and heat maps of the worst error and violations — the
+//! question the paper leaves open, how to choose gains.
+//!
+//! Every grid point is an independent, deterministic run, and results are
+//! stored by grid index, so the output is bit-identical whatever the number
+//! of threads. `--shard I/N` runs the points with `index % N == I`; `cdyn
+//! merge` joins shard outputs into exactly what one run writes.
+
+use crate::heatmap::{HeatMap, write_heatmap};
+use crate::runner::run_case_quietly;
+use crate::scenario::Scenario;
+use anyhow::{Context, Result, anyhow, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The keys a sweep can vary: `[method]` gains and the step size.
+pub const AXES: [&str; 11] =
+    ["zeta", "alpha_g", "alpha", "beta", "omega", "damping_ratio", "alpha_e", "rho_q", "rho_v", "eta", "h"];
+
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Axis {
+    pub name: String,
+    pub values: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Point {
+    pub index: usize,
+    /// One value per axis.
+    pub values: Vec<f64>,
+    pub max_abs_phi: f64,
+    pub max_abs_psi: f64,
+    pub max_abs_err: Option<f64>,
+    pub steps: u64,
+    pub error: Option<String>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+/// What `sweep.json` holds.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Sweep {
+    pub scenario: String,
+    pub axes: Vec<Axis>,
+    /// `None` for a complete sweep.
+    pub shard: Option<Shard>,
+    pub points: Vec<Point>,
+}
+
+impl Sweep {
+    pub fn total(&self) -> usize {
+        self.axes.iter().map(|a| a.values.len()).product()
+    }
+}
+
+/// Parses `I/N`.
+pub fn parse_shard(s: &str) -> Result<Shard> {
+    let (i, n) = s.split_once('/').ok_or_else(|| anyhow!("--shard {s:?}: expected I/N, e.g. 0/4"))?;
+    let (index, count): (usize, usize) = (
+        i.parse().map_err(|_| anyhow!("--shard {s:?}: I is not a number"))?,
+        n.parse().map_err(|_| anyhow!("--shard {s:?}: N is not a number"))?,
+    );
+    if count == 0 || index >= count {
+        bail!("--shard {s:?}: need 0 ≤ I < N");
+    }
+    Ok(Shard { index, count })
+}
+
+/// The axes of the scenario's `[sweep]` table, in file order.
+pub fn axes(scenario: &Scenario, file: &str) -> Result<Vec<Axis>> {
+    let table = scenario
+        .sweep
+        .as_ref()
+        .ok_or_else(|| anyhow!("{file}: a sweep needs a [sweep] table, e.g. alpha_g = [10, 20, 40]"))?;
+    if table.is_empty() {
+        bail!("{file}: [sweep] is empty");
+    }
+    table
+        .iter()
+        .map(|(name, value)| {
+            if !AXES.contains(&name.as_str()) {
+                bail!("{file}: [sweep] unknown key `{name}`; expected one of {}", AXES.join(", "));
+            }
+            let values: Vec<f64> = value
+                .as_array()
+                .ok_or_else(|| anyhow!("{file}: [sweep] {name}: expected a list of numbers"))?
+                .iter()
+                .map(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+                .collect::<Option<_>>()
+                .ok_or_else(|| anyhow!("{file}: [sweep] {name}: expected a list of numbers"))?;
+            if values.is_empty() {
+                bail!("{file}: [sweep] {name}: the list is empty");
+            }
+            Ok(Axis { name: name.clone(), values })
+        })
+        .collect()
+}
+
+/// The grid values of point `index` (last axis fastest).
+fn values_at(axes: &[Axis], mut index: usize) -> Vec<f64> {
+    let mut out = vec![0.0; axes.len()];
+    for (k, a) in axes.iter().enumerate().rev() {
+        out[k] = a.values[index % a.values.len()];
+        index /= a.values.len();
+    }
+    out
+}
+
+/// The scenario with one grid point's values set.
+fn at_point(scenario: &Scenario, axes: &[Axis], values: &[f64]) -> Scenario {
+    let mut s = scenario.clone();
+    for (a, &v) in axes.iter().zip(values) {
+        let m = &mut s.method;
+        match a.name.as_str() {
+            "zeta" => m.zeta = Some(v),
+            "alpha_g" => m.alpha_g = Some(v),
+            "alpha" => m.alpha = Some(v),
+            "beta" => m.beta = Some(v),
+            "omega" => m.omega = Some(v),
+            "damping_ratio" => m.damping_ratio = Some(v),
+            "alpha_e" => m.alpha_e = Some(v),
+            "rho_q" => m.rho_q = Some(v),
+            "rho_v" => m.rho_v = Some(v),
+            "eta" => m.eta = Some(v),
+            "h" => s.integrator.h = v,
+            other => unreachable!("axis {other} was checked"),
+        }
+    }
+    s
+}
+
+/// Runs the grid points of `shard` (all of them without one) on `threads` threads.
+pub fn run(scenario: &Scenario, path: &Path, shard: Option<Shard>, threads: Option<usize>) -> Result<Sweep> {
+    let file = path.display().to_string();
+    let axes = axes(scenario, &file)?;
+    let total: usize = axes.iter().map(|a| a.values.len()).product();
+    // Check every point's settings before running any, so mistakes surface at once.
+    let mut cases = Vec::new();
+    for index in (0..total).filter(|i| shard.as_ref().is_none_or(|s| i % s.count == s.index)) {
+        let values = values_at(&axes, index);
+        let case = at_point(scenario, &axes, &values).case(path).map_err(|e| {
+            let at: Vec<String> = axes.iter().zip(&values).map(|(a, v)| format!("{} = {v}", a.name)).collect();
+            anyhow!("{e} (at sweep point {})", at.join(", "))
+        })?;
+        cases.push((index, values, case));
+    }
+    let bar = ProgressBar::new(cases.len() as u64).with_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} points, {elapsed} elapsed, about {eta} left")
+            .expect("valid template"),
+    );
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start threads")?;
+    let points: Vec<Point> = pool.install(|| {
+        cases
+            .par_iter()
+            .map(|(index, values, case)| {
+                let r = run_case_quietly(case);
+                bar.inc(1);
+                Point {
+                    index: *index,
+                    values: values.clone(),
+                    max_abs_phi: r.max_abs_phi,
+                    max_abs_psi: r.max_abs_psi,
+                    max_abs_err: r.max_abs_err_x,
+                    steps: r.steps,
+                    error: r.error,
+                }
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    Ok(Sweep { scenario: file, axes, shard, points })
+}
+
+/// Joins shard outputs into the complete sweep.
+pub fn merge(parts: Vec<Sweep>) -> Result<Sweep> {
+    let first = parts.first().ok_or_else(|| anyhow!("merge: no sweep.json given"))?.clone();
+    let mut points: Vec<Point> = Vec::new();
+    for p in &parts {
+        if p.axes != first.axes || p.scenario != first.scenario {
+            bail!("merge: the parts come from different sweeps ({} and {})", first.scenario, p.scenario);
+        }
+        points.extend(p.points.iter().cloned());
+    }
+    points.sort_by_key(|p| p.index);
+    let total = first.total();
+    for (expected, p) in points.iter().enumerate() {
+        if p.index != expected {
+            let what = if p.index < expected { "twice" } else { "missing" };
+            bail!("merge: grid point {} is {what}; give every shard exactly once", expected.min(p.index));
+        }
+    }
+    if points.len() != total {
+        bail!("merge: {} of {total} grid points present; a shard is missing", points.len());
+    }
+    Ok(Sweep { scenario: first.scenario, axes: first.axes, shard: None, points })
+}
+
+/// Writes `sweep.json`, and for a complete sweep the heat maps.
+pub fn write(sweep: &Sweep, dir: &Path) -> Result<()> {
+    let path = dir.join("sweep.json");
+    std::fs::write(&path, serde_json::to_string_pretty(sweep)? + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    if sweep.shard.is_none() {
+        heat_maps(sweep, dir)?;
+    }
+    Ok(())
+}
+
+/// Heat maps over the first two axes (the first alone when there is one);
+/// each cell shows the best value over the remaining axes.
+fn heat_maps(sweep: &Sweep, dir: &Path) -> Result<()> {
+    let axes = &sweep.axes;
+    let (x, y) = (&axes[0], axes.get(1));
+    let ny = y.map_or(1, |a| a.values.len());
+    let others: usize = axes.iter().skip(2).map(|a| a.values.len()).product();
+    type Metric = fn(&Point) -> Option<f64>;
+    let metrics: [(&str, &str, Metric); 3] = [
+        ("heat_err", "max |error| against the reference", |p| p.max_abs_err),
+        ("heat_phi", "max |Φ|", |p| Some(p.max_abs_phi)),
+        ("heat_psi", "max |Ψ|", |p| Some(p.max_abs_psi)),
+    ];
+    for (stem, what, metric) in metrics {
+        if sweep.points.iter().all(|p| metric(p).is_none()) {
+            continue;
+        }
+        let mut z = vec![vec![None::<f64>; x.values.len()]; ny];
+        for p in &sweep.points {
+            let i = p.index / others;
+            let (ix, iy) = match y {
+                Some(a) => (i / a.values.len(), i % a.values.len()),
+                None => (i, 0),
+            };
+            let v = if p.error.is_some() { None } else { metric(p) };
+            if let Some(v) = v {
+                let cell = &mut z[iy][ix];
+                *cell = Some(cell.map_or(v, |c| c.min(v)));
+            }
+        }
+        let title = format!("{what}{}", if others > 1 { " (best over the other axes)" } else { "" });
+        let y_values = y.map_or(vec![0.0], |a| a.values.clone());
+        write_heatmap(
+            &dir.join(stem),
+            &HeatMap {
+                title: &title,
+                x_label: &x.name,
+                x_values: &x.values,
+                y_label: y.map_or("", |a| a.name.as_str()),
+                y_values: &y_values,
+                z: &z,
+            },
+        )?;
+    }
+    Ok(())
+}
+
+/// One line per grid point.
+pub fn table(sweep: &Sweep) -> String {
+    let mut out: String = sweep.axes.iter().map(|a| format!("{:>12}", a.name)).collect();
+    out += &format!(" {:>11} {:>11} {:>11}\n", "max|phi|", "max|psi|", "max|err|");
+    for p in &sweep.points {
+        out += &p.values.iter().map(|v| format!("{v:>12}")).collect::<String>();
+        let err = p.max_abs_err.map_or("-".into(), |e| format!("{e:.3e}"));
+        match &p.error {
+            Some(e) => out += &format!(" failed: {e}\n"),
+            None => out += &format!(" {:>11.3e} {:>11.3e} {err:>11}\n", p.max_abs_phi, p.max_abs_psi),
+        }
+    }
+    out
+}
