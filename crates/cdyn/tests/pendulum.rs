@@ -262,7 +262,7 @@ fn backward_euler_cvsgf_with_unit_gain_step_is_a_gauss_newton_projection() {
     // violation is removed to first order.
     let model = pendulum();
     let h = 0.01;
-    for eps in [1e-3, 1e-5] {
+    for eps in [1e-3_f64, 1e-5] {
         let c = Control {
             geometric: Geometric::Gradient(Gain::Rate(1.0 / h)),
             energy: Energy::None,
