@@ -13,32 +13,25 @@ use std::path::Path;
 pub const H: f64 = 0.01;
 pub const T_END: f64 = 20.0;
 
-/// Every case of the paper's test, by name.
+/// Every case of the paper's test, by name: the Cartesian pendulum under
+/// each method, then the pendulum in θ without and with energy control.
 pub fn cases() -> Result<Vec<Case>> {
     let gains = MethodGains::paper();
     let params = PendulumParams::default();
+    let models: [(Vec<_>, fn(PendulumParams) -> cdyn::Result<_>); 2] =
+        [(redundant_cases(&gains), cartesian_pendulum), (independent_cases(&gains), theta_pendulum)];
     let mut cases = Vec::new();
-    for (name, control) in redundant_cases(&gains) {
-        let example = cartesian_pendulum(params)?;
-        cases.push(Case {
-            name: name.into(),
-            example,
-            settings: Settings::new(Scheme::AdamsBashforth3, H, control),
-            t_end: T_END,
-            every: 1,
-            assembly: None,
-        });
-    }
-    for (name, control) in independent_cases(&gains) {
-        let example = theta_pendulum(params)?;
-        cases.push(Case {
-            name: name.into(),
-            example,
-            settings: Settings::new(Scheme::AdamsBashforth3, H, control),
-            t_end: T_END,
-            every: 1,
-            assembly: None,
-        });
+    for (methods, model) in models {
+        for (name, control) in methods {
+            cases.push(Case {
+                name: name.into(),
+                example: model(params)?,
+                settings: Settings::new(Scheme::AdamsBashforth3, H, control),
+                t_end: T_END,
+                every: 1,
+                assembly: None,
+            });
+        }
     }
     Ok(cases)
 }
