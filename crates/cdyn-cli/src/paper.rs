@@ -18,7 +18,8 @@ pub const T_END: f64 = 20.0;
 pub fn cases() -> Result<Vec<Case>> {
     let gains = MethodGains::paper();
     let params = PendulumParams::default();
-    let models: [(Vec<_>, fn(PendulumParams) -> cdyn::Result<_>); 2] =
+    type Build = fn(PendulumParams) -> cdyn::Result<cdyn::models::Example>;
+    let models: [(Vec<_>, Build); 2] =
         [(redundant_cases(&gains), cartesian_pendulum), (independent_cases(&gains), theta_pendulum)];
     let mut cases = Vec::new();
     for (methods, model) in models {

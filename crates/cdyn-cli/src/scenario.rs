@@ -375,35 +375,60 @@ fn worst_entry(example: &Example, rows: &[String]) -> String {
 }
 
 impl MethodSpec {
+    /// The CVSGF gain given, if any: `zeta` (fixed) or `alpha_g` (rate).
+    fn cvsgf_gain(&self, file: &str) -> Result<Option<Gain>> {
+        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
+        Ok(match (self.zeta, self.alpha_g) {
+            (Some(_), Some(_)) => bail!("{file}: [method] give one of zeta, alpha_g, not both"),
+            (Some(z), None) => Some(Gain::Fixed(num("zeta", z)?)),
+            (None, Some(a)) => Some(Gain::Rate(num("alpha_g", a)?)),
+            (None, None) => None,
+        })
+    }
+
+    /// The gradient energy gains given, if any: `alpha_e`, or `rho_v` (and `rho_q`).
+    fn energy_gain(&self, file: &str) -> Result<Option<EnergyGain>> {
+        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
+        Ok(match (self.alpha_e, self.rho_q, self.rho_v) {
+            (Some(a), None, None) => Some(EnergyGain::Rate { alpha_e: num("alpha_e", a)? }),
+            (None, q, Some(v)) => {
+                Some(EnergyGain::Fixed { rho_q: num("rho_q", q.unwrap_or(0.0))?, rho_v: num("rho_v", v)? })
+            }
+            (None, None, None) => None,
+            _ => bail!("{file}: [method] gradient energy control takes alpha_e, or rho_v (and rho_q, default 0)"),
+        })
+    }
+
+    /// Baumgarte's `(α, β)` given, if any: `alpha` and `beta`, or `omega` (and `damping_ratio`).
+    fn baumgarte_gains(&self, file: &str) -> Result<Option<(f64, f64)>> {
+        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
+        Ok(match (self.alpha, self.beta, self.omega, self.damping_ratio) {
+            (Some(a), Some(b), None, None) => Some((num("alpha", a)?, num("beta", b)?)),
+            (None, None, Some(w), ratio) => {
+                let w = check(file, "[method] omega", w, true)?;
+                match Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)? {
+                    Geometric::Baumgarte { alpha, beta } => Some((alpha, beta)),
+                    _ => unreachable!("baumgarte_from makes Baumgarte gains"),
+                }
+            }
+            (None, None, None, None) => None,
+            _ => bail!("{file}: [method] Baumgarte takes alpha and beta, or omega (and damping_ratio, default 1)"),
+        })
+    }
+
     /// Gains for `cdyn compare`: those the scenario gives, else target
     /// rates `α_g = α_e = 0.2/h` (half the paper's `hα = 0.4`: coupled
     /// constraints raise the effective rate of CVSGF above `α_g`) and Baumgarte
     /// `β = 0.2/h`, critically damped.
     pub fn gains(&self, file: &str, h: f64) -> Result<MethodGains> {
-        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
         let rate = 0.2 / h;
-        let cvsgf = match (self.zeta, self.alpha_g) {
-            (Some(_), Some(_)) => bail!("{file}: [method] give zeta or alpha_g, not both"),
-            (Some(z), None) => Gain::Fixed(num("zeta", z)?),
-            (None, Some(a)) => Gain::Rate(num("alpha_g", a)?),
-            (None, None) => Gain::Rate(rate),
-        };
-        let energy = match (self.alpha_e, self.rho_q, self.rho_v) {
-            (Some(a), None, None) => EnergyGain::Rate { alpha_e: num("alpha_e", a)? },
-            (None, q, Some(v)) => EnergyGain::Fixed { rho_q: num("rho_q", q.unwrap_or(0.0))?, rho_v: num("rho_v", v)? },
-            (None, None, None) => EnergyGain::Rate { alpha_e: rate },
-            _ => bail!("{file}: [method] give alpha_e, or rho_v (and rho_q), not both"),
-        };
-        let (alpha, beta) = match (self.alpha, self.beta, self.omega, self.damping_ratio) {
-            (Some(a), Some(b), None, None) => (num("alpha", a)?, num("beta", b)?),
-            (None, None, Some(w), ratio) => {
-                let w = check(file, "[method] omega", w, true)?;
-                (2.0 * num("damping_ratio", ratio.unwrap_or(1.0))? * w, w * w)
-            }
-            (None, None, None, None) => (2.0 * rate.sqrt(), rate),
-            _ => bail!("{file}: [method] Baumgarte needs alpha and beta, or omega (and damping_ratio)"),
-        };
-        Ok(MethodGains { cvsgf, energy, baumgarte_alpha: alpha, baumgarte_beta: beta })
+        let (alpha, beta) = self.baumgarte_gains(file)?.unwrap_or((2.0 * rate.sqrt(), rate));
+        Ok(MethodGains {
+            cvsgf: self.cvsgf_gain(file)?.unwrap_or(Gain::Rate(rate)),
+            energy: self.energy_gain(file)?.unwrap_or(EnergyGain::Rate { alpha_e: rate }),
+            baumgarte_alpha: alpha,
+            baumgarte_beta: beta,
+        })
     }
 
     /// The control law, refusing gains that the chosen methods do not use.
@@ -427,41 +452,26 @@ impl MethodSpec {
             used(key, value, e == EnergyKind::Gradient, "energy = \"gradient\"")?;
         }
         used("eta", self.eta, e == EnergyKind::Baumgarte, "energy = \"baumgarte\"")?;
-        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
-
         let geometric = match g {
             GeometricKind::None => Geometric::None,
-            GeometricKind::Cvsgf => match (self.zeta, self.alpha_g) {
-                (Some(z), None) => Geometric::Gradient(Gain::Fixed(num("zeta", z)?)),
-                (None, Some(a)) => Geometric::Gradient(Gain::Rate(num("alpha_g", a)?)),
-                _ => bail!("{file}: [method] geometric = \"cvsgf\" needs exactly one of zeta, alpha_g"),
+            GeometricKind::Cvsgf => match self.cvsgf_gain(file)? {
+                Some(gain) => Geometric::Gradient(gain),
+                None => bail!("{file}: [method] geometric = \"cvsgf\" needs one of zeta, alpha_g"),
             },
-            GeometricKind::Baumgarte => match (self.alpha, self.beta, self.omega, self.damping_ratio) {
-                (Some(a), Some(b), None, None) => {
-                    Geometric::Baumgarte { alpha: num("alpha", a)?, beta: num("beta", b)? }
-                }
-                (None, None, Some(w), ratio) => {
-                    let w = check(file, "[method] omega", w, true)?;
-                    Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)?
-                }
-                _ => bail!(
-                    "{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega (and damping_ratio, default 1)"
-                ),
+            GeometricKind::Baumgarte => match self.baumgarte_gains(file)? {
+                Some((alpha, beta)) => Geometric::Baumgarte { alpha, beta },
+                None => bail!("{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega"),
             },
         };
         let energy = match e {
             EnergyKind::None => Energy::None,
             EnergyKind::Baumgarte => match self.eta {
-                Some(eta) => Energy::Baumgarte { eta: num("eta", eta)? },
+                Some(eta) => Energy::Baumgarte { eta: check(file, "[method] eta", eta, false)? },
                 None => bail!("{file}: [method] energy = \"baumgarte\" needs eta"),
             },
-            EnergyKind::Gradient => match (self.alpha_e, self.rho_q, self.rho_v) {
-                (Some(a), None, None) => Energy::Gradient(EnergyGain::Rate { alpha_e: num("alpha_e", a)? }),
-                (None, q, Some(v)) => Energy::Gradient(EnergyGain::Fixed {
-                    rho_q: num("rho_q", q.unwrap_or(0.0))?,
-                    rho_v: num("rho_v", v)?,
-                }),
-                _ => bail!("{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q, default 0)"),
+            EnergyKind::Gradient => match self.energy_gain(file)? {
+                Some(gain) => Energy::Gradient(gain),
+                None => bail!("{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q)"),
             },
         };
         let application = match self.apply {

@@ -138,15 +138,6 @@ impl Integrator {
         }
     }
 
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
-    }
-
-    /// Forgets the history, so the next step starts the scheme afresh.
-    pub fn restart(&mut self) {
-        self.filled = 0;
-    }
-
     /// The scheme the next step uses: the start-up one until enough history exists.
     pub fn active_scheme(&self) -> Scheme {
         let info = self.scheme.info();

@@ -171,11 +171,6 @@ impl Model {
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
     }
-    /// Whether any force element is present (then `Ė` is not identically zero).
-    pub fn has_forces(&self) -> bool {
-        !self.forces.is_empty()
-    }
-
     /// `Φ`, `Φ̇`, `γ` and the Jacobian values (in [`Pattern`] order).
     pub(crate) fn constraints(
         &self,

@@ -142,13 +142,6 @@ impl Mechanism {
         }
     }
 
-    pub fn body_mut(&mut self, id: BodyId) -> Option<&mut Body> {
-        match id {
-            BodyId::Ground => None,
-            BodyId::Body(i) => self.bodies.get_mut(i),
-        }
-    }
-
     /// The model, its initial state and coordinate names. Errors name the
     /// body or element (by position, from 0) at fault.
     pub fn build(&self) -> Result<Built> {
