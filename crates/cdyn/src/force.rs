@@ -5,8 +5,8 @@
 //! force on its coordinates; its power `F·v` is the energy input `Ė` that the
 //! energy constraint integrates.
 
+use crate::constraint::seeded;
 use crate::scalar::Scalar;
-use num_dual::DualSVec64;
 use std::any::Any;
 
 /// Potential energy `V(x)` of `K` coordinates.
@@ -43,12 +43,13 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64 {
         let mut total = 0.0;
         for (p, idx) in &self.items {
-            let x = std::array::from_fn(|j| DualSVec64::<K>::from_re(q[idx[j]]).derivative(j));
-            let e = p.energy(x);
-            total += e.re;
-            if let Some(d) = &e.eps.0 {
-                for (j, &i) in idx.iter().enumerate() {
-                    grad[i] += d[j];
+            let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
+            // One scalar dual pass per coordinate (see `constraint.rs`).
+            for j in 0..K {
+                let e = p.energy(seeded(&x, j));
+                grad[idx[j]] += e.eps;
+                if j == 0 {
+                    total += e.re;
                 }
             }
         }
