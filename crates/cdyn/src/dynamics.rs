@@ -50,7 +50,7 @@ impl Dynamics {
             force_power: 0.0,
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
-            schur: Schur::new(model.pattern(), n, solver),
+            schur: Schur::new(model.pattern(), model.inv_mass(), solver),
         }
     }
 
@@ -72,7 +72,7 @@ impl Dynamics {
         if model.m() == 0 {
             return Ok(());
         }
-        self.schur.factor(&self.jac, w)?;
+        self.schur.factor(&self.jac)?;
         // (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
         jac_mul(model.pattern(), &self.jac, &self.acc, &mut self.lambda);
         for (l, g) in self.lambda.iter_mut().zip(&self.gamma) {

@@ -1,11 +1,20 @@
 //! The `m × m` system `S = Φ_q M⁻¹ Φ_qᵀ`: its assembly from the sparse
-//! Jacobian and its factorization.
+//! Jacobian and its `L D Lᵀ` factorization.
 //!
-//! Assembly is a precomputed list of products `J_a J_b / m_c` (one per pair
-//! of rows sharing a coordinate), so forming `S` costs the same as reading
-//! the Jacobian for chains and trees, and never allocates.
+//! Everything structural is done once: the list of products `J_a J_b / m_c`
+//! that make `S` (one per pair of rows sharing a coordinate, so forming `S`
+//! costs the same as reading the Jacobian for chains and trees), the
+//! ordering, and the pattern of `L`. A step then only refills values,
+//! eliminates along the known pattern and solves — in buffers allocated
+//! here, never per step.
+//!
+//! Dense and sparse share the kernel and differ in the pattern of `L`:
+//! dense takes the full lower triangle in the natural order; sparse takes
+//! the pattern faer's symbolic Cholesky finds (`sparse.rs`), with an AMD
+//! ordering when it fills less than the natural one.
 
 use crate::model::Pattern;
+use std::cell::RefCell;
 
 /// Why `S` could not be factored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,22 +25,19 @@ pub enum Breakdown {
     NonFinite,
 }
 
-/// One contribution `J[ja] J[jb] / m[col]` to entry `s` of `S`.
-#[derive(Debug, Clone, Copy)]
-struct Term {
-    s: usize,
-    ja: usize,
-    jb: usize,
-    col: usize,
+/// How to factor `Φ_q M⁻¹ Φ_qᵀ`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinearSolver {
+    /// Dense below [`SPARSE_FROM`] constraint rows, sparse from there on.
+    #[default]
+    Auto,
+    Dense,
+    Sparse,
 }
 
-/// Dense Cholesky factorization of `S`, stored lower-triangular row-major.
-pub(crate) struct DenseSchur {
-    m: usize,
-    terms: Vec<Term>,
-    a: Vec<f64>,
-    diag: Vec<f64>,
-}
+/// Constraint rows from which `Auto` factors sparse: below it the dense
+/// pattern costs about the same and needs no symbolic analysis.
+pub const SPARSE_FROM: usize = 48;
 
 /// Pivots below this fraction of the assembled diagonal mean the row
 /// depends on the rows before it.
@@ -61,117 +67,294 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
     out
 }
 
-impl DenseSchur {
-    pub fn new(pattern: &Pattern, n: usize) -> Self {
+/// A symmetric elimination order and the pattern of the strictly lower
+/// triangle of `L` in it, by columns with rows ascending.
+pub(crate) struct Structure {
+    /// `perm[i]` is the original row eliminated `i`-th; `None` for the natural order.
+    pub perm: Option<Vec<usize>>,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+}
+
+impl Structure {
+    /// The full lower triangle in the natural order.
+    fn dense(m: usize) -> Self {
+        let col_ptr = (0..=m).map(|j| j * m - j * (j + 1) / 2).collect();
+        let row_idx = (0..m).flat_map(|j| j + 1..m).collect();
+        Self { perm: None, col_ptr, row_idx }
+    }
+}
+
+/// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the
+/// elimination order of its [`Structure`].
+pub(crate) struct Schur {
+    m: usize,
+    perm: Option<Vec<usize>>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// For each row `j`, the columns `k < j` with `L_jk ≠ 0` and the slot of `L_jk`.
+    row_ptr: Vec<usize>,
+    row_entries: Vec<(usize, usize)>,
+    /// The products `J[ja] J[jb] / m` that sum to each entry of `S`: the
+    /// diagonal entries (in elimination order) first, then the entries in
+    /// `L`'s slots (zero sums for fill).
+    sum_ptr: Vec<usize>,
+    terms: Vec<(u32, u32, f64)>,
+    /// `L` and `L D` below the diagonal, and `D⁻¹`.
+    lower: Vec<f64>,
+    scaled: Vec<f64>,
+    inv_d: Vec<f64>,
+    /// Dense column being eliminated.
+    work: Vec<f64>,
+    /// Right-hand side in the elimination order (when permuted).
+    permuted: RefCell<Vec<f64>>,
+}
+
+impl Schur {
+    pub fn new(pattern: &Pattern, inv_mass: &[f64], solver: LinearSolver) -> Self {
         let m = pattern.start.len() - 1;
-        let mut terms: Vec<Term> = products(pattern, n)
-            .into_iter()
-            .map(|(ra, rb, ja, jb, col)| Term { s: ra * m + rb, ja, jb, col })
+        let products = products(pattern, inv_mass.len());
+        let sparse = match solver {
+            LinearSolver::Auto => m >= SPARSE_FROM,
+            LinearSolver::Dense => false,
+            LinearSolver::Sparse => true,
+        };
+        let structure = if sparse && m > 0 {
+            crate::sparse::analyse(m, products.iter().map(|&(a, b, ..)| (a, b)))
+        } else {
+            Structure::dense(m)
+        };
+        let Structure { perm, col_ptr, row_idx } = structure;
+        let mut position = vec![0; m];
+        match &perm {
+            Some(p) => p.iter().enumerate().for_each(|(new, &old)| position[old] = new),
+            None => position.iter_mut().enumerate().for_each(|(i, p)| *p = i),
+        }
+        let mut by_slot: Vec<(usize, (u32, u32, f64))> = products
+            .iter()
+            .map(|&(a, b, ja, jb, col)| {
+                let (i, j) = (position[a].max(position[b]), position[a].min(position[b]));
+                let slot = if i == j {
+                    j
+                } else {
+                    let column = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+                    m + col_ptr[j] + column.binary_search(&i).expect("S's pattern lies inside L's")
+                };
+                (slot, (ja as u32, jb as u32, inv_mass[col]))
+            })
             .collect();
-        terms.sort_by_key(|t| t.s);
-        Self { m, terms, a: vec![0.0; m * m], diag: vec![0.0; m] }
+        by_slot.sort_by_key(|&(slot, _)| slot);
+        let mut sum_ptr = vec![0; m + row_idx.len() + 1];
+        for &(slot, _) in &by_slot {
+            sum_ptr[slot + 1] += 1;
+        }
+        for i in 0..sum_ptr.len() - 1 {
+            sum_ptr[i + 1] += sum_ptr[i];
+        }
+        // Row patterns of L, by walking its columns in order.
+        let mut row_ptr = vec![0; m + 1];
+        for &i in &row_idx {
+            row_ptr[i + 1] += 1;
+        }
+        for i in 0..m {
+            row_ptr[i + 1] += row_ptr[i];
+        }
+        let mut fill = row_ptr.clone();
+        let mut row_entries = vec![(0, 0); row_idx.len()];
+        for k in 0..m {
+            for p in col_ptr[k]..col_ptr[k + 1] {
+                let i = row_idx[p];
+                row_entries[fill[i]] = (k, p);
+                fill[i] += 1;
+            }
+        }
+        Self {
+            m,
+            lower: vec![0.0; row_idx.len()],
+            scaled: vec![0.0; row_idx.len()],
+            permuted: RefCell::new(if perm.is_some() { vec![0.0; m] } else { Vec::new() }),
+            perm,
+            col_ptr,
+            row_idx,
+            row_ptr,
+            row_entries,
+            sum_ptr,
+            terms: by_slot.into_iter().map(|(_, t)| t).collect(),
+            inv_d: vec![0.0; m],
+            work: vec![0.0; m],
+        }
     }
 
-    /// Assembles `S` from the Jacobian values and factors it.
-    pub fn factor(&mut self, jac: &[f64], inv_mass: &[f64]) -> Result<(), Breakdown> {
+    /// Entry `slot` of `S` (see `sum_ptr`), summed in a register.
+    #[inline(always)]
+    fn entry(&self, jac: &[f64], slot: usize) -> f64 {
+        let terms = &self.terms[self.sum_ptr[slot]..self.sum_ptr[slot + 1]];
+        terms.iter().map(|&(a, b, w)| jac[a as usize] * jac[b as usize] * w).sum()
+    }
+
+    /// Assembles `S` from the Jacobian values and factors it, column by
+    /// column (left-looking: column `j` from the finished columns `k < j`).
+    pub fn factor(&mut self, jac: &[f64]) -> Result<(), Breakdown> {
         let m = self.m;
-        self.a.fill(0.0);
-        for t in &self.terms {
-            self.a[t.s] += jac[t.ja] * jac[t.jb] * inv_mass[t.col];
-        }
-        for r in 0..m {
-            self.diag[r] = self.a[r * m + r];
-        }
         for j in 0..m {
-            let mut d = self.a[j * m + j];
-            for k in 0..j {
-                d -= self.a[j * m + k] * self.a[j * m + k];
+            let s_jj = self.entry(jac, j);
+            let own = self.col_ptr[j]..self.col_ptr[j + 1];
+            for p in own.clone() {
+                self.work[self.row_idx[p]] = self.entry(jac, m + p);
             }
-            if !d.is_finite() {
-                return Err(Breakdown::NonFinite);
-            }
-            if d.is_nan() || d <= PIVOT_TOLERANCE * self.diag[j] {
-                return Err(Breakdown::Singular(j));
-            }
-            let d = d.sqrt();
-            self.a[j * m + j] = d;
-            for i in j + 1..m {
-                let mut s = self.a[i * m + j];
-                for k in 0..j {
-                    s -= self.a[i * m + k] * self.a[j * m + k];
+            let mut d = s_jj;
+            for &(k, at) in &self.row_entries[self.row_ptr[j]..self.row_ptr[j + 1]] {
+                // (L D)_jk is known before 1/d_k: the pivot waits on one
+                // multiplication after the division, not two.
+                let u = self.scaled[at];
+                d -= u * u * self.inv_d[k];
+                for p in at + 1..self.col_ptr[k + 1] {
+                    self.work[self.row_idx[p]] -= self.lower[p] * u;
                 }
-                self.a[i * m + j] = s / d;
+            }
+            // `!(d > …)` also catches NaN.
+            if !(d > PIVOT_TOLERANCE * s_jj) {
+                let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
+                return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(self.original(j)) });
+            }
+            let inv = 1.0 / d;
+            self.inv_d[j] = inv;
+            for p in own {
+                let u = self.work[self.row_idx[p]];
+                self.scaled[p] = u;
+                self.lower[p] = u * inv;
             }
         }
         Ok(())
     }
 
+    fn original(&self, j: usize) -> usize {
+        self.perm.as_ref().map_or(j, |p| p[j])
+    }
+
     /// Solves `S x = b` in place with the current factorization.
     pub fn solve(&self, b: &mut [f64]) {
-        let m = self.m;
-        for i in 0..m {
-            let mut s = b[i];
-            for k in 0..i {
-                s -= self.a[i * m + k] * b[k];
+        match &self.perm {
+            None => self.solve_ordered(b),
+            Some(perm) => {
+                let y = &mut *self.permuted.borrow_mut();
+                for (y, &p) in y.iter_mut().zip(perm) {
+                    *y = b[p];
+                }
+                self.solve_ordered(y);
+                for (y, &p) in y.iter().zip(perm) {
+                    b[p] = *y;
+                }
             }
-            b[i] = s / self.a[i * m + i];
         }
-        for i in (0..m).rev() {
-            let mut s = b[i];
-            for k in i + 1..m {
-                s -= self.a[k * m + i] * b[k];
+    }
+
+    fn solve_ordered(&self, y: &mut [f64]) {
+        for j in 0..self.m {
+            let yj = y[j];
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[self.row_idx[p]] -= self.lower[p] * yj;
             }
-            b[i] = s / self.a[i * m + i];
+        }
+        for (y, inv) in y.iter_mut().zip(&self.inv_d) {
+            *y *= inv;
+        }
+        for j in (0..self.m).rev() {
+            let mut yj = y[j];
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                yj -= self.lower[p] * y[self.row_idx[p]];
+            }
+            y[j] = yj;
         }
     }
 }
 
-/// How to factor `Φ_q M⁻¹ Φ_qᵀ`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LinearSolver {
-    /// Dense below [`SPARSE_FROM`] constraint rows, sparse from there on.
-    #[default]
-    Auto,
-    Dense,
-    Sparse,
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// Constraint rows from which `Auto` factors sparse: below it a dense
-/// Cholesky of `S` is cheaper than the sparse machinery.
-pub const SPARSE_FROM: usize = 48;
+    /// Rows of a star: a hub row on coordinates 0..2 and `arms` chains of
+    /// `len` rows, each row coupling two consecutive coordinate pairs;
+    /// numbered level by level so that the natural order fills in.
+    fn star(arms: usize, len: usize) -> (Pattern, usize) {
+        let mut rows: Vec<Vec<usize>> = vec![vec![0, 1]];
+        let pair = |arm: usize, level: usize| 2 + 2 * (level * arms + arm);
+        for level in 0..len {
+            for arm in 0..arms {
+                let inner = if level == 0 { 0 } else { pair(arm, level - 1) };
+                let outer = pair(arm, level);
+                rows.push(vec![inner, inner + 1, outer, outer + 1]);
+            }
+        }
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
+        for r in rows {
+            pattern.cols.extend(r);
+            pattern.start.push(pattern.cols.len());
+        }
+        (pattern, 2 + 2 * arms * len)
+    }
 
-/// `S` with the chosen factorization.
-pub(crate) enum Schur {
-    Dense(DenseSchur),
-    Sparse(Box<crate::sparse::SparseSchur>),
-}
+    fn values(len: usize, seed: f64) -> Vec<f64> {
+        (0..len).map(|i| (seed + 1.7 * i as f64).sin() + 0.2 * (i % 3) as f64).collect()
+    }
 
-impl Schur {
-    pub fn new(pattern: &Pattern, n: usize, solver: LinearSolver) -> Self {
+    /// `‖S x − b‖ / ‖b‖` with `S = J M⁻¹ Jᵀ` formed densely.
+    fn residual(pattern: &Pattern, jac: &[f64], inv_mass: &[f64], x: &[f64], b: &[f64]) -> f64 {
         let m = pattern.start.len() - 1;
-        let sparse = match solver {
-            LinearSolver::Auto => m >= SPARSE_FROM,
-            LinearSolver::Dense => false,
-            LinearSolver::Sparse => m > 0,
-        };
-        if sparse {
-            Schur::Sparse(Box::new(crate::sparse::SparseSchur::new(pattern, n)))
-        } else {
-            Schur::Dense(DenseSchur::new(pattern, n))
+        let mut jt_x = vec![0.0; inv_mass.len()];
+        for r in 0..m {
+            for j in pattern.row(r) {
+                jt_x[pattern.cols[j]] += jac[j] * x[r] * inv_mass[pattern.cols[j]];
+            }
+        }
+        let mut worst = 0.0_f64;
+        for r in 0..m {
+            let s_x: f64 = pattern.row(r).map(|j| jac[j] * jt_x[pattern.cols[j]]).sum();
+            worst = worst.max((s_x - b[r]).abs());
+        }
+        worst / b.iter().fold(0.0_f64, |a, b| a.max(b.abs()))
+    }
+
+    #[test]
+    fn dense_and_reordered_sparse_factors_solve_s() {
+        let (pattern, n) = star(5, 12);
+        let jac = values(pattern.nnz(), 0.3);
+        let inv_mass: Vec<f64> = values(n, 1.1).iter().map(|x| 1.0 / (1.5 + x)).collect();
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &inv_mass, solver);
+            // The sparse analysis must have reordered (the natural order fills).
+            assert_eq!(s.perm.is_some(), solver == LinearSolver::Sparse);
+            s.factor(&jac).unwrap();
+            let b = values(pattern.start.len() - 1, 2.0);
+            let mut x = b.clone();
+            s.solve(&mut x);
+            let r = residual(&pattern, &jac, &inv_mass, &x, &b);
+            assert!(r < 1e-12, "{solver:?}: relative residual {r:e}");
         }
     }
 
-    pub fn factor(&mut self, jac: &[f64], inv_mass: &[f64]) -> Result<(), Breakdown> {
-        match self {
-            Schur::Dense(d) => d.factor(jac, inv_mass),
-            Schur::Sparse(s) => s.factor(jac, inv_mass),
-        }
-    }
-
-    pub fn solve(&self, b: &mut [f64]) {
-        match self {
-            Schur::Dense(d) => d.solve(b),
-            Schur::Sparse(s) => s.solve(b),
+    #[test]
+    fn a_dependent_row_is_named_and_a_blown_up_jacobian_is_not_called_singular() {
+        let (mut pattern, n) = star(3, 4);
+        // Repeat the last row.
+        let last = pattern.row(pattern.start.len() - 2);
+        let repeated: Vec<usize> = pattern.cols[last.clone()].to_vec();
+        pattern.cols.extend(&repeated);
+        pattern.start.push(pattern.cols.len());
+        let mut jac = values(pattern.nnz(), 0.7);
+        let k = repeated.len();
+        let tail = jac.len() - k;
+        let copy = jac[tail - k..tail].to_vec();
+        jac[tail..].copy_from_slice(&copy);
+        let inv_mass = vec![1.0; n];
+        let m = pattern.start.len() - 1;
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &inv_mass, solver);
+            let err = s.factor(&jac).unwrap_err();
+            assert!(matches!(err, Breakdown::Singular(r) if r == m - 1 || r == m - 2), "{solver:?}: {err:?}");
+            let mut bad = values(pattern.nnz(), 0.7);
+            bad[3] = f64::INFINITY;
+            assert_eq!(s.factor(&bad), Err(Breakdown::NonFinite), "{solver:?}");
         }
     }
 }
