@@ -16,11 +16,12 @@ pub trait Constraint<const K: usize, const R: usize>: Send + Sync + 'static {
     fn eval<D: Scalar>(&self, x: [D; K], t: D) -> [D; R];
 }
 
-/// Where one evaluation of the constraints goes: per row `Φ`, `Φ̇`, `γ`,
-/// and the Jacobian entries of each row in the order of its coordinates.
+/// Where one evaluation of the constraints goes: per row `Φ`, `Φ̇`, `Φ_t`,
+/// `γ`, and the Jacobian entries of each row in the order of its coordinates.
 pub(crate) struct ConstraintValues<'a> {
     pub phi: &'a mut [f64],
     pub phi_dot: &'a mut [f64],
+    pub phi_t: &'a mut [f64],
     pub gamma: &'a mut [f64],
     pub jac: &'a mut [f64],
 }
@@ -74,11 +75,16 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
             // One scalar dual pass per coordinate: for the few coordinates an
             // element reads this is about ten times cheaper than one pass of a
             // K-vector dual, whose optional derivative vectors defeat inlining.
+            let mut jv = [0.0; R];
             for j in 0..K {
                 let rows = c.eval(seeded(&x, j), Dual64::from(t));
                 for r in 0..R {
                     out.jac[(e * R + r) * K + j] = rows[r].eps;
+                    jv[r] += rows[r].eps * v[idx[j]];
                 }
+            }
+            for r in 0..R {
+                out.phi_t[e * R + r] = along[r].v1 - jv[r];
             }
         }
     }

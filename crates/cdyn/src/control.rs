@@ -144,19 +144,18 @@ impl Control {
             }
             Geometric::Gradient(gain) => {
                 // U_q = −2 Φ_qᵀ Z Φ
-                for (r, s) in scratch.iter_mut().enumerate() {
+                for (r, &phi) in d.phi.iter().enumerate() {
+                    let (jac, cols) = (&d.jac[pattern.row(r)], &pattern.cols[pattern.row(r)]);
                     let zeta = match gain {
                         Gain::Fixed(z) => z,
                         Gain::Rate(alpha_g) => {
-                            let g2: f64 = pattern.row(r).map(|j| d.jac[j] * d.jac[j]).sum();
+                            let g2: f64 = jac.iter().map(|j| j * j).sum();
                             if g2 > 0.0 { alpha_g / (2.0 * g2) } else { 0.0 }
                         }
                     };
-                    *s = zeta * d.phi[r];
-                }
-                for (r, &s) in scratch.iter().enumerate() {
-                    for j in pattern.row(r) {
-                        u_q[pattern.cols[j]] -= 2.0 * s * d.jac[j];
+                    let s = 2.0 * zeta * phi;
+                    for (j, &c) in jac.iter().zip(cols) {
+                        u_q[c] -= s * j;
                     }
                 }
             }
@@ -172,8 +171,10 @@ impl Control {
                     }
                 };
                 // U_q −= 2ρ_q Ψ Ψ_q,  U_v −= 2ρ_v Ψ Ψ_v,  Ψ_q = ∇V, Ψ_v = M v
-                for (u, g) in u_q.iter_mut().zip(&d.grad_potential) {
-                    *u -= 2.0 * rho_q * psi * g;
+                if rho_q != 0.0 {
+                    for (u, g) in u_q.iter_mut().zip(&d.grad_potential) {
+                        *u -= 2.0 * rho_q * psi * g;
+                    }
                 }
                 for ((u, m), v) in u_v.iter_mut().zip(model.mass()).zip(v) {
                     *u -= 2.0 * rho_v * psi * m * v;

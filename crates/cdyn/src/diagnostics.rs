@@ -1,6 +1,7 @@
 //! What a sample reports: the violations `Φ`, `Φ̇`, `Ψ` and the coupling
 //! measure `Y_c` (Eq. 47), computed without factorizing anything.
 
+use crate::constraint::ConstraintValues;
 use crate::energy;
 use crate::model::Model;
 
@@ -21,6 +22,7 @@ pub struct Measures {
 pub struct Probe {
     phi: Vec<f64>,
     phi_dot: Vec<f64>,
+    phi_t: Vec<f64>,
     gamma: Vec<f64>,
     jac: Vec<f64>,
     grad: Vec<f64>,
@@ -32,6 +34,7 @@ impl Probe {
         Self {
             phi: vec![0.0; m],
             phi_dot: vec![0.0; m],
+            phi_t: vec![0.0; m],
             gamma: vec![0.0; m],
             jac: vec![0.0; model.pattern().nnz()],
             grad: vec![0.0; model.n()],
@@ -40,7 +43,14 @@ impl Probe {
 
     /// Measures the violations at `(q, v, e, t)` for initial energy `e0`.
     pub fn measure(&mut self, model: &Model, q: &[f64], v: &[f64], e: f64, t: f64, e0: f64) -> Measures {
-        model.constraints(q, v, t, &mut self.phi, &mut self.phi_dot, &mut self.gamma, &mut self.jac);
+        let values = ConstraintValues {
+            phi: &mut self.phi,
+            phi_dot: &mut self.phi_dot,
+            phi_t: &mut self.phi_t,
+            gamma: &mut self.gamma,
+            jac: &mut self.jac,
+        };
+        model.constraints(q, v, t, values);
         self.grad.fill(0.0);
         let potential = model.potential(q, Some(&mut self.grad));
         let pattern = model.pattern();

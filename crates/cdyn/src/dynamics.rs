@@ -1,6 +1,7 @@
 //! What the system does, uncontrolled: `Φ`, `Φ_q`, `γ`, the multipliers
 //! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
 
+use crate::constraint::ConstraintValues;
 use crate::linalg::Schur;
 pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
 use crate::model::{Model, Pattern};
@@ -12,6 +13,8 @@ pub struct Dynamics {
     pub phi: Vec<f64>,
     /// `Φ̇ = Φ_q v + Φ_t`
     pub phi_dot: Vec<f64>,
+    /// `Φ_t`, as `Φ̇ − Φ_q v` (zero up to round-off without drives).
+    pub phi_t: Vec<f64>,
     /// `γ` of Eq. 5
     pub gamma: Vec<f64>,
     /// Values of `Φ_q` in the model's [`Pattern`] order.
@@ -42,6 +45,7 @@ impl Dynamics {
         Self {
             phi: vec![0.0; m],
             phi_dot: vec![0.0; m],
+            phi_t: vec![0.0; m],
             gamma: vec![0.0; m],
             jac: vec![0.0; model.pattern().nnz()],
             force: vec![0.0; n],
@@ -57,7 +61,14 @@ impl Dynamics {
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the
     /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
     pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
-        model.constraints(q, v, t, &mut self.phi, &mut self.phi_dot, &mut self.gamma, &mut self.jac);
+        let out = ConstraintValues {
+            phi: &mut self.phi,
+            phi_dot: &mut self.phi_dot,
+            phi_t: &mut self.phi_t,
+            gamma: &mut self.gamma,
+            jac: &mut self.jac,
+        };
+        model.constraints(q, v, t, out);
         self.grad_potential.fill(0.0);
         self.potential = model.potential(q, Some(&mut self.grad_potential));
         for (f, g) in self.force.iter_mut().zip(&self.grad_potential) {

@@ -15,16 +15,9 @@ pub fn psi(model: &Model, v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
     model.kinetic(v) + potential - e0 - e
 }
 
-/// `Ė = F·v + λᵀ Φ_t`, with `Φ_t = Φ̇ − Φ_q v`, from an evaluated [`Dynamics`].
-pub fn energy_input(model: &Model, d: &Dynamics, v: &[f64]) -> f64 {
-    let pattern = model.pattern();
-    let drives: f64 = (0..model.m())
-        .map(|r| {
-            let jv: f64 = pattern.row(r).map(|j| d.jac[j] * v[pattern.cols[j]]).sum();
-            d.lambda[r] * (d.phi_dot[r] - jv)
-        })
-        .sum();
-    d.force_power + drives
+/// `Ė = F·v + λᵀ Φ_t`, from an evaluated [`Dynamics`].
+pub fn energy_input(d: &Dynamics) -> f64 {
+    d.force_power + d.lambda.iter().zip(&d.phi_t).map(|(l, p)| l * p).sum::<f64>()
 }
 
 /// `|Ψ_v|² = |M v|²`.

@@ -155,11 +155,9 @@ impl Integrator {
         self.filled = (self.filled + 1).min(self.history.len());
         match active.formula {
             Formula::Multistep(w) => {
-                for (j, &wj) in w.iter().enumerate() {
-                    for (xi, fi) in x.iter_mut().zip(&self.history[j]) {
-                        *xi += h * wj * fi;
-                    }
-                }
+                // The forward Euler control step joins the same pass over memory.
+                let u = (split && self.application == Application::ForwardEuler).then_some(&self.u[..]);
+                advance(x, h, w, &self.history, u);
             }
             Formula::RungeKutta { a, b, c } => {
                 self.stages[0].copy_from_slice(&self.history[0]);
@@ -187,7 +185,8 @@ impl Integrator {
                 }
             }
         }
-        if split {
+        let multistep = matches!(active.formula, Formula::Multistep(_));
+        if split && !(multistep && self.application == Application::ForwardEuler) {
             if self.application == Application::BackwardEuler {
                 rhs.eval(x, t + h, &mut self.scratch, Some(&mut self.u))?;
             }
@@ -209,6 +208,23 @@ impl Integrator {
                 Ok(())
             }
         }
+    }
+}
+
+/// `x += h Σ_j w_j f_j (+ h u)` in one pass (at most three past evaluations).
+fn advance(x: &mut [f64], h: f64, w: &[f64], f: &[Vec<f64>], u: Option<&[f64]>) {
+    let hw = |j: usize| w.get(j).map_or(0.0, |w| h * w);
+    let (w0, w1, w2) = (hw(0), hw(1), hw(2));
+    let f0 = &f[0][..x.len()];
+    let f1 = if w.len() > 1 { &f[1][..x.len()] } else { f0 };
+    let f2 = if w.len() > 2 { &f[2][..x.len()] } else { f0 };
+    let (hu, u) = match u {
+        Some(u) => (h, &u[..x.len()]),
+        None => (0.0, f0),
+    };
+    assert!(w.len() <= 3, "multistep formulas read at most three past evaluations");
+    for i in 0..x.len() {
+        x[i] += w0 * f0[i] + w1 * f1[i] + w2 * f2[i] + hu * u[i];
     }
 }
 

@@ -212,8 +212,7 @@ impl Schur {
                     self.work[self.row_idx[p]] -= self.lower[p] * u;
                 }
             }
-            // `!(d > …)` also catches NaN.
-            if !(d > PIVOT_TOLERANCE * s_jj) {
+            if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
                 let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
                 return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(self.original(j)) });
             }

@@ -171,17 +171,8 @@ impl Model {
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
     }
-    /// `Φ`, `Φ̇`, `γ` and the Jacobian values (in [`Pattern`] order).
-    pub(crate) fn constraints(
-        &self,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        phi: &mut [f64],
-        phi_dot: &mut [f64],
-        gamma: &mut [f64],
-        jac: &mut [f64],
-    ) {
+    /// `Φ`, `Φ̇`, `Φ_t`, `γ` and the Jacobian values (in [`Pattern`] order).
+    pub(crate) fn constraints(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
         for (b, &(r0, j0)) in self.constraints.iter().zip(&self.offsets) {
             let (r1, j1) = (r0 + b.rows(), j0 + b.rows() * b.width());
             b.evaluate(
@@ -189,10 +180,11 @@ impl Model {
                 v,
                 t,
                 ConstraintValues {
-                    phi: &mut phi[r0..r1],
-                    phi_dot: &mut phi_dot[r0..r1],
-                    gamma: &mut gamma[r0..r1],
-                    jac: &mut jac[j0..j1],
+                    phi: &mut out.phi[r0..r1],
+                    phi_dot: &mut out.phi_dot[r0..r1],
+                    phi_t: &mut out.phi_t[r0..r1],
+                    gamma: &mut out.gamma[r0..r1],
+                    jac: &mut out.jac[j0..j1],
                 },
             );
         }

@@ -79,7 +79,7 @@ impl Rhs for ControlledSystem<'_> {
             Breakdown::Singular(row) => EvalError::Singular { t, row },
             Breakdown::NonFinite => EvalError::NonFinite { t },
         })?;
-        let e_dot = energy::energy_input(self.model, &self.dynamics, v);
+        let e_dot = energy::energy_input(&self.dynamics);
         f[..n].copy_from_slice(v);
         f[n..2 * n].copy_from_slice(&self.dynamics.acc);
         f[2 * n] = e_dot;
