@@ -17,8 +17,13 @@ pub trait Constraint<const K: usize, const R: usize>: Send + Sync + 'static {
 }
 
 /// Where one evaluation of the constraints goes: per row `Φ`, `Φ̇`, `Φ_t`,
-/// `γ`, and the Jacobian entries of each row in the order of its coordinates.
+/// `γ`, the Jacobian entries of each row in the order of its coordinates,
+/// and the right-hand side of Eq. 7, `Φ_q a − γ`, for the given
+/// unconstrained acceleration `a = M⁻¹ G` (formed here while the row's
+/// derivatives are in registers, saving a pass over the Jacobian).
 pub(crate) struct ConstraintValues<'a> {
+    pub free_acc: &'a [f64],
+    pub rhs: &'a mut [f64],
     pub phi: &'a mut [f64],
     pub phi_dot: &'a mut [f64],
     pub phi_t: &'a mut [f64],
@@ -75,16 +80,18 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
             // One scalar dual pass per coordinate: for the few coordinates an
             // element reads this is about ten times cheaper than one pass of a
             // K-vector dual, whose optional derivative vectors defeat inlining.
-            let mut jv = [0.0; R];
+            let (mut jv, mut ja) = ([0.0; R], [0.0; R]);
             for j in 0..K {
                 let rows = c.eval(seeded(&x, j), Dual64::from(t));
                 for r in 0..R {
                     out.jac[(e * R + r) * K + j] = rows[r].eps;
                     jv[r] += rows[r].eps * v[idx[j]];
+                    ja[r] += rows[r].eps * out.free_acc[idx[j]];
                 }
             }
             for r in 0..R {
                 out.phi_t[e * R + r] = along[r].v1 - jv[r];
+                out.rhs[e * R + r] = ja[r] + along[r].v2;
             }
         }
     }

@@ -26,6 +26,9 @@ pub struct Probe {
     gamma: Vec<f64>,
     jac: Vec<f64>,
     grad: Vec<f64>,
+    /// The constraint pass also forms `Φ_q a − γ`; here for `a = 0`, unused.
+    zeros: Vec<f64>,
+    rhs: Vec<f64>,
 }
 
 impl Probe {
@@ -38,12 +41,16 @@ impl Probe {
             gamma: vec![0.0; m],
             jac: vec![0.0; model.pattern().nnz()],
             grad: vec![0.0; model.n()],
+            zeros: vec![0.0; model.n()],
+            rhs: vec![0.0; m],
         }
     }
 
     /// Measures the violations at `(q, v, e, t)` for initial energy `e0`.
     pub fn measure(&mut self, model: &Model, q: &[f64], v: &[f64], e: f64, t: f64, e0: f64) -> Measures {
         let values = ConstraintValues {
+            free_acc: &self.zeros,
+            rhs: &mut self.rhs,
             phi: &mut self.phi,
             phi_dot: &mut self.phi_dot,
             phi_t: &mut self.phi_t,

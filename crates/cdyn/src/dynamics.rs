@@ -61,7 +61,20 @@ impl Dynamics {
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the
     /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
     pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
+        self.grad_potential.fill(0.0);
+        self.potential = model.potential(q, Some(&mut self.grad_potential));
+        for (f, g) in self.force.iter_mut().zip(&self.grad_potential) {
+            *f = -g;
+        }
+        self.force_power = model.add_forces(q, v, t, &mut self.force);
+        let w = model.inv_mass();
+        for ((a, f), w) in self.acc.iter_mut().zip(&self.force).zip(w) {
+            *a = f * w;
+        }
+        // λ starts as the right-hand side of (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
         let out = ConstraintValues {
+            free_acc: &self.acc,
+            rhs: &mut self.lambda,
             phi: &mut self.phi,
             phi_dot: &mut self.phi_dot,
             phi_t: &mut self.phi_t,
@@ -69,26 +82,10 @@ impl Dynamics {
             jac: &mut self.jac,
         };
         model.constraints(q, v, t, out);
-        self.grad_potential.fill(0.0);
-        self.potential = model.potential(q, Some(&mut self.grad_potential));
-        for (f, g) in self.force.iter_mut().zip(&self.grad_potential) {
-            *f = -g;
-        }
-        self.force_power = model.add_forces(q, v, t, &mut self.force);
-
-        let w = model.inv_mass();
-        for ((a, f), w) in self.acc.iter_mut().zip(&self.force).zip(w) {
-            *a = f * w;
-        }
         if model.m() == 0 {
             return Ok(());
         }
         self.schur.factor(&self.jac)?;
-        // (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
-        jac_mul(model.pattern(), &self.jac, &self.acc, &mut self.lambda);
-        for (l, g) in self.lambda.iter_mut().zip(&self.gamma) {
-            *l -= g;
-        }
         self.schur.solve(&mut self.lambda);
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
         add_weighted_jt(model.pattern(), &self.jac, &self.lambda, w, -1.0, &mut self.acc);

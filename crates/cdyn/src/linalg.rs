@@ -293,6 +293,31 @@ mod tests {
         (pattern, 2 + 2 * arms * len)
     }
 
+    /// A `w × w` lattice of coordinate pairs with a row on every edge
+    /// (a net of rods), rows numbered with a stride: a pattern without a
+    /// fill-free order, in a numbering that fills more than AMD's.
+    fn net(w: usize, stride: usize) -> (Pattern, usize) {
+        let pair = |x: usize, y: usize| 2 * (y * w + x);
+        let mut edges = Vec::new();
+        for y in 0..w {
+            for x in 0..w {
+                if x + 1 < w {
+                    edges.push((pair(x, y), pair(x + 1, y)));
+                }
+                if y + 1 < w {
+                    edges.push((pair(x, y), pair(x, y + 1)));
+                }
+            }
+        }
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
+        for r in 0..edges.len() {
+            let (a, b) = edges[(r * stride) % edges.len()];
+            pattern.cols.extend([a, a + 1, b, b + 1]);
+            pattern.start.push(pattern.cols.len());
+        }
+        (pattern, 2 * w * w)
+    }
+
     fn values(len: usize, seed: f64) -> Vec<f64> {
         (0..len).map(|i| (seed + 1.7 * i as f64).sin() + 0.2 * (i % 3) as f64).collect()
     }
@@ -316,19 +341,32 @@ mod tests {
 
     #[test]
     fn dense_and_reordered_sparse_factors_solve_s() {
-        let (pattern, n) = star(5, 12);
-        let jac = values(pattern.nnz(), 0.3);
-        let inv_mass: Vec<f64> = values(n, 1.1).iter().map(|x| 1.0 / (1.5 + x)).collect();
-        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
-            let mut s = Schur::new(&pattern, &inv_mass, solver);
-            // The sparse analysis must have reordered (the natural order fills).
-            assert_eq!(s.perm.is_some(), solver == LinearSolver::Sparse);
-            s.factor(&jac).unwrap();
-            let b = values(pattern.start.len() - 1, 2.0);
-            let mut x = b.clone();
-            s.solve(&mut x);
-            let r = residual(&pattern, &jac, &inv_mass, &x, &b);
-            assert!(r < 1e-12, "{solver:?}: relative residual {r:e}");
+        for (name, (pattern, n)) in [("star", star(5, 12)), ("net", net(8, 17))] {
+            let m = pattern.start.len() - 1;
+            let jac = values(pattern.nnz(), 0.3);
+            let inv_mass: Vec<f64> = values(n, 1.1).iter().map(|x| 1.0 / (1.5 + x)).collect();
+            for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+                let mut s = Schur::new(&pattern, &inv_mass, solver);
+                // The sparse analysis must have reordered (the natural order fills).
+                assert_eq!(s.perm.is_some(), solver == LinearSolver::Sparse, "{name}");
+                if solver == LinearSolver::Sparse {
+                    let off_diagonal_of_s = products(&pattern, n)
+                        .iter()
+                        .filter(|&&(a, b, ..)| a != b)
+                        .map(|&(a, b, ..)| (a, b))
+                        .collect::<std::collections::BTreeSet<_>>()
+                        .len();
+                    let fill = s.row_idx.len() - off_diagonal_of_s;
+                    // The star is chordal: peeled without fill. The net is not.
+                    assert_eq!(fill == 0, name == "star", "{name}: fill {fill}");
+                }
+                s.factor(&jac).unwrap();
+                let b = values(m, 2.0);
+                let mut x = b.clone();
+                s.solve(&mut x);
+                let r = residual(&pattern, &jac, &inv_mass, &x, &b);
+                assert!(r < 1e-12, "{name} {solver:?}: relative residual {r:e}");
+            }
         }
     }
 

@@ -171,7 +171,7 @@ impl Model {
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
     }
-    /// `Φ`, `Φ̇`, `Φ_t`, `γ` and the Jacobian values (in [`Pattern`] order).
+    /// `Φ`, `Φ̇`, `Φ_t`, `γ`, the Jacobian values (in [`Pattern`] order) and `Φ_q a − γ`.
     pub(crate) fn constraints(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
         for (b, &(r0, j0)) in self.constraints.iter().zip(&self.offsets) {
             let (r1, j1) = (r0 + b.rows(), j0 + b.rows() * b.width());
@@ -180,6 +180,8 @@ impl Model {
                 v,
                 t,
                 ConstraintValues {
+                    free_acc: out.free_acc,
+                    rhs: &mut out.rhs[r0..r1],
                     phi: &mut out.phi[r0..r1],
                     phi_dot: &mut out.phi_dot[r0..r1],
                     phi_t: &mut out.phi_t[r0..r1],

@@ -1,8 +1,15 @@
-//! Symbolic analysis of a sparse `S = Φ_q M⁻¹ Φ_qᵀ` with faer: the
-//! elimination order (AMD, or the natural order when it fills no more —
-//! chains and trees often come ordered) and the pattern of its Cholesky
-//! factor. Done once per model; the numeric factorization in `linalg.rs`
-//! follows the pattern found here at every step.
+//! Symbolic analysis of a sparse `S = Φ_q M⁻¹ Φ_qᵀ`: the elimination
+//! order and the pattern of its Cholesky factor. Done once per model; the
+//! numeric factorization in `linalg.rs` follows the pattern found here at
+//! every step.
+//!
+//! Chains and trees (more generally, chordal patterns) are eliminated
+//! without fill by peeling, round after round, every row whose neighbours
+//! are already coupled to each other. Rows of one round are independent,
+//! so their eliminations overlap in the processor instead of waiting on
+//! one another: a chain peeled from both ends has half the dependent
+//! divisions of one eliminated from the top. Other patterns get faer's
+//! AMD ordering, or the natural order when that fills no more.
 
 use crate::linalg::Structure;
 use faer::Side;
@@ -11,14 +18,23 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
+use std::collections::BTreeSet;
 
 /// Analyses the `m × m` symmetric pattern with entries `(a, b)`, `a ≥ b`
 /// (repeats allowed).
 pub(crate) fn analyse(m: usize, entries: impl Iterator<Item = (usize, usize)>) -> Structure {
     // Upper triangle by columns: entry (b, a), b ≤ a, in column a.
     let mut columns: Vec<Vec<usize>> = vec![Vec::new(); m];
+    let mut neighbours: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); m];
     for (a, b) in entries {
         columns[a].push(b);
+        if a != b {
+            neighbours[a].insert(b);
+            neighbours[b].insert(a);
+        }
+    }
+    if let Some(order) = peel(neighbours.clone()) {
+        return without_fill(&order, &neighbours);
     }
     let mut col_ptr = vec![0];
     let mut row_idx = Vec::new();
@@ -55,4 +71,64 @@ pub(crate) fn analyse(m: usize, entries: impl Iterator<Item = (usize, usize)>) -
     }
     let perm = symbolic.perm().map(|p| p.arrays().0.to_vec());
     Structure { perm, col_ptr, row_idx }
+}
+
+/// Rows whose neighbours number more than this are not tested for being
+/// simplicial (the test is quadratic in the degree).
+const MAX_PEEL_DEGREE: usize = 32;
+
+/// An elimination order without fill, by rounds of simplicial rows (whose
+/// remaining neighbours are pairwise coupled); `None` if peeling gets stuck.
+fn peel(mut neighbours: Vec<BTreeSet<usize>>) -> Option<Vec<usize>> {
+    let m = neighbours.len();
+    let simplicial = |nb: &[BTreeSet<usize>], u: usize| {
+        nb[u].len() <= MAX_PEEL_DEGREE && nb[u].iter().all(|&a| nb[u].iter().all(|&b| a >= b || nb[a].contains(&b)))
+    };
+    let mut order = Vec::with_capacity(m);
+    let mut done = vec![false; m];
+    // Only rows whose neighbourhood shrank can have become simplicial.
+    let mut candidates: Vec<usize> = (0..m).collect();
+    let mut seen = vec![usize::MAX; m];
+    for round in 0.. {
+        if order.len() == m {
+            return Some(order);
+        }
+        let peeled: Vec<usize> =
+            candidates.iter().copied().filter(|&u| !done[u] && simplicial(&neighbours, u)).collect();
+        if peeled.is_empty() {
+            return None;
+        }
+        candidates.clear();
+        for &u in &peeled {
+            done[u] = true;
+            order.push(u);
+            for a in std::mem::take(&mut neighbours[u]) {
+                neighbours[a].remove(&u);
+                if !done[a] && seen[a] != round {
+                    seen[a] = round;
+                    candidates.push(a);
+                }
+            }
+        }
+    }
+    unreachable!()
+}
+
+/// The structure of an elimination order without fill: `L`'s pattern is
+/// `S`'s, renumbered.
+fn without_fill(order: &[usize], neighbours: &[BTreeSet<usize>]) -> Structure {
+    let mut position = vec![0; order.len()];
+    for (new, &old) in order.iter().enumerate() {
+        position[old] = new;
+    }
+    let mut col_ptr = vec![0];
+    let mut row_idx = Vec::new();
+    for (j, &old) in order.iter().enumerate() {
+        let start = row_idx.len();
+        row_idx.extend(neighbours[old].iter().map(|&a| position[a]).filter(|&i| i > j));
+        row_idx[start..].sort_unstable();
+        col_ptr.push(row_idx.len());
+    }
+    let natural = order.iter().enumerate().all(|(i, &o)| i == o);
+    Structure { perm: (!natural).then(|| order.to_vec()), col_ptr, row_idx }
 }
