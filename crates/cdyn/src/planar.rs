@@ -258,7 +258,14 @@ impl Mechanism {
                 same(a, b)?;
                 let length = positive("length", *length)?;
                 let (ea, eb) = (self.attach(*a, *pa, offsets, &mut idx)?, self.attach(*b, *pb, offsets, &mut idx)?);
-                with_k!(idx, K, builder.constrain(Distance::<K> { a: ea, b: eb, length }, idx_array(&idx)))
+                match (ea, eb) {
+                    (End::Point { .. }, End::Point { .. }) => builder.constrain(PointRod { length }, idx_array(&idx)),
+                    (End::Ground { point: anchor }, End::Point { .. })
+                    | (End::Point { .. }, End::Ground { point: anchor }) => {
+                        builder.constrain(AnchoredRod { anchor, length }, idx_array(&idx))
+                    }
+                    _ => with_k!(idx, K, builder.constrain(Distance::<K> { a: ea, b: eb, length }, idx_array(&idx))),
+                }
             }
             Element::Prismatic { a, pa, b, pb, axis } => {
                 same(a, b)?;
@@ -549,6 +556,35 @@ impl<const K: usize> Constraint<K, 1> for Distance<K> {
     }
 }
 
+/// [`Distance`] between two point masses `(x_a, y_a, x_b, y_b)`: the rod of
+/// chains, ropes and nets, with its coordinates at fixed places so that
+/// its derivative passes select nothing at run time.
+struct PointRod {
+    length: f64,
+}
+
+impl Constraint<4, 1> for PointRod {
+    #[inline(always)]
+    fn eval<D: Scalar>(&self, [xa, ya, xb, yb]: [D; 4], _t: D) -> [D; 1] {
+        let (dx, dy) = (xb - xa, yb - ya);
+        [(dx * dx + dy * dy - self.length * self.length) * 0.5]
+    }
+}
+
+/// [`Distance`] between a fixed point and a point mass `(x, y)`.
+struct AnchoredRod {
+    anchor: [f64; 2],
+    length: f64,
+}
+
+impl Constraint<2, 1> for AnchoredRod {
+    #[inline(always)]
+    fn eval<D: Scalar>(&self, [x, y]: [D; 2], _t: D) -> [D; 1] {
+        let (dx, dy) = (x - self.anchor[0], y - self.anchor[1]);
+        [(dx * dx + dy * dy - self.length * self.length) * 0.5]
+    }
+}
+
 /// `(p_b − p_a) · n = 0` with `n` the line's normal turning with `a`.
 struct OnLine<const K: usize> {
     a: End,
@@ -708,5 +744,36 @@ impl Force<1> for Torque {
     #[inline(always)]
     fn force<D: Scalar>(&self, _x: [D; 1], _xd: [D; 1], t: D) -> [D; 1] {
         [self.f.eval(t)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_dual::{Dual2_64, Dual64};
+
+    /// The fixed-layout rods are the general distance element, written for
+    /// one layout: same values and derivatives.
+    #[test]
+    fn point_rods_agree_with_the_general_distance() {
+        let general = Distance::<4> { a: End::Point { at: 0 }, b: End::Point { at: 2 }, length: 1.3 };
+        let anchored = Distance::<2> { a: End::Ground { point: [0.4, -0.2] }, b: End::Point { at: 0 }, length: 0.7 };
+        let x = [0.3, -1.1, 1.2, 0.5];
+        let v = [0.7, -0.2, 0.1, 1.4];
+        let along = |i: usize| Dual2_64::new(x[i], v[i], 0.0);
+        let t = Dual2_64::new(0.0, 1.0, 0.0);
+        let [a] = PointRod { length: 1.3 }.eval(std::array::from_fn(along), t);
+        let [b] = general.eval(std::array::from_fn(along), t);
+        assert_eq!((a.re, a.v1, a.v2), (b.re, b.v1, b.v2));
+        for j in 0..4 {
+            let seeded = |i: usize| Dual64::new(x[i], if i == j { 1.0 } else { 0.0 });
+            let [a] = PointRod { length: 1.3 }.eval(std::array::from_fn(seeded), Dual64::from(0.0));
+            let [b] = general.eval(std::array::from_fn(seeded), Dual64::from(0.0));
+            assert_eq!((a.re, a.eps), (b.re, b.eps));
+        }
+        let rod = AnchoredRod { anchor: [0.4, -0.2], length: 0.7 };
+        let [a] = rod.eval([along(0), along(1)], t);
+        let [b] = anchored.eval([along(0), along(1)], t);
+        assert_eq!((a.re, a.v1, a.v2), (b.re, b.v1, b.v2));
     }
 }
