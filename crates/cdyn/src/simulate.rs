@@ -148,7 +148,7 @@ impl<'m> Simulation<'m> {
             EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t + self.settings.h },
         })?;
         self.step += 1;
-        if self.x.iter().any(|x| !x.is_finite()) {
+        if !all_finite(&self.x) {
             return Err(Error::Diverged { step: self.step, t: self.t() });
         }
         // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.
@@ -191,4 +191,10 @@ pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
         return Err(Error::InvalidParameter { name: "t_end / h", value: ratio, reason: "more than 1e12 steps" });
     }
     Ok((ratio - 1e-9 * ratio.max(1.0)).ceil().max(1.0) as u64)
+}
+
+/// Whether every value is finite; without early exit inside a chunk, so
+/// that the test vectorizes.
+fn all_finite(x: &[f64]) -> bool {
+    x.chunks(64).all(|c| c.iter().fold(true, |ok, x| ok & x.is_finite()))
 }
