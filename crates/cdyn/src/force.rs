@@ -44,6 +44,9 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
         let mut total = 0.0;
         for (p, idx) in &self.items {
             let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
+            if K == 0 {
+                total += p.energy(x);
+            }
             // One scalar dual pass per coordinate (see `constraint.rs`).
             for j in 0..K {
                 let e = p.energy(seeded(&x, j));

@@ -213,6 +213,7 @@ impl Integrator {
 
 /// `x += h Σ_j w_j f_j (+ h u)` in one pass (at most three past evaluations).
 fn advance(x: &mut [f64], h: f64, w: &[f64], f: &[Vec<f64>], u: Option<&[f64]>) {
+    assert!(w.len() <= 3, "multistep formulas read at most three past evaluations");
     let hw = |j: usize| w.get(j).map_or(0.0, |w| h * w);
     let (w0, w1, w2) = (hw(0), hw(1), hw(2));
     let f0 = &f[0][..x.len()];
@@ -222,7 +223,6 @@ fn advance(x: &mut [f64], h: f64, w: &[f64], f: &[Vec<f64>], u: Option<&[f64]>) 
         Some(u) => (h, &u[..x.len()]),
         None => (0.0, f0),
     };
-    assert!(w.len() <= 3, "multistep formulas read at most three past evaluations");
     for i in 0..x.len() {
         x[i] += w0 * f0[i] + w1 * f1[i] + w2 * f2[i] + hu * u[i];
     }
