@@ -153,11 +153,13 @@ impl Integrator {
         self.history.rotate_right(1);
         self.evaluate_first(rhs, x, t, control)?;
         self.filled = (self.filled + 1).min(self.history.len());
+        let mut control_pending = true;
         match active.formula {
             Formula::Multistep(w) => {
                 // The forward Euler control step joins the same pass over memory.
-                let u = (split && self.application == Application::ForwardEuler).then_some(&self.u[..]);
-                advance(x, h, w, &self.history, u);
+                let joined = split && self.application == Application::ForwardEuler;
+                advance(x, h, w, &self.history, joined.then_some(&self.u[..]));
+                control_pending = !joined;
             }
             Formula::RungeKutta { a, b, c } => {
                 self.stages[0].copy_from_slice(&self.history[0]);
@@ -185,8 +187,7 @@ impl Integrator {
                 }
             }
         }
-        let multistep = matches!(active.formula, Formula::Multistep(_));
-        if split && !(multistep && self.application == Application::ForwardEuler) {
+        if split && control_pending {
             if self.application == Application::BackwardEuler {
                 rhs.eval(x, t + h, &mut self.scratch, Some(&mut self.u))?;
             }

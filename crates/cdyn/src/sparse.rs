@@ -23,11 +23,8 @@ use std::collections::BTreeSet;
 /// Analyses the `m × m` symmetric pattern with entries `(a, b)`, `a ≥ b`
 /// (repeats allowed).
 pub(crate) fn analyse(m: usize, entries: impl Iterator<Item = (usize, usize)>) -> Structure {
-    // Upper triangle by columns: entry (b, a), b ≤ a, in column a.
-    let mut columns: Vec<Vec<usize>> = vec![Vec::new(); m];
     let mut neighbours: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); m];
     for (a, b) in entries {
-        columns[a].push(b);
         if a != b {
             neighbours[a].insert(b);
             neighbours[b].insert(a);
@@ -36,13 +33,12 @@ pub(crate) fn analyse(m: usize, entries: impl Iterator<Item = (usize, usize)>) -
     if let Some(order) = peel(neighbours.clone()) {
         return without_fill(&order, &neighbours);
     }
+    // Upper triangle by columns: rows b ≤ a in column a, ascending.
     let mut col_ptr = vec![0];
     let mut row_idx = Vec::new();
-    for (a, rows) in columns.iter_mut().enumerate() {
-        rows.push(a);
-        rows.sort_unstable();
-        rows.dedup();
-        row_idx.extend_from_slice(rows);
+    for (a, rows) in neighbours.iter().enumerate() {
+        row_idx.extend(rows.range(..a));
+        row_idx.push(a);
         col_ptr.push(row_idx.len());
     }
     let structure = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);

@@ -449,14 +449,17 @@ impl SliderCrankParams {
         positive("rod_inertia", self.rod_inertia)?;
         positive("slider_mass", self.slider_mass)?;
         positive("slider_inertia", self.slider_inertia)?;
-        finite("omega", self.omega)?;
-        finite("theta0", self.theta0)?;
-        non_negative("gravity", self.gravity)?;
-        if let Some(load) = &self.load {
-            load.validate()?;
-        }
-        Ok(())
+        validate_drive(self.omega, self.theta0, self.gravity, self.load.as_ref())
     }
+}
+
+/// Checks shared by the crank-driven mechanisms: drive speed, initial
+/// crank angle, gravity and the optional load pendulum.
+fn validate_drive(omega: f64, theta0: f64, gravity: f64, load: Option<&LoadPendulum>) -> Result<()> {
+    finite("omega", omega)?;
+    finite("theta0", theta0)?;
+    non_negative("gravity", gravity)?;
+    load.map_or(Ok(()), LoadPendulum::validate)
 }
 
 /// Exact kinematics of the slider-crank at crank angle `θ`, speed `ω`.
@@ -656,13 +659,7 @@ impl FourBarParams {
         positive("coupler_inertia", self.coupler_inertia)?;
         positive("rocker_mass", self.rocker_mass)?;
         positive("rocker_inertia", self.rocker_inertia)?;
-        finite("omega", self.omega)?;
-        finite("theta0", self.theta0)?;
-        non_negative("gravity", self.gravity)?;
-        if let Some(load) = &self.load {
-            load.validate()?;
-        }
-        Ok(())
+        validate_drive(self.omega, self.theta0, self.gravity, self.load.as_ref())
     }
 }
 
