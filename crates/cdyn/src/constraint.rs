@@ -67,31 +67,16 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
 
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
         for (e, (c, idx)) in self.items.iter().enumerate() {
-            let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
-            // Second directional derivative of s ↦ Φ(q + s v, t + s): Φ̈ at zero
-            // acceleration, which is −γ.
-            let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], v[idx[j]], 0.0));
-            let along = c.eval(path, Dual2_64::new(t, 1.0, 0.0));
+            let gather = |s: &[f64]| std::array::from_fn(|j| s[idx[j]]);
+            let l = local(c, gather(q), gather(v), gather(out.free_acc), t);
             for r in 0..R {
-                out.phi[e * R + r] = along[r].re;
-                out.phi_dot[e * R + r] = along[r].v1;
-                out.gamma[e * R + r] = -along[r].v2;
-            }
-            // One scalar dual pass per coordinate: for the few coordinates an
-            // element reads this is about ten times cheaper than one pass of a
-            // K-vector dual, whose optional derivative vectors defeat inlining.
-            let (mut jv, mut ja) = ([0.0; R], [0.0; R]);
-            for j in 0..K {
-                let rows = c.eval(seeded(&x, j), Dual64::from(t));
-                for r in 0..R {
-                    out.jac[(e * R + r) * K + j] = rows[r].eps;
-                    jv[r] += rows[r].eps * v[idx[j]];
-                    ja[r] += rows[r].eps * out.free_acc[idx[j]];
-                }
-            }
-            for r in 0..R {
-                out.phi_t[e * R + r] = along[r].v1 - jv[r];
-                out.rhs[e * R + r] = ja[r] + along[r].v2;
+                let row = e * R + r;
+                out.phi[row] = l.phi[r];
+                out.phi_dot[row] = l.phi_dot[r];
+                out.phi_t[row] = l.phi_t[r];
+                out.gamma[row] = l.gamma[r];
+                out.rhs[row] = l.rhs[r];
+                out.jac[row * K..(row + 1) * K].copy_from_slice(&l.jac[r]);
             }
         }
     }
@@ -105,6 +90,55 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
+    }
+}
+
+/// One element's rows at a state: what [`ConstraintValues`] holds, locally.
+pub(crate) struct Local<const K: usize, const R: usize> {
+    pub phi: [f64; R],
+    pub phi_dot: [f64; R],
+    pub phi_t: [f64; R],
+    pub gamma: [f64; R],
+    /// `Φ_q a − γ`
+    pub rhs: [f64; R],
+    /// `∂Φ_r/∂x_j`, row by row.
+    pub jac: [[f64; K]; R],
+}
+
+/// Differentiates one element at positions `x`, velocities `v`, free
+/// accelerations `a` and time `t`.
+#[inline(always)]
+pub(crate) fn local<C: Constraint<K, R>, const K: usize, const R: usize>(
+    c: &C,
+    x: [f64; K],
+    v: [f64; K],
+    a: [f64; K],
+    t: f64,
+) -> Local<K, R> {
+    // Second directional derivative of s ↦ Φ(q + s v, t + s): Φ̈ at zero
+    // acceleration, which is −γ.
+    let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], v[j], 0.0));
+    let along = c.eval(path, Dual2_64::new(t, 1.0, 0.0));
+    // One scalar dual pass per coordinate: for the few coordinates an
+    // element reads this is about ten times cheaper than one pass of a
+    // K-vector dual, whose optional derivative vectors defeat inlining.
+    let mut jac = [[0.0; K]; R];
+    let (mut jv, mut ja) = ([0.0; R], [0.0; R]);
+    for j in 0..K {
+        let rows = c.eval(seeded(&x, j), Dual64::from(t));
+        for r in 0..R {
+            jac[r][j] = rows[r].eps;
+            jv[r] += rows[r].eps * v[j];
+            ja[r] += rows[r].eps * a[j];
+        }
+    }
+    Local {
+        phi: along.map(|d| d.re),
+        phi_dot: along.map(|d| d.v1),
+        phi_t: std::array::from_fn(|r| along[r].v1 - jv[r]),
+        gamma: along.map(|d| -d.v2),
+        rhs: std::array::from_fn(|r| ja[r] + along[r].v2),
+        jac,
     }
 }
 

@@ -2,10 +2,8 @@
 //! data (Eqs. 13, 19, 20–27, 28–40, 48–53) and the control term `U(x, t)`
 //! they add to the uncontrolled state equations.
 
-use crate::dynamics::Dynamics;
 use crate::energy;
 use crate::error::{Result, non_negative, positive};
-use crate::model::Model;
 
 /// A gain either fixed, or set at every evaluation from a target decay rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +23,18 @@ pub enum Geometric {
     Baumgarte { alpha: f64, beta: f64 },
     /// CVSGF: `dq/dt = v − 2 Φ_qᵀ Z Φ` (Eqs. 28, 49).
     Gradient(Gain),
+}
+
+impl Gain {
+    /// `ζᵢ` for a row with `|∇Φᵢ|² = g2`.
+    #[inline(always)]
+    fn zeta(self, g2: f64) -> f64 {
+        match self {
+            Gain::Fixed(z) => z,
+            Gain::Rate(alpha_g) if g2 > 0.0 => alpha_g / (2.0 * g2),
+            Gain::Rate(_) => 0.0,
+        }
+    }
 }
 
 impl Geometric {
@@ -77,6 +87,23 @@ pub struct Control {
     pub application: Application,
 }
 
+/// What the control laws read of one evaluation of the dynamics.
+pub(crate) trait Evaluation {
+    /// The diagonal of `M`.
+    fn mass(&self) -> &[f64];
+    fn phi(&self) -> &[f64];
+    fn phi_dot(&self) -> &[f64];
+    /// `∇V`, which is also `Ψ_q`.
+    fn grad_potential(&self) -> &[f64];
+    /// The uncontrolled acceleration `A`.
+    fn acc(&self) -> &[f64];
+    /// Row `r` of `Φ_q`: its entries and their coordinates.
+    fn row(&self, r: usize) -> (&[f64], &[usize]);
+    /// For a change `b` of the constraint right-hand side, adds the change
+    /// of acceleration `−M⁻¹ Φ_qᵀ S⁻¹ b` to `out`; `b` is overwritten.
+    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]);
+}
+
 /// Below this `|Ψ_v|²` (or `vᵀMv`) the energy control has no direction to
 /// act along — the system is at rest — and is skipped rather than divided by zero.
 const REST: f64 = 1e-30;
@@ -119,10 +146,10 @@ impl Control {
     /// `d` were just evaluated. `psi` and `e_dot` are `Ψ` and `Ė` there;
     /// `scratch` has length `m`.
     #[allow(clippy::too_many_arguments)]
-    pub fn terms(
+    #[inline(always)]
+    pub(crate) fn terms<E: Evaluation>(
         &self,
-        model: &Model,
-        d: &Dynamics,
+        d: &E,
         v: &[f64],
         psi: f64,
         e_dot: f64,
@@ -132,28 +159,21 @@ impl Control {
     ) {
         u_q.fill(0.0);
         u_v.fill(0.0);
-        let pattern = model.pattern();
+        let mass = d.mass();
         match self.geometric {
             Geometric::None => {}
             Geometric::Baumgarte { alpha, beta } => {
                 // A_B − A for γ_B = γ − α Φ̇ − β Φ.
-                for ((b, pd), p) in scratch.iter_mut().zip(&d.phi_dot).zip(&d.phi) {
+                for ((b, pd), p) in scratch.iter_mut().zip(d.phi_dot()).zip(d.phi()) {
                     *b = alpha * pd + beta * p;
                 }
-                d.add_constraint_response(model, scratch, u_v);
+                d.add_constraint_response(scratch, u_v);
             }
             Geometric::Gradient(gain) => {
                 // U_q = −2 Φ_qᵀ Z Φ
-                for (r, &phi) in d.phi.iter().enumerate() {
-                    let (jac, cols) = (&d.jac[pattern.row(r)], &pattern.cols[pattern.row(r)]);
-                    let zeta = match gain {
-                        Gain::Fixed(z) => z,
-                        Gain::Rate(alpha_g) => {
-                            let g2: f64 = jac.iter().map(|j| j * j).sum();
-                            if g2 > 0.0 { alpha_g / (2.0 * g2) } else { 0.0 }
-                        }
-                    };
-                    let s = 2.0 * zeta * phi;
+                for (r, &phi) in d.phi().iter().enumerate() {
+                    let (jac, cols) = d.row(r);
+                    let s = 2.0 * gain.zeta(jac.iter().map(|j| j * j).sum()) * phi;
                     for (j, &c) in jac.iter().zip(cols) {
                         u_q[c] -= s * j;
                     }
@@ -166,28 +186,29 @@ impl Control {
                 let (rho_q, rho_v) = match gain {
                     EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
                     EnergyGain::Rate { alpha_e } => {
-                        let g2 = energy::psi_v_norm2(model, v);
+                        let g2 = energy::psi_v_norm2(mass, v);
                         (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
                     }
                 };
                 // U_q −= 2ρ_q Ψ Ψ_q,  U_v −= 2ρ_v Ψ Ψ_v,  Ψ_q = ∇V, Ψ_v = M v
                 if rho_q != 0.0 {
-                    for (u, g) in u_q.iter_mut().zip(&d.grad_potential) {
+                    for (u, g) in u_q.iter_mut().zip(d.grad_potential()) {
                         *u -= 2.0 * rho_q * psi * g;
                     }
                 }
-                for ((u, m), v) in u_v.iter_mut().zip(model.mass()).zip(v) {
+                for ((u, m), v) in u_v.iter_mut().zip(mass).zip(v) {
                     *u -= 2.0 * rho_v * psi * m * v;
                 }
             }
             Energy::Baumgarte { eta } => {
                 // μ = [Ψ_v A_geo + Ψ_q v − Ė + η Ψ] / (Ψ_v M⁻¹ Ψ_vᵀ), with
                 // A_geo = A + U_v so far, Ψ_v = Mv, M⁻¹ Ψ_vᵀ = v (Eqs. 17–19).
-                let two_t = 2.0 * model.kinetic(v);
+                let two_t = 2.0 * energy::kinetic(mass, v);
                 if two_t > REST {
+                    let (acc, grad) = (d.acc(), d.grad_potential());
                     let mut num = eta * psi - e_dot;
                     for i in 0..v.len() {
-                        num += model.mass()[i] * v[i] * (d.acc[i] + u_v[i]) + d.grad_potential[i] * v[i];
+                        num += mass[i] * v[i] * (acc[i] + u_v[i]) + grad[i] * v[i];
                     }
                     let mu = num / two_t;
                     for (u, v) in u_v.iter_mut().zip(v) {

@@ -12,7 +12,13 @@ use crate::model::Model;
 
 /// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e`, with `V` taken from the dynamics.
 pub fn psi(model: &Model, v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
-    model.kinetic(v) + potential - e0 - e
+    kinetic(model.mass(), v) + potential - e0 - e
+}
+
+/// Kinetic energy `½ vᵀ M v` for the diagonal `mass`.
+#[inline(always)]
+pub fn kinetic(mass: &[f64], v: &[f64]) -> f64 {
+    0.5 * mass.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
 }
 
 /// `Ė = F·v + λᵀ Φ_t`, from an evaluated [`Dynamics`].
@@ -20,7 +26,8 @@ pub fn energy_input(d: &Dynamics) -> f64 {
     d.force_power + d.lambda.iter().zip(&d.phi_t).map(|(l, p)| l * p).sum::<f64>()
 }
 
-/// `|Ψ_v|² = |M v|²`.
-pub fn psi_v_norm2(model: &Model, v: &[f64]) -> f64 {
-    model.mass().iter().zip(v).map(|(m, v)| (m * v) * (m * v)).sum()
+/// `|Ψ_v|² = |M v|²` for the diagonal `mass`.
+#[inline(always)]
+pub fn psi_v_norm2(mass: &[f64], v: &[f64]) -> f64 {
+    mass.iter().zip(v).map(|(m, v)| (m * v) * (m * v)).sum()
 }

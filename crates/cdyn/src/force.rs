@@ -43,17 +43,10 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64 {
         let mut total = 0.0;
         for (p, idx) in &self.items {
-            let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
-            if K == 0 {
-                total += p.energy(x);
-            }
-            // One scalar dual pass per coordinate (see `constraint.rs`).
+            let (energy, gradient) = energy_and_gradient(p, std::array::from_fn(|j| q[idx[j]]));
+            total += energy;
             for j in 0..K {
-                let e = p.energy(seeded(&x, j));
-                grad[idx[j]] += e.eps;
-                if j == 0 {
-                    total += e.re;
-                }
+                grad[idx[j]] += gradient[j];
             }
         }
         total
@@ -70,6 +63,21 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
+}
+
+/// `V(x)` and `∇V(x)`: one scalar dual pass per coordinate (see `constraint.rs`).
+#[inline(always)]
+pub(crate) fn energy_and_gradient<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> (f64, [f64; K]) {
+    if K == 0 {
+        return (p.energy(x), [0.0; K]);
+    }
+    let mut energy = 0.0;
+    let gradient = std::array::from_fn(|j| {
+        let e = p.energy(seeded(&x, j));
+        energy = e.re;
+        e.eps
+    });
+    (energy, gradient)
 }
 
 pub(crate) struct ForceGroup<F, const K: usize> {

@@ -18,6 +18,7 @@ pub mod planar;
 pub mod reference;
 pub mod scalar;
 pub mod simulate;
+pub mod small;
 mod sparse;
 pub mod system;
 pub mod timefn;

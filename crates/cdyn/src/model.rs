@@ -214,6 +214,6 @@ impl Model {
 
     /// Kinetic energy `½ vᵀ M v`.
     pub fn kinetic(&self, v: &[f64]) -> f64 {
-        0.5 * self.mass.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
+        crate::energy::kinetic(&self.mass, v)
     }
 }

@@ -5,12 +5,12 @@
 //! seen every step before it.
 
 use crate::control::Control;
-use crate::diagnostics::{Measures, Probe};
+use crate::diagnostics::Measures;
 use crate::dynamics::LinearSolver;
 use crate::error::{Error, Result, positive};
-use crate::integrate::{Integrator, Rhs, Scheme};
+use crate::integrate::{Integrator, Scheme};
 use crate::model::Model;
-use crate::system::{ControlledSystem, EvalError, split_state};
+use crate::system::{ControlledSystem, EvalError, System};
 
 /// How to simulate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,52 +55,66 @@ impl Settings {
     }
 }
 
-/// A running simulation.
-pub struct Simulation<'m> {
-    system: ControlledSystem<'m>,
+/// A running simulation of any controlled [`System`]: the general
+/// [`Simulation`] of a [`Model`], or a [`SmallSimulation`](crate::small::SmallSimulation).
+pub struct Stepper<S> {
+    system: S,
     integrator: Integrator,
-    probe: Probe,
     settings: Settings,
     x: Vec<f64>,
     step: u64,
 }
+
+/// A running simulation of a [`Model`].
+pub type Simulation<'m> = Stepper<ControlledSystem<'m>>;
 
 impl<'m> Simulation<'m> {
     /// Starts at `t = 0` from `(q0, v0)`, checking the settings and, unless
     /// disabled, that the initial state satisfies the constraints.
     pub fn new(model: &'m Model, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
         settings.validate()?;
-        let n = model.n();
-        if q0.len() != n || v0.len() != n {
-            return Err(Error::InvalidModel(format!(
-                "initial state has {} positions and {} velocities, the model has {n} coordinates",
-                q0.len(),
-                v0.len()
-            )));
-        }
-        if let Some((i, &x)) = q0.iter().chain(v0).enumerate().find(|(_, x)| !x.is_finite()) {
-            return Err(Error::InvalidModel(format!("initial state component {i} is {x}")));
-        }
+        check_initial_state(model.n(), q0, v0)?;
         let e0 = model.kinetic(v0) + model.potential(q0, None);
-        let mut x = Vec::with_capacity(2 * n + 1);
-        x.extend_from_slice(q0);
-        x.extend_from_slice(v0);
-        x.push(0.0);
-        let mut probe = Probe::new(model);
-        if let Some(tolerance) = settings.consistency_tolerance {
-            let m = probe.measure(model, q0, v0, 0.0, 0.0, e0);
-            if m.phi.abs() > tolerance || m.phi_dot > tolerance {
-                return Err(Error::InconsistentInitialState { phi: m.phi.abs(), phi_dot: m.phi_dot, tolerance });
-            }
-        }
-        let system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
-        let integrator = Integrator::new(settings.scheme, settings.control.application, system.state_len());
-        Ok(Self { system, integrator, probe, settings, x, step: 0 })
+        Self::start(ControlledSystem::with_solver(model, settings.control, e0, settings.solver), settings, q0, v0)
     }
 
     pub fn model(&self) -> &'m Model {
         self.system.model()
     }
+}
+
+/// Checks an initial state has `n` finite positions and velocities.
+pub(crate) fn check_initial_state(n: usize, q0: &[f64], v0: &[f64]) -> Result<()> {
+    if q0.len() != n || v0.len() != n {
+        return Err(Error::InvalidModel(format!(
+            "initial state has {} positions and {} velocities, the model has {n} coordinates",
+            q0.len(),
+            v0.len()
+        )));
+    }
+    if let Some((i, &x)) = q0.iter().chain(v0).enumerate().find(|(_, x)| !x.is_finite()) {
+        return Err(Error::InvalidModel(format!("initial state component {i} is {x}")));
+    }
+    Ok(())
+}
+
+impl<S: System> Stepper<S> {
+    /// Starts `system` at `t = 0` from a checked `(q0, v0)` with valid `settings`.
+    pub(crate) fn start(mut system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        let mut x = Vec::with_capacity(2 * q0.len() + 1);
+        x.extend_from_slice(q0);
+        x.extend_from_slice(v0);
+        x.push(0.0);
+        if let Some(tolerance) = settings.consistency_tolerance {
+            let m = system.measure(&x, 0.0);
+            if m.phi.abs() > tolerance || m.phi_dot > tolerance {
+                return Err(Error::InconsistentInitialState { phi: m.phi.abs(), phi_dot: m.phi_dot, tolerance });
+            }
+        }
+        let integrator = Integrator::new(settings.scheme, settings.control.application, system.state_len());
+        Ok(Self { system, integrator, settings, x, step: 0 })
+    }
+
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
@@ -113,30 +127,29 @@ impl<'m> Simulation<'m> {
         self.step as f64 * self.settings.h
     }
     pub fn q(&self) -> &[f64] {
-        &self.x[..self.model().n()]
+        &self.x[..self.system.n()]
     }
     pub fn v(&self) -> &[f64] {
-        let n = self.model().n();
+        let n = self.system.n();
         &self.x[n..2 * n]
     }
     /// `∫Ė dτ` so far.
     pub fn energy_input(&self) -> f64 {
-        self.x[2 * self.model().n()]
+        self.x[2 * self.system.n()]
     }
     /// `E₀ = T₀ + V₀`.
     pub fn initial_energy(&self) -> f64 {
-        self.system.e0
+        self.system.e0()
     }
     /// Right-hand-side evaluations so far.
     pub fn evaluations(&self) -> u64 {
-        self.system.evaluations
+        self.system.evaluations()
     }
 
     /// Violations at the current state.
     pub fn measure(&mut self) -> Measures {
-        let model = self.system.model();
-        let (q, v, e) = split_state(&self.x, model.n());
-        self.probe.measure(model, q, v, e, self.t(), self.system.e0)
+        let t = self.t();
+        self.system.measure(&self.x, t)
     }
 
     /// One step of size `h`.
@@ -153,7 +166,7 @@ impl<'m> Simulation<'m> {
         }
         // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.
         if self.settings.violation_limit.is_finite() {
-            let phi = self.system.dynamics.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()));
+            let phi = self.system.last_violation();
             if phi > self.settings.violation_limit {
                 return Err(Error::ViolationLimit { step, t, phi, limit: self.settings.violation_limit });
             }

@@ -1,7 +1,8 @@
 //! The controlled state equation `ẋ = f(x, t) + U(x, t)` of a model, with
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
-use crate::control::Control;
+use crate::control::{Control, Evaluation};
+use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::Rhs;
@@ -14,6 +15,30 @@ pub enum EvalError {
     Singular { t: f64, row: usize },
     /// The state handed in was not finite.
     NonFinite { t: f64 },
+}
+
+impl EvalError {
+    pub(crate) fn at(b: Breakdown, t: f64) -> Self {
+        match b {
+            Breakdown::Singular(row) => EvalError::Singular { t, row },
+            Breakdown::NonFinite => EvalError::NonFinite { t },
+        }
+    }
+}
+
+/// What a [`Stepper`](crate::simulate::Stepper) steps: a controlled state
+/// equation over `x = (q, v, e)` that can also report its violations.
+pub trait System: Rhs<Error = EvalError> {
+    /// Number of coordinates `n`.
+    fn n(&self) -> usize;
+    /// `E₀ = T₀ + V₀`.
+    fn e0(&self) -> f64;
+    /// Right-hand-side evaluations so far.
+    fn evaluations(&self) -> u64;
+    /// `max |Φ|` at the state of the latest evaluation.
+    fn last_violation(&self) -> f64;
+    /// Violations at the state `x`, time `t`.
+    fn measure(&mut self, x: &[f64], t: f64) -> Measures;
 }
 
 /// Splits a state into `(q, v, e)`.
@@ -30,6 +55,7 @@ pub struct ControlledSystem<'m> {
     /// `E₀ = T₀ + V₀`
     pub e0: f64,
     scratch: Vec<f64>,
+    probe: Probe,
     /// Right-hand-side evaluations so far.
     pub evaluations: u64,
 }
@@ -47,6 +73,7 @@ impl<'m> ControlledSystem<'m> {
             dynamics: Dynamics::with_solver(model, solver),
             e0,
             scratch: vec![0.0; model.m()],
+            probe: Probe::new(model),
             evaluations: 0,
         }
     }
@@ -75,10 +102,7 @@ impl Rhs for ControlledSystem<'_> {
         let n = self.model.n();
         let (q, v, e) = split_state(x, n);
         self.evaluations += 1;
-        self.dynamics.evaluate(self.model, q, v, t).map_err(|b| match b {
-            Breakdown::Singular(row) => EvalError::Singular { t, row },
-            Breakdown::NonFinite => EvalError::NonFinite { t },
-        })?;
+        self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
         let e_dot = energy::energy_input(&self.dynamics);
         f[..n].copy_from_slice(v);
         f[n..2 * n].copy_from_slice(&self.dynamics.acc);
@@ -88,8 +112,59 @@ impl Rhs for ControlledSystem<'_> {
             let (u_q, rest) = u.split_at_mut(n);
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
-            self.control.terms(self.model, &self.dynamics, v, psi, e_dot, u_q, u_v, &mut self.scratch);
+            let d = Evaluated { model: self.model, dynamics: &self.dynamics };
+            self.control.terms(&d, v, psi, e_dot, u_q, u_v, &mut self.scratch);
         }
         Ok(())
+    }
+}
+
+impl System for ControlledSystem<'_> {
+    fn n(&self) -> usize {
+        self.model.n()
+    }
+    fn e0(&self) -> f64 {
+        self.e0
+    }
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+    fn last_violation(&self) -> f64 {
+        self.dynamics.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
+    }
+    fn measure(&mut self, x: &[f64], t: f64) -> Measures {
+        let (q, v, e) = split_state(x, self.model.n());
+        self.probe.measure(self.model, q, v, e, t, self.e0)
+    }
+}
+
+/// One evaluation of a general model, as the control laws read it.
+struct Evaluated<'a> {
+    model: &'a Model,
+    dynamics: &'a Dynamics,
+}
+
+impl Evaluation for Evaluated<'_> {
+    fn mass(&self) -> &[f64] {
+        self.model.mass()
+    }
+    fn phi(&self) -> &[f64] {
+        &self.dynamics.phi
+    }
+    fn phi_dot(&self) -> &[f64] {
+        &self.dynamics.phi_dot
+    }
+    fn grad_potential(&self) -> &[f64] {
+        &self.dynamics.grad_potential
+    }
+    fn acc(&self) -> &[f64] {
+        &self.dynamics.acc
+    }
+    fn row(&self, r: usize) -> (&[f64], &[usize]) {
+        let (pattern, range) = (self.model.pattern(), self.model.pattern().row(r));
+        (&self.dynamics.jac[range.clone()], &pattern.cols[range])
+    }
+    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
+        self.dynamics.add_constraint_response(self.model, b, out);
     }
 }

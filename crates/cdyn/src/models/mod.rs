@@ -7,7 +7,7 @@ mod pendulum;
 
 pub use andrews::andrews;
 pub use mechanisms::*;
-pub use pendulum::{PendulumParams, cartesian_pendulum, theta_pendulum};
+pub use pendulum::{PendulumParams, SmallPendulum, cartesian_pendulum, small_pendulum, theta_pendulum};
 
 /// `(q, v)` of the exact solution at time `t`, in the model's coordinates.
 pub type Reference = Box<dyn Fn(f64, &mut [f64], &mut [f64]) + Send + Sync>;

@@ -6,6 +6,7 @@
 use super::Example;
 use crate::error::{Result, non_negative, positive};
 use crate::reference::PendulumExact;
+use crate::small::SmallSystem;
 use crate::{Constraint, Model, Potential, Scalar};
 
 /// Parameters of the pendulum; the default is the paper's Example 1.
@@ -112,6 +113,34 @@ pub fn cartesian_pendulum(p: PendulumParams) -> Result<Example> {
         observe: Box::new(|q, v, out| out.copy_from_slice(&[q[0], q[1], v[0], v[1]])),
         reference,
     })
+}
+
+/// The pendulum in Cartesian coordinates as a [`SmallSystem`]: the same
+/// equations as [`cartesian_pendulum`], in fixed-size arrays.
+#[derive(Debug, Clone, Copy)]
+pub struct SmallPendulum {
+    rod: f64,
+    mass: f64,
+    weight: f64,
+}
+
+impl SmallSystem<2, 1> for SmallPendulum {
+    fn mass(&self) -> [f64; 2] {
+        [self.mass; 2]
+    }
+    fn constraints<D: Scalar>(&self, q: [D; 2], t: D) -> [D; 1] {
+        Rod { length: self.rod }.eval(q, t)
+    }
+    fn potential<D: Scalar>(&self, [_, y]: [D; 2]) -> D {
+        Weight { w: self.weight }.energy([y])
+    }
+}
+
+/// The Cartesian pendulum as a [`SmallSystem`], with its initial `(q, v)`.
+pub fn small_pendulum(p: PendulumParams) -> Result<(SmallPendulum, [f64; 2], [f64; 2])> {
+    p.validate()?;
+    let [x, y, vx, vy] = tip(p.length, p.theta0, p.omega0);
+    Ok((SmallPendulum { rod: p.length, mass: p.mass, weight: p.mass * p.gravity }, [x, y], [vx, vy]))
 }
 
 /// The pendulum in the independent angle `q = (θ)`, `m L² θ̈ + m g L cos θ = 0`.

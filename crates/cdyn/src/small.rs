@@ -1,0 +1,339 @@
+//! Small systems whose size is known at compile time: `N` coordinates and
+//! `M` constraint rows written as one function each, simulated in
+//! fixed-size arrays.
+//!
+//! A general [`Model`] reads its elements through dynamic dispatch and its
+//! buffers through run-time lengths. That costs a few nanoseconds per call
+//! — nothing for a chain of a thousand bodies, most of the step for a
+//! pendulum. Here every call is resolved and every length known at compile
+//! time, so a step compiles to about what one would write by hand. The
+//! physics, the control laws and the integrator are the general ones; only
+//! the storage differs. [`to_model`] turns the same system into a general
+//! model, and the tests hold both to the same trajectories.
+
+use crate::constraint::{Constraint, local};
+use crate::control::{Control, Evaluation};
+use crate::diagnostics::Measures;
+use crate::energy;
+use crate::error::{Error, Result, positive};
+use crate::force::{Force, Potential, energy_and_gradient};
+use crate::integrate::Rhs;
+use crate::linalg::{Breakdown, PIVOT_TOLERANCE};
+use crate::model::Model;
+use crate::scalar::Scalar;
+use crate::simulate::{Settings, Stepper, check_initial_state};
+use crate::system::{EvalError, System};
+use std::sync::Arc;
+
+/// A whole system of `N` coordinates with a constant diagonal mass matrix
+/// and `M` holonomic constraints, written once for every scalar type.
+pub trait SmallSystem<const N: usize, const M: usize>: Send + Sync + 'static {
+    /// The diagonal of the mass matrix.
+    fn mass(&self) -> [f64; N];
+    /// `Φ(q, t)`.
+    fn constraints<D: Scalar>(&self, q: [D; N], t: D) -> [D; M];
+    /// The potential energy `V(q)`; none unless given.
+    fn potential<D: Scalar>(&self, q: [D; N]) -> D {
+        let _ = q;
+        D::from(0.0)
+    }
+    /// The non-conservative generalized force; none unless given.
+    fn force<D: Scalar>(&self, q: [D; N], v: [D; N], t: D) -> [D; N] {
+        let _ = (q, v, t);
+        [D::from(0.0); N]
+    }
+}
+
+/// A small system seen as one constraint, potential and force element.
+struct Whole<S, const N: usize, const M: usize>(Arc<S>);
+
+impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Constraint<N, M> for Whole<S, N, M> {
+    #[inline(always)]
+    fn eval<D: Scalar>(&self, q: [D; N], t: D) -> [D; M] {
+        self.0.constraints(q, t)
+    }
+}
+
+impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Potential<N> for Whole<S, N, M> {
+    #[inline(always)]
+    fn energy<D: Scalar>(&self, q: [D; N]) -> D {
+        self.0.potential(q)
+    }
+}
+
+impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Force<N> for Whole<S, N, M> {
+    #[inline(always)]
+    fn force<D: Scalar>(&self, q: [D; N], v: [D; N], t: D) -> [D; N] {
+        self.0.force(q, v, t)
+    }
+}
+
+/// The same system as a general [`Model`], one element of each kind over all coordinates.
+pub fn to_model<S: SmallSystem<N, M>, const N: usize, const M: usize>(system: S) -> Result<Model> {
+    let system = Arc::new(system);
+    let all: [usize; N] = std::array::from_fn(|i| i);
+    let mut builder = Model::builder(system.mass().to_vec());
+    if M > 0 {
+        builder = builder.constrain(Whole::<S, N, M>(system.clone()), all);
+    }
+    builder.potential(Whole::<S, N, M>(system.clone()), all).force(Whole::<S, N, M>(system), all).build()
+}
+
+/// A running simulation of a [`SmallSystem`].
+pub type SmallSimulation<S, const N: usize, const M: usize> = Stepper<SmallControlled<S, N, M>>;
+
+impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N, M> {
+    /// Starts at `t = 0` from `(q0, v0)`, checking the settings, the masses
+    /// and, unless disabled, that the initial state satisfies the constraints.
+    pub fn new(system: S, settings: Settings, q0: [f64; N], v0: [f64; N]) -> Result<Self> {
+        settings.validate()?;
+        check_initial_state(N, &q0, &v0)?;
+        let mass = system.mass();
+        for &m in &mass {
+            positive("mass", m)?;
+        }
+        if M > N {
+            return Err(Error::InvalidModel(format!(
+                "{M} constraints on {N} coordinates: more constraints than coordinates"
+            )));
+        }
+        let system = Whole(Arc::new(system));
+        let e0 = energy::kinetic(&mass, &v0) + system.energy(q0);
+        let controlled =
+            SmallControlled { system, control: settings.control, e0, evaluations: 0, d: SmallDynamics::new(mass) };
+        Self::start(controlled, settings, &q0, &v0)
+    }
+}
+
+/// A small system with a control law: the right-hand side the integrator steps.
+pub struct SmallControlled<S, const N: usize, const M: usize> {
+    system: Whole<S, N, M>,
+    control: Control,
+    e0: f64,
+    evaluations: u64,
+    d: SmallDynamics<N, M>,
+}
+
+/// One evaluation of the dynamics of a small system (as `Dynamics`, in arrays).
+struct SmallDynamics<const N: usize, const M: usize> {
+    mass: [f64; N],
+    inv_mass: [f64; N],
+    phi: [f64; M],
+    phi_dot: [f64; M],
+    phi_t: [f64; M],
+    jac: [[f64; N]; M],
+    grad_potential: [f64; N],
+    potential: f64,
+    force_power: f64,
+    lambda: [f64; M],
+    acc: [f64; N],
+    /// `S = Φ_q M⁻¹ Φ_qᵀ = L D Lᵀ`: the strictly lower part of `L`, `D` and `1/D`.
+    lower: [[f64; M]; M],
+    d: [f64; M],
+    inv_d: [f64; M],
+}
+
+impl<const N: usize, const M: usize> SmallDynamics<N, M> {
+    /// The coordinates of a row of `Φ_q`: all of them.
+    const COLUMNS: [usize; N] = {
+        let mut all = [0; N];
+        let mut i = 0;
+        while i < N {
+            all[i] = i;
+            i += 1;
+        }
+        all
+    };
+
+    fn new(mass: [f64; N]) -> Self {
+        Self {
+            mass,
+            inv_mass: mass.map(|m| 1.0 / m),
+            phi: [0.0; M],
+            phi_dot: [0.0; M],
+            phi_t: [0.0; M],
+            jac: [[0.0; N]; M],
+            grad_potential: [0.0; N],
+            potential: 0.0,
+            force_power: 0.0,
+            lambda: [0.0; M],
+            acc: [0.0; N],
+            lower: [[0.0; M]; M],
+            d: [0.0; M],
+            inv_d: [0.0; M],
+        }
+    }
+
+    /// As [`Dynamics::evaluate`](crate::dynamics::Dynamics::evaluate).
+    #[inline(always)]
+    fn evaluate<S: SmallSystem<N, M>>(
+        &mut self,
+        system: &Whole<S, N, M>,
+        q: [f64; N],
+        v: [f64; N],
+        t: f64,
+    ) -> Result<(), Breakdown> {
+        let (potential, grad) = energy_and_gradient(system, q);
+        let force = system.force(q, v, t);
+        self.potential = potential;
+        self.grad_potential = grad;
+        self.force_power = (0..N).map(|i| force[i] * v[i]).sum();
+        let mut acc: [f64; N] = std::array::from_fn(|i| (force[i] - grad[i]) * self.inv_mass[i]);
+        let l = local(system, q, v, acc, t);
+        (self.phi, self.phi_dot, self.phi_t, self.jac) = (l.phi, l.phi_dot, l.phi_t, l.jac);
+        self.factor()?;
+        // (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
+        let mut lambda = l.rhs;
+        self.solve(&mut lambda);
+        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
+        self.subtract_weighted_jt(&lambda, &mut acc);
+        (self.lambda, self.acc) = (lambda, acc);
+        Ok(())
+    }
+
+    /// Factors `S = Φ_q M⁻¹ Φ_qᵀ` as `L D Lᵀ`, with the pivot test of the general kernel.
+    #[inline(always)]
+    fn factor(&mut self) -> Result<(), Breakdown> {
+        for j in 0..M {
+            let s_jj = self.s(j, j);
+            let d = s_jj - (0..j).map(|k| self.lower[j][k] * self.lower[j][k] * self.d[k]).sum::<f64>();
+            if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
+                let blown_up = !d.is_finite() || self.jac.iter().flatten().any(|x| !x.is_finite());
+                return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(j) });
+            }
+            self.d[j] = d;
+            self.inv_d[j] = 1.0 / d;
+            for i in j + 1..M {
+                let update: f64 = (0..j).map(|k| self.lower[i][k] * self.lower[j][k] * self.d[k]).sum();
+                self.lower[i][j] = (self.s(i, j) - update) * self.inv_d[j];
+            }
+        }
+        Ok(())
+    }
+
+    /// An entry of `S`.
+    #[inline(always)]
+    fn s(&self, i: usize, j: usize) -> f64 {
+        (0..N).map(|c| self.jac[i][c] * self.jac[j][c] * self.inv_mass[c]).sum()
+    }
+
+    /// Solves `S x = b` in place with the current factorization.
+    #[inline(always)]
+    fn solve(&self, b: &mut [f64; M]) {
+        for i in 0..M {
+            for k in 0..i {
+                b[i] -= self.lower[i][k] * b[k];
+            }
+        }
+        for i in 0..M {
+            b[i] *= self.inv_d[i];
+        }
+        for i in (0..M).rev() {
+            for k in i + 1..M {
+                b[i] -= self.lower[k][i] * b[k];
+            }
+        }
+    }
+
+    /// `out −= M⁻¹ Φ_qᵀ y`
+    #[inline(always)]
+    fn subtract_weighted_jt(&self, y: &[f64; M], out: &mut [f64]) {
+        for r in 0..M {
+            for c in 0..N {
+                out[c] -= self.inv_mass[c] * self.jac[r][c] * y[r];
+            }
+        }
+    }
+}
+
+impl<const N: usize, const M: usize> Evaluation for SmallDynamics<N, M> {
+    fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+    fn phi(&self) -> &[f64] {
+        &self.phi
+    }
+    fn phi_dot(&self) -> &[f64] {
+        &self.phi_dot
+    }
+    fn grad_potential(&self) -> &[f64] {
+        &self.grad_potential
+    }
+    fn acc(&self) -> &[f64] {
+        &self.acc
+    }
+    fn row(&self, r: usize) -> (&[f64], &[usize]) {
+        (&self.jac[r], &Self::COLUMNS)
+    }
+    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
+        let b: &mut [f64; M] = b.try_into().expect("one value per constraint row");
+        self.solve(b);
+        self.subtract_weighted_jt(b, out);
+    }
+}
+
+impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControlled<S, N, M> {
+    type Error = EvalError;
+
+    fn state_len(&self) -> usize {
+        2 * N + 1
+    }
+
+    fn has_control(&self) -> bool {
+        self.control.is_active()
+    }
+
+    #[inline(always)]
+    fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
+        let q: [f64; N] = std::array::from_fn(|i| x[i]);
+        let v: [f64; N] = std::array::from_fn(|i| x[N + i]);
+        let e = x[2 * N];
+        self.evaluations += 1;
+        let d = &mut self.d;
+        d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
+        let e_dot = d.force_power + (0..M).map(|r| d.lambda[r] * d.phi_t[r]).sum::<f64>();
+        f[..N].copy_from_slice(&v);
+        f[N..2 * N].copy_from_slice(&d.acc);
+        f[2 * N] = e_dot;
+        if let Some(u) = u {
+            let psi = energy::kinetic(&d.mass, &v) + d.potential - self.e0 - e;
+            let (u_q, rest) = u.split_at_mut(N);
+            let (u_v, u_e) = rest.split_at_mut(N);
+            u_e[0] = 0.0;
+            self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, &mut [0.0; M]);
+        }
+        Ok(())
+    }
+}
+
+impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallControlled<S, N, M> {
+    fn n(&self) -> usize {
+        N
+    }
+    fn e0(&self) -> f64 {
+        self.e0
+    }
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+    fn last_violation(&self) -> f64 {
+        self.d.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
+    }
+    fn measure(&mut self, x: &[f64], t: f64) -> Measures {
+        let q: [f64; N] = std::array::from_fn(|i| x[i]);
+        let v: [f64; N] = std::array::from_fn(|i| x[N + i]);
+        let l = local(&self.system, q, v, [0.0; N], t);
+        let (potential, grad) = energy_and_gradient(&self.system, q);
+        let mut out =
+            Measures { psi: energy::kinetic(&self.d.mass, &v) + potential - self.e0 - x[2 * N], ..Measures::default() };
+        for r in 0..M {
+            if l.phi[r].abs() > out.phi.abs() {
+                out.phi = l.phi[r];
+            }
+            out.phi_dot = out.phi_dot.max(l.phi_dot[r].abs());
+            let y: f64 = (0..N).map(|c| grad[c] * l.jac[r][c]).sum();
+            out.coupling = out.coupling.max(y.abs());
+        }
+        out
+    }
+}
