@@ -13,7 +13,7 @@ fn light_bench_writes_a_complete_report() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("bench.json")).unwrap()).unwrap();
     let e = &r["example1"];
-    for key in ["cdyn_ns_per_step", "handwritten_ns_per_step", "overhead_ratio"] {
+    for key in ["cdyn_ns_per_step", "general_ns_per_step", "handwritten_ns_per_step", "overhead_ratio"] {
         assert!(e[key].as_f64().unwrap() > 0.0, "{key}");
     }
     assert_eq!(e["allocations_per_step"].as_f64(), Some(0.0));

@@ -100,22 +100,49 @@ pub trait Rhs {
     fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), Self::Error>;
 }
 
+/// Storage of a state or of a derivative: a vector, or a fixed-size
+/// array when the size is known at compile time (so that a small system's
+/// step keeps its numbers in registers).
+pub trait Buffer: Clone {
+    fn as_slice(&self) -> &[f64];
+    fn as_mut_slice(&mut self) -> &mut [f64];
+}
+
+impl Buffer for Vec<f64> {
+    #[inline(always)]
+    fn as_slice(&self) -> &[f64] {
+        self
+    }
+    #[inline(always)]
+    fn as_mut_slice(&mut self) -> &mut [f64] {
+        self
+    }
+}
+
 /// Steps a state with one scheme and one way of applying the control.
 /// All buffers are allocated here, none in [`step`](Self::step).
-pub struct Integrator {
+pub struct Integrator<B = Vec<f64>> {
     scheme: Scheme,
     application: Application,
-    /// Past evaluations, newest first.
-    history: Vec<Vec<f64>>,
+    /// Past evaluations, a ring: the newest at `newest`, older ones after it.
+    history: Vec<B>,
+    newest: usize,
     filled: usize,
-    stages: Vec<Vec<f64>>,
-    stage_x: Vec<f64>,
-    u: Vec<f64>,
-    scratch: Vec<f64>,
+    stages: Vec<B>,
+    stage_x: B,
+    u: B,
+    scratch: B,
 }
 
 impl Integrator {
     pub fn new(scheme: Scheme, application: Application, len: usize) -> Self {
+        Self::with_zero(scheme, application, vec![0.0; len])
+    }
+}
+
+impl<B: Buffer> Integrator<B> {
+    /// With buffers shaped like `zero`.
+    pub fn with_zero(scheme: Scheme, application: Application, zero: B) -> Self {
         let info = scheme.info();
         let stages = [Some(scheme), info.startup]
             .into_iter()
@@ -129,12 +156,13 @@ impl Integrator {
         Self {
             scheme,
             application,
-            history: vec![vec![0.0; len]; info.history],
+            history: vec![zero.clone(); info.history],
+            newest: 0,
             filled: 0,
-            stages: vec![vec![0.0; len]; stages],
-            stage_x: vec![0.0; len],
-            u: vec![0.0; len],
-            scratch: vec![0.0; len],
+            stages: vec![zero.clone(); stages],
+            stage_x: zero.clone(),
+            u: zero.clone(),
+            scratch: zero,
         }
     }
 
@@ -144,13 +172,20 @@ impl Integrator {
         if self.filled + 1 < info.history { info.startup.unwrap_or(self.scheme) } else { self.scheme }
     }
 
+    /// The evaluation `j` steps back (0: the newest).
+    #[inline(always)]
+    fn past(&self, j: usize) -> &[f64] {
+        self.history[(self.newest + j) % self.history.len()].as_slice()
+    }
+
     /// Advances `x` from `t` to `t + h`.
+    #[inline]
     pub fn step<R: Rhs>(&mut self, rhs: &mut R, x: &mut [f64], t: f64, h: f64) -> Result<(), R::Error> {
         let active = self.active_scheme().info();
         let control = rhs.has_control();
         let split = control && self.application != Application::InRhs;
         // F(x_k): f + U in the right-hand side, f alone when split; U(x_k) kept for forward Euler.
-        self.history.rotate_right(1);
+        self.newest = (self.newest + self.history.len() - 1) % self.history.len();
         self.evaluate_first(rhs, x, t, control)?;
         self.filled = (self.filled + 1).min(self.history.len());
         let mut control_pending = true;
@@ -158,30 +193,32 @@ impl Integrator {
             Formula::Multistep(w) => {
                 // The forward Euler control step joins the same pass over memory.
                 let joined = split && self.application == Application::ForwardEuler;
-                advance(x, h, w, &self.history, joined.then_some(&self.u[..]));
+                let f: [&[f64]; 3] = std::array::from_fn(|j| self.past(if j < w.len() { j } else { 0 }));
+                advance(x, h, w, f, joined.then_some(self.u.as_slice()));
                 control_pending = !joined;
             }
             Formula::RungeKutta { a, b, c } => {
-                self.stages[0].copy_from_slice(&self.history[0]);
+                self.stages[0].as_mut_slice().copy_from_slice(self.history[self.newest].as_slice());
                 for i in 1..b.len() {
-                    self.stage_x.copy_from_slice(x);
+                    let stage_x = self.stage_x.as_mut_slice();
+                    stage_x.copy_from_slice(x);
                     for (j, &aij) in a[i].iter().enumerate() {
                         if aij != 0.0 {
-                            for (s, k) in self.stage_x.iter_mut().zip(&self.stages[j]) {
+                            for (s, k) in stage_x.iter_mut().zip(self.stages[j].as_slice()) {
                                 *s += h * aij * k;
                             }
                         }
                     }
-                    let ki = &mut self.stages[i];
+                    let ki = self.stages[i].as_mut_slice();
                     if control && !split {
-                        rhs.eval(&self.stage_x, t + c[i] * h, ki, Some(&mut self.u))?;
-                        add(ki, &self.u);
+                        rhs.eval(self.stage_x.as_slice(), t + c[i] * h, ki, Some(self.u.as_mut_slice()))?;
+                        add(ki, self.u.as_slice());
                     } else {
-                        rhs.eval(&self.stage_x, t + c[i] * h, ki, None)?;
+                        rhs.eval(self.stage_x.as_slice(), t + c[i] * h, ki, None)?;
                     }
                 }
                 for (i, &bi) in b.iter().enumerate() {
-                    for (xi, k) in x.iter_mut().zip(&self.stages[i]) {
+                    for (xi, k) in x.iter_mut().zip(self.stages[i].as_slice()) {
                         *xi += h * bi * k;
                     }
                 }
@@ -189,42 +226,44 @@ impl Integrator {
         }
         if split && control_pending {
             if self.application == Application::BackwardEuler {
-                rhs.eval(x, t + h, &mut self.scratch, Some(&mut self.u))?;
+                rhs.eval(x, t + h, self.scratch.as_mut_slice(), Some(self.u.as_mut_slice()))?;
             }
-            for (xi, ui) in x.iter_mut().zip(&self.u) {
+            for (xi, ui) in x.iter_mut().zip(self.u.as_slice()) {
                 *xi += h * ui;
             }
         }
         Ok(())
     }
 
+    #[inline(always)]
     fn evaluate_first<R: Rhs>(&mut self, rhs: &mut R, x: &[f64], t: f64, control: bool) -> Result<(), R::Error> {
-        let f = &mut self.history[0];
+        let (f, u) = (self.history[self.newest].as_mut_slice(), self.u.as_mut_slice());
         match (control, self.application) {
             (false, _) | (true, Application::BackwardEuler) => rhs.eval(x, t, f, None),
-            (true, Application::ForwardEuler) => rhs.eval(x, t, f, Some(&mut self.u)),
+            (true, Application::ForwardEuler) => rhs.eval(x, t, f, Some(u)),
             (true, Application::InRhs) => {
-                rhs.eval(x, t, f, Some(&mut self.u))?;
-                add(f, &self.u);
+                rhs.eval(x, t, f, Some(u))?;
+                add(f, u);
                 Ok(())
             }
         }
     }
 }
 
-/// `x += h Σ_j w_j f_j (+ h u)` in one pass (at most three past evaluations).
-fn advance(x: &mut [f64], h: f64, w: &[f64], f: &[Vec<f64>], u: Option<&[f64]>) {
+/// `x += h Σ_j w_j f_j (+ h u)` in one pass (at most three past evaluations,
+/// newest first; entries past `w` are not read).
+#[inline(always)]
+fn advance(x: &mut [f64], h: f64, w: &[f64], f: [&[f64]; 3], u: Option<&[f64]>) {
     assert!(w.len() <= 3, "multistep formulas read at most three past evaluations");
     let hw = |j: usize| w.get(j).map_or(0.0, |w| h * w);
     let (w0, w1, w2) = (hw(0), hw(1), hw(2));
-    let f0 = &f[0][..x.len()];
-    let f1 = if w.len() > 1 { &f[1][..x.len()] } else { f0 };
-    let f2 = if w.len() > 2 { &f[2][..x.len()] } else { f0 };
+    let n = x.len();
+    let (f0, f1, f2) = (&f[0][..n], &f[1][..n], &f[2][..n]);
     let (hu, u) = match u {
-        Some(u) => (h, &u[..x.len()]),
+        Some(u) => (h, &u[..n]),
         None => (0.0, f0),
     };
-    for i in 0..x.len() {
+    for i in 0..n {
         x[i] += w0 * f0[i] + w1 * f1[i] + w2 * f2[i] + hu * u[i];
     }
 }

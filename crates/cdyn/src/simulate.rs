@@ -8,7 +8,7 @@ use crate::control::Control;
 use crate::diagnostics::Measures;
 use crate::dynamics::LinearSolver;
 use crate::error::{Error, Result, positive};
-use crate::integrate::{Integrator, Scheme};
+use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
 use crate::system::{ControlledSystem, EvalError, System};
 
@@ -57,11 +57,11 @@ impl Settings {
 
 /// A running simulation of any controlled [`System`]: the general
 /// [`Simulation`] of a [`Model`], or a [`SmallSimulation`](crate::small::SmallSimulation).
-pub struct Stepper<S> {
+pub struct Stepper<S: System> {
     system: S,
-    integrator: Integrator,
+    integrator: Integrator<S::State>,
     settings: Settings,
-    x: Vec<f64>,
+    x: S::State,
     step: u64,
 }
 
@@ -101,17 +101,17 @@ pub(crate) fn check_initial_state(n: usize, q0: &[f64], v0: &[f64]) -> Result<()
 impl<S: System> Stepper<S> {
     /// Starts `system` at `t = 0` from a checked `(q0, v0)` with valid `settings`.
     pub(crate) fn start(mut system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
-        let mut x = Vec::with_capacity(2 * q0.len() + 1);
-        x.extend_from_slice(q0);
-        x.extend_from_slice(v0);
-        x.push(0.0);
+        let n = q0.len();
+        let mut x = system.zero_state();
+        x.as_mut_slice()[..n].copy_from_slice(q0);
+        x.as_mut_slice()[n..2 * n].copy_from_slice(v0);
         if let Some(tolerance) = settings.consistency_tolerance {
-            let m = system.measure(&x, 0.0);
+            let m = system.measure(x.as_slice(), 0.0);
             if m.phi.abs() > tolerance || m.phi_dot > tolerance {
                 return Err(Error::InconsistentInitialState { phi: m.phi.abs(), phi_dot: m.phi_dot, tolerance });
             }
         }
-        let integrator = Integrator::new(settings.scheme, settings.control.application, system.state_len());
+        let integrator = Integrator::with_zero(settings.scheme, settings.control.application, system.zero_state());
         Ok(Self { system, integrator, settings, x, step: 0 })
     }
 
@@ -127,15 +127,15 @@ impl<S: System> Stepper<S> {
         self.step as f64 * self.settings.h
     }
     pub fn q(&self) -> &[f64] {
-        &self.x[..self.system.n()]
+        &self.x.as_slice()[..self.system.n()]
     }
     pub fn v(&self) -> &[f64] {
         let n = self.system.n();
-        &self.x[n..2 * n]
+        &self.x.as_slice()[n..2 * n]
     }
     /// `∫Ė dτ` so far.
     pub fn energy_input(&self) -> f64 {
-        self.x[2 * self.system.n()]
+        self.x.as_slice()[2 * self.system.n()]
     }
     /// `E₀ = T₀ + V₀`.
     pub fn initial_energy(&self) -> f64 {
@@ -149,19 +149,19 @@ impl<S: System> Stepper<S> {
     /// Violations at the current state.
     pub fn measure(&mut self) -> Measures {
         let t = self.t();
-        self.system.measure(&self.x, t)
+        self.system.measure(self.x.as_slice(), t)
     }
 
     /// One step of size `h`.
     pub fn step(&mut self) -> Result<()> {
         let t = self.t();
         let step = self.step;
-        self.integrator.step(&mut self.system, &mut self.x, t, self.settings.h).map_err(|e| match e {
+        self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, self.settings.h).map_err(|e| match e {
             EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
             EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t + self.settings.h },
         })?;
         self.step += 1;
-        if !all_finite(&self.x) {
+        if !all_finite(self.x.as_slice()) {
             return Err(Error::Diverged { step: self.step, t: self.t() });
         }
         // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.

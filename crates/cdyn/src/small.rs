@@ -17,7 +17,7 @@ use crate::diagnostics::Measures;
 use crate::energy;
 use crate::error::{Error, Result, positive};
 use crate::force::{Force, Potential, energy_and_gradient};
-use crate::integrate::Rhs;
+use crate::integrate::{Buffer, Rhs};
 use crate::linalg::{Breakdown, PIVOT_TOLERANCE};
 use crate::model::Model;
 use crate::scalar::Scalar;
@@ -102,6 +102,30 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
         let controlled =
             SmallControlled { system, control: settings.control, e0, evaluations: 0, d: SmallDynamics::new(mass) };
         Self::start(controlled, settings, &q0, &v0)
+    }
+}
+
+/// The state `x = (q, v, e)` of a small system, in place.
+#[derive(Debug, Clone, Copy)]
+#[repr(C)]
+pub struct SmallState<const N: usize> {
+    q: [f64; N],
+    v: [f64; N],
+    e: f64,
+}
+
+impl<const N: usize> Buffer for SmallState<N> {
+    #[inline(always)]
+    fn as_slice(&self) -> &[f64] {
+        // SAFETY: `repr(C)` lays out `2N + 1` consecutive `f64`s with no
+        // padding (every field has the alignment and size of `f64` units),
+        // and any bit pattern is a valid `f64`.
+        unsafe { std::slice::from_raw_parts((self as *const Self).cast::<f64>(), 2 * N + 1) }
+    }
+    #[inline(always)]
+    fn as_mut_slice(&mut self) -> &mut [f64] {
+        // SAFETY: as in `as_slice`; the borrow of `self` is exclusive.
+        unsafe { std::slice::from_raw_parts_mut((self as *mut Self).cast::<f64>(), 2 * N + 1) }
     }
 }
 
@@ -307,6 +331,10 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
 }
 
 impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallControlled<S, N, M> {
+    type State = SmallState<N>;
+    fn zero_state(&self) -> SmallState<N> {
+        SmallState { q: [0.0; N], v: [0.0; N], e: 0.0 }
+    }
     fn n(&self) -> usize {
         N
     }

@@ -5,7 +5,7 @@ use crate::control::{Control, Evaluation};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, Dynamics, LinearSolver};
 use crate::energy;
-use crate::integrate::Rhs;
+use crate::integrate::{Buffer, Rhs};
 use crate::model::Model;
 
 /// A failed evaluation of the right-hand side.
@@ -29,6 +29,10 @@ impl EvalError {
 /// What a [`Stepper`](crate::simulate::Stepper) steps: a controlled state
 /// equation over `x = (q, v, e)` that can also report its violations.
 pub trait System: Rhs<Error = EvalError> {
+    /// Storage of a state.
+    type State: Buffer;
+    /// A zero state.
+    fn zero_state(&self) -> Self::State;
     /// Number of coordinates `n`.
     fn n(&self) -> usize;
     /// `E₀ = T₀ + V₀`.
@@ -120,6 +124,10 @@ impl Rhs for ControlledSystem<'_> {
 }
 
 impl System for ControlledSystem<'_> {
+    type State = Vec<f64>;
+    fn zero_state(&self) -> Vec<f64> {
+        vec![0.0; self.state_len()]
+    }
     fn n(&self) -> usize {
         self.model.n()
     }

@@ -1,11 +1,13 @@
 //! No allocation inside a step: a counting global allocator watches 200
 //! steps after warm-up, for every scheme, control law and application, on
-//! Example 1 and on a mechanism with every kind of element.
+//! Example 1 (as a general model and as a small system) and on a mechanism
+//! with every kind of element.
 
 use cdyn::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
 use cdyn::dynamics::LinearSolver;
-use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum};
+use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
 use cdyn::planar::{Coordinate, Element, Mechanism};
+use cdyn::small::SmallSimulation;
 use cdyn::timefn::TimeFn;
 use cdyn::{Scheme, Settings, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -100,6 +102,21 @@ fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: 
     count() - before
 }
 
+/// As [`allocations_per_run`], for the Example 1 pendulum as a small system.
+fn small_allocations_per_run(settings: Settings, warm_up: usize, steps: usize) -> usize {
+    let (system, q0, v0) = small_pendulum(PendulumParams::default()).unwrap();
+    let mut sim = SmallSimulation::new(system, settings, q0, v0).unwrap();
+    for _ in 0..warm_up {
+        sim.step().unwrap();
+    }
+    let before = count();
+    for _ in 0..steps {
+        sim.step().unwrap();
+        std::hint::black_box(sim.measure());
+    }
+    count() - before
+}
+
 // One test function, so no other test thread allocates while we count.
 #[test]
 fn steps_do_not_allocate() {
@@ -113,6 +130,8 @@ fn steps_do_not_allocate() {
         for control in controls() {
             let n = allocations_per_run(&pendulum, Settings::new(scheme, 0.01, control), 5, 200);
             assert_eq!(n, 0, "pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+            let n = small_allocations_per_run(Settings::new(scheme, 0.01, control), 5, 200);
+            assert_eq!(n, 0, "small pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
         // Rates with hα = 0.4, as in the paper.
         let control = |h: f64| Control {
