@@ -369,3 +369,53 @@ fn inconsistent_initial_state_is_refused_unless_allowed() {
         Error::InvalidParameter { name: "h", .. }
     ));
 }
+
+/// A finding about the method, not a feature: with the paper's gains
+/// (`ζ = 20`, `α_e = 40`) the controlled equations of Example 1 have an
+/// equilibrium off the constraint manifold. The bob sits at `X = 0` below the
+/// pivot with the rod compressed (`Φ < 0`) and a velocity `V_Y > 0` that the
+/// CVSGF term cancels in `Ẏ = V_Y − 2ζΦ ∂Φ/∂Y` and the energy term cancels in
+/// `V̇_Y = A_Y − α_e Ψ V_Y/|V|²`. Nothing feeds `Φ̇` back, so velocity drift
+/// grows slowly until, after some hundreds of seconds, the run falls into it.
+/// The test finds the equilibrium from those two conditions (bisection in
+/// `Y`) and checks the run ends there.
+#[test]
+fn paper_gains_have_a_spurious_equilibrium_that_long_runs_reach() {
+    use cdyn::models::small_pendulum;
+    use cdyn::small::SmallSimulation;
+    let (zeta, alpha_e, e0) = (20.0, 40.0, 2.0);
+    // At X = V_X = 0: V_Y = w(Y) makes Ẏ = 0, and the residual of V̇_Y = 0 is r(Y).
+    let w = |y: f64| zeta * (y * y - 1.0) * y;
+    let r = |y: f64| {
+        let (w, lambda) = (w(y), (w(y) * w(y) - G * y) / (y * y));
+        let psi = 0.5 * w * w + G * y - e0;
+        (-G - y * lambda) - alpha_e * psi / w
+    };
+    let (mut lo, mut hi) = (-0.99, -0.9);
+    assert!(r(lo) * r(hi) < 0.0, "the equilibrium is bracketed");
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if r(lo) * r(mid) <= 0.0 { hi = mid } else { lo = mid }
+    }
+    let y_eq = 0.5 * (lo + hi);
+
+    let control = Control {
+        geometric: Geometric::Gradient(Gain::Fixed(zeta)),
+        energy: Energy::Gradient(EnergyGain::Rate { alpha_e }),
+        application: Application::ForwardEuler,
+    };
+    let (system, q0, v0) = small_pendulum(PendulumParams::default()).unwrap();
+    let mut sim = SmallSimulation::new(system, Settings::new(Scheme::AdamsBashforth3, 0.01, control), q0, v0).unwrap();
+    let mut phi_at_100s = 0.0_f64;
+    for step in 1..=100_000 {
+        sim.step().unwrap();
+        if step <= 10_000 {
+            phi_at_100s = phi_at_100s.max(sim.measure().phi.abs());
+        }
+    }
+    assert!(phi_at_100s < 1e-5, "on the manifold for the first 100 s: {phi_at_100s:e}");
+    let (q, v) = (sim.q(), sim.v());
+    assert!(q[0].abs() < 1e-9 && v[0].abs() < 1e-9, "at rest in X: {q:?} {v:?}");
+    assert!((q[1] - y_eq).abs() < 1e-9 && (v[1] - w(y_eq)).abs() < 1e-9, "{q:?} {v:?} vs Y = {y_eq}");
+    assert!(sim.measure().phi < -0.07, "rod compressed: {:?}", sim.measure());
+}
