@@ -18,6 +18,17 @@ pub struct Measures {
     pub coupling: f64,
 }
 
+impl Measures {
+    /// Takes in one constraint row: its `Φᵢ`, `Φ̇ᵢ` and `Y_ci`.
+    pub(crate) fn add_row(&mut self, phi: f64, phi_dot: f64, coupling: f64) {
+        if phi.abs() > self.phi.abs() {
+            self.phi = phi;
+        }
+        self.phi_dot = self.phi_dot.max(phi_dot.abs());
+        self.coupling = self.coupling.max(coupling.abs());
+    }
+}
+
 /// Buffers for measuring; one per model.
 pub struct Probe {
     phi: Vec<f64>,
@@ -63,12 +74,8 @@ impl Probe {
         let pattern = model.pattern();
         let mut out = Measures { psi: energy::psi(model, v, potential, e, e0), ..Measures::default() };
         for r in 0..model.m() {
-            if self.phi[r].abs() > out.phi.abs() {
-                out.phi = self.phi[r];
-            }
-            out.phi_dot = out.phi_dot.max(self.phi_dot[r].abs());
             let y: f64 = pattern.row(r).map(|j| self.grad[pattern.cols[j]] * self.jac[j]).sum();
-            out.coupling = out.coupling.max(y.abs());
+            out.add_row(self.phi[r], self.phi_dot[r], y);
         }
         out
     }

@@ -129,6 +129,12 @@ impl<const N: usize> Buffer for SmallState<N> {
     }
 }
 
+/// `(q, v, e)` of a state of length `2N + 1`.
+#[inline(always)]
+fn split<const N: usize>(x: &[f64]) -> ([f64; N], [f64; N], f64) {
+    (std::array::from_fn(|i| x[i]), std::array::from_fn(|i| x[N + i]), x[2 * N])
+}
+
 /// A small system with a control law: the right-hand side the integrator steps.
 pub struct SmallControlled<S, const N: usize, const M: usize> {
     system: Whole<S, N, M>,
@@ -309,9 +315,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
 
     #[inline(always)]
     fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
-        let q: [f64; N] = std::array::from_fn(|i| x[i]);
-        let v: [f64; N] = std::array::from_fn(|i| x[N + i]);
-        let e = x[2 * N];
+        let (q, v, e) = split(x);
         self.evaluations += 1;
         let d = &mut self.d;
         d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
@@ -348,19 +352,13 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         self.d.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
     }
     fn measure(&mut self, x: &[f64], t: f64) -> Measures {
-        let q: [f64; N] = std::array::from_fn(|i| x[i]);
-        let v: [f64; N] = std::array::from_fn(|i| x[N + i]);
+        let (q, v, e) = split(x);
         let l = local(&self.system, q, v, [0.0; N], t);
         let (potential, grad) = energy_and_gradient(&self.system, q);
         let mut out =
-            Measures { psi: energy::kinetic(&self.d.mass, &v) + potential - self.e0 - x[2 * N], ..Measures::default() };
+            Measures { psi: energy::kinetic(&self.d.mass, &v) + potential - self.e0 - e, ..Measures::default() };
         for r in 0..M {
-            if l.phi[r].abs() > out.phi.abs() {
-                out.phi = l.phi[r];
-            }
-            out.phi_dot = out.phi_dot.max(l.phi_dot[r].abs());
-            let y: f64 = (0..N).map(|c| grad[c] * l.jac[r][c]).sum();
-            out.coupling = out.coupling.max(y.abs());
+            out.add_row(l.phi[r], l.phi_dot[r], (0..N).map(|c| grad[c] * l.jac[r][c]).sum());
         }
         out
     }
