@@ -85,8 +85,7 @@ impl Dynamics {
         if model.m() == 0 {
             return Ok(());
         }
-        self.schur.factor(&self.jac)?;
-        self.schur.solve(&mut self.lambda);
+        self.schur.factor_and_solve(&self.jac, &mut self.lambda)?;
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
         add_weighted_jt(model.pattern(), &self.jac, &self.lambda, w, -1.0, &mut self.acc);
         Ok(())
