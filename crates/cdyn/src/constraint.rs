@@ -36,8 +36,9 @@ pub(crate) trait ConstraintBlock: Send + Sync {
     fn rows(&self) -> usize;
     /// Coordinates read by each row (the same `K` for every row of the block).
     fn width(&self) -> usize;
-    /// Appends the coordinate index of every Jacobian entry, row by row.
-    fn columns(&self, out: &mut Vec<usize>);
+    /// Appends the coordinate index of every Jacobian entry, row by row
+    /// (the model checks they fit in `u32`).
+    fn columns(&self, out: &mut Vec<u32>);
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>);
     /// `Φ` only, in plain `f64`.
     fn values(&self, q: &[f64], t: f64, phi: &mut [f64]);
@@ -57,10 +58,10 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
         K
     }
 
-    fn columns(&self, out: &mut Vec<usize>) {
+    fn columns(&self, out: &mut Vec<u32>) {
         for (_, idx) in &self.items {
             for _ in 0..R {
-                out.extend_from_slice(idx);
+                out.extend(idx.iter().map(|&i| i as u32));
             }
         }
     }

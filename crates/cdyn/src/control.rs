@@ -155,7 +155,7 @@ impl Control {
                     };
                     let s = 2.0 * zeta * phi;
                     for (j, &c) in jac.iter().zip(cols) {
-                        u_q[c] -= s * j;
+                        u_q[c as usize] -= s * j;
                     }
                 }
             }

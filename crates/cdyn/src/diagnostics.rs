@@ -67,7 +67,7 @@ impl Probe {
                 out.phi = self.phi[r];
             }
             out.phi_dot = out.phi_dot.max(self.phi_dot[r].abs());
-            let y: f64 = pattern.row(r).map(|j| self.grad[pattern.cols[j]] * self.jac[j]).sum();
+            let y: f64 = pattern.row(r).map(|j| self.grad[pattern.cols[j] as usize] * self.jac[j]).sum();
             out.coupling = out.coupling.max(y.abs());
         }
         out

@@ -50,7 +50,7 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
     let mut by_col: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
     for r in 0..m {
         for j in pattern.row(r) {
-            by_col[pattern.cols[j]].push((r, j));
+            by_col[pattern.cols[j] as usize].push((r, j));
         }
     }
     let mut out = Vec::new();
@@ -304,8 +304,8 @@ mod tests {
         }
         let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
         for r in rows {
-            pattern.cols.extend(r);
-            pattern.start.push(pattern.cols.len());
+            pattern.cols.extend(r.iter().map(|&c| c as u32));
+            pattern.start.push(pattern.cols.len() as u32);
         }
         (pattern, 2 + 2 * arms * len)
     }
@@ -329,8 +329,8 @@ mod tests {
         let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
         for r in 0..edges.len() {
             let (a, b) = edges[(r * stride) % edges.len()];
-            pattern.cols.extend([a, a + 1, b, b + 1]);
-            pattern.start.push(pattern.cols.len());
+            pattern.cols.extend([a, a + 1, b, b + 1].map(|c| c as u32));
+            pattern.start.push(pattern.cols.len() as u32);
         }
         (pattern, 2 * w * w)
     }
@@ -345,12 +345,13 @@ mod tests {
         let mut jt_x = vec![0.0; inv_mass.len()];
         for r in 0..m {
             for j in pattern.row(r) {
-                jt_x[pattern.cols[j]] += jac[j] * x[r] * inv_mass[pattern.cols[j]];
+                let c = pattern.cols[j] as usize;
+                jt_x[c] += jac[j] * x[r] * inv_mass[c];
             }
         }
         let mut worst = 0.0_f64;
         for r in 0..m {
-            let s_x: f64 = pattern.row(r).map(|j| jac[j] * jt_x[pattern.cols[j]]).sum();
+            let s_x: f64 = pattern.row(r).map(|j| jac[j] * jt_x[pattern.cols[j] as usize]).sum();
             worst = worst.max((s_x - b[r]).abs());
         }
         worst / b.iter().fold(0.0_f64, |a, b| a.max(b.abs()))
@@ -399,9 +400,9 @@ mod tests {
         let (mut pattern, n) = star(3, 4);
         // Repeat the last row.
         let last = pattern.row(pattern.start.len() - 2);
-        let repeated: Vec<usize> = pattern.cols[last.clone()].to_vec();
+        let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
         pattern.cols.extend(&repeated);
-        pattern.start.push(pattern.cols.len());
+        pattern.start.push(pattern.cols.len() as u32);
         let mut jac = values(pattern.nnz(), 0.7);
         let k = repeated.len();
         let tail = jac.len() - k;
