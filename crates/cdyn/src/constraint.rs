@@ -67,16 +67,28 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
     }
 
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
-        for (e, (c, idx)) in self.items.iter().enumerate() {
+        // Per element: its rows of every output, as fixed-size chunks (no
+        // bounds checks inside the loop).
+        let rows = out
+            .rhs
+            .chunks_exact_mut(R)
+            .zip(out.phi.chunks_exact_mut(R))
+            .zip(out.phi_dot.chunks_exact_mut(R))
+            .zip(out.phi_t.chunks_exact_mut(R))
+            .zip(out.gamma.chunks_exact_mut(R))
+            .zip(out.jac.chunks_exact_mut(R * K));
+        for ((c, idx), (((((rhs, phi), phi_dot), phi_t), gamma), jac)) in self.items.iter().zip(rows) {
             let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
+            let xv: [f64; K] = std::array::from_fn(|j| v[idx[j]]);
+            let xa: [f64; K] = std::array::from_fn(|j| out.free_acc[idx[j]]);
             // Second directional derivative of s ↦ Φ(q + s v, t + s): Φ̈ at zero
             // acceleration, which is −γ.
-            let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], v[idx[j]], 0.0));
+            let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], xv[j], 0.0));
             let along = c.eval(path, Dual2_64::new(t, 1.0, 0.0));
             for r in 0..R {
-                out.phi[e * R + r] = along[r].re;
-                out.phi_dot[e * R + r] = along[r].v1;
-                out.gamma[e * R + r] = -along[r].v2;
+                phi[r] = along[r].re;
+                phi_dot[r] = along[r].v1;
+                gamma[r] = -along[r].v2;
             }
             // One scalar dual pass per coordinate: for the few coordinates an
             // element reads this is about ten times cheaper than one pass of a
@@ -85,14 +97,14 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
             for j in 0..K {
                 let rows = c.eval(seeded(&x, j), Dual64::from(t));
                 for r in 0..R {
-                    out.jac[(e * R + r) * K + j] = rows[r].eps;
-                    jv[r] += rows[r].eps * v[idx[j]];
-                    ja[r] += rows[r].eps * out.free_acc[idx[j]];
+                    jac[r * K + j] = rows[r].eps;
+                    jv[r] += rows[r].eps * xv[j];
+                    ja[r] += rows[r].eps * xa[j];
                 }
             }
             for r in 0..R {
-                out.phi_t[e * R + r] = along[r].v1 - jv[r];
-                out.rhs[e * R + r] = ja[r] + along[r].v2;
+                phi_t[r] = along[r].v1 - jv[r];
+                rhs[r] = ja[r] + along[r].v2;
             }
         }
     }
