@@ -234,6 +234,9 @@ impl Schur {
             && self.inv_d.len() == m
             && self.work.len() == m;
         assert!(ok, "inconsistent structure of S");
+        // A row reads each coordinate once, so its diagonal products are squares.
+        let squares = self.terms[..self.sum_ptr[m] as usize].iter().all(|&(a, b, _)| a == b);
+        assert!(squares, "a constraint row reads a coordinate twice");
     }
 
     /// Assembles `S` from the Jacobian values, factors it and solves
@@ -269,8 +272,21 @@ impl Schur {
                 terms.iter().map(|&(a, b, w)| jac.get_unchecked(a as usize) * jac.get_unchecked(b as usize) * w).sum()
             }
         };
+        // A diagonal entry's products are squares (`ja = jb`): one index read, not two.
+        let diagonal = |slot: usize| -> f64 {
+            unsafe {
+                let terms = terms.get_unchecked(span_unchecked(sum_ptr, slot));
+                terms
+                    .iter()
+                    .map(|&(a, _, w)| {
+                        let x = *jac.get_unchecked(a as usize);
+                        x * x * w
+                    })
+                    .sum()
+            }
+        };
         for j in 0..m {
-            let s_jj = entry(j);
+            let s_jj = diagonal(j);
             let own = unsafe { span_unchecked(col_ptr, j) };
             for p in own.clone() {
                 unsafe { *work.get_unchecked_mut(*row_idx.get_unchecked(p) as usize) = entry(m + p) };
