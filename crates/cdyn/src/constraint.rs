@@ -36,8 +36,9 @@ pub(crate) trait ConstraintBlock: Send + Sync {
     fn rows(&self) -> usize;
     /// Coordinates read by each row (the same `K` for every row of the block).
     fn width(&self) -> usize;
-    /// Appends the coordinate index of every Jacobian entry, row by row.
-    fn columns(&self, out: &mut Vec<usize>);
+    /// Appends the coordinate index of every Jacobian entry, row by row
+    /// (the model checks they fit in `u32`).
+    fn columns(&self, out: &mut Vec<u32>);
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>);
     /// `Φ` only, in plain `f64`.
     fn values(&self, q: &[f64], t: f64, phi: &mut [f64]);
@@ -57,27 +58,34 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
         K
     }
 
-    fn columns(&self, out: &mut Vec<usize>) {
+    fn columns(&self, out: &mut Vec<u32>) {
         for (_, idx) in &self.items {
             for _ in 0..R {
-                out.extend_from_slice(idx);
+                out.extend(idx.iter().map(|&i| i as u32));
             }
         }
     }
 
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
-        for (e, (c, idx)) in self.items.iter().enumerate() {
+        // Per element: its rows of every output, as fixed-size chunks (no
+        // bounds checks inside the loop).
+        let rows = out
+            .rhs
+            .chunks_exact_mut(R)
+            .zip(out.phi.chunks_exact_mut(R))
+            .zip(out.phi_dot.chunks_exact_mut(R))
+            .zip(out.phi_t.chunks_exact_mut(R))
+            .zip(out.gamma.chunks_exact_mut(R))
+            .zip(out.jac.chunks_exact_mut(R * K));
+        for ((c, idx), (((((rhs, phi), phi_dot), phi_t), gamma), jac)) in self.items.iter().zip(rows) {
             let gather = |s: &[f64]| std::array::from_fn(|j| s[idx[j]]);
             let l = local(c, gather(q), gather(v), gather(out.free_acc), t);
-            for r in 0..R {
-                let row = e * R + r;
-                out.phi[row] = l.phi[r];
-                out.phi_dot[row] = l.phi_dot[r];
-                out.phi_t[row] = l.phi_t[r];
-                out.gamma[row] = l.gamma[r];
-                out.rhs[row] = l.rhs[r];
-                out.jac[row * K..(row + 1) * K].copy_from_slice(&l.jac[r]);
-            }
+            rhs.copy_from_slice(&l.rhs);
+            phi.copy_from_slice(&l.phi);
+            phi_dot.copy_from_slice(&l.phi_dot);
+            phi_t.copy_from_slice(&l.phi_t);
+            gamma.copy_from_slice(&l.gamma);
+            jac.copy_from_slice(l.jac.as_flattened());
         }
     }
 

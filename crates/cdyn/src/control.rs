@@ -98,7 +98,7 @@ pub(crate) trait Evaluation {
     /// The uncontrolled acceleration `A`.
     fn acc(&self) -> &[f64];
     /// Row `r` of `Φ_q`: its entries and their coordinates.
-    fn row(&self, r: usize) -> (&[f64], &[usize]);
+    fn row(&self, r: usize) -> (&[f64], &[u32]);
     /// For a change `b` of the constraint right-hand side, adds the change
     /// of acceleration `−M⁻¹ Φ_qᵀ S⁻¹ b` to `out`; `b` is overwritten.
     fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]);
@@ -175,7 +175,7 @@ impl Control {
                     let (jac, cols) = d.row(r);
                     let s = 2.0 * gain.zeta(jac.iter().map(|j| j * j).sum()) * phi;
                     for (j, &c) in jac.iter().zip(cols) {
-                        u_q[c] -= s * j;
+                        u_q[c as usize] -= s * j;
                     }
                 }
             }

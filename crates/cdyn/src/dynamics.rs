@@ -85,8 +85,7 @@ impl Dynamics {
         if model.m() == 0 {
             return Ok(());
         }
-        self.schur.factor(&self.jac)?;
-        self.schur.solve(&mut self.lambda);
+        self.schur.factor_and_solve(&self.jac, &mut self.lambda)?;
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
         add_weighted_jt(model.pattern(), &self.jac, &self.lambda, w, -1.0, &mut self.acc);
         Ok(())
@@ -105,7 +104,7 @@ impl Dynamics {
 /// `out = Φ_q x`
 pub fn jac_mul(pattern: &Pattern, jac: &[f64], x: &[f64], out: &mut [f64]) {
     for (r, o) in out.iter_mut().enumerate() {
-        *o = pattern.row(r).map(|j| jac[j] * x[pattern.cols[j]]).sum();
+        *o = pattern.row(r).map(|j| jac[j] * x[pattern.cols[j] as usize]).sum();
     }
 }
 
@@ -114,7 +113,7 @@ pub fn add_weighted_jt(pattern: &Pattern, jac: &[f64], y: &[f64], weight: &[f64]
     for (r, &yr) in y.iter().enumerate() {
         let s = scale * yr;
         for j in pattern.row(r) {
-            let c = pattern.cols[j];
+            let c = pattern.cols[j] as usize;
             out[c] += s * weight[c] * jac[j];
         }
     }

@@ -165,11 +165,11 @@ struct SmallDynamics<const N: usize, const M: usize> {
 
 impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     /// The coordinates of a row of `Φ_q`: all of them.
-    const COLUMNS: [usize; N] = {
+    const COLUMNS: [u32; N] = {
         let mut all = [0; N];
         let mut i = 0;
         while i < N {
-            all[i] = i;
+            all[i] = i as u32;
             i += 1;
         }
         all
@@ -292,7 +292,7 @@ impl<const N: usize, const M: usize> Evaluation for SmallDynamics<N, M> {
     fn acc(&self) -> &[f64] {
         &self.acc
     }
-    fn row(&self, r: usize) -> (&[f64], &[usize]) {
+    fn row(&self, r: usize) -> (&[f64], &[u32]) {
         (&self.jac[r], &Self::COLUMNS)
     }
     fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {

@@ -168,7 +168,7 @@ impl Evaluation for Evaluated<'_> {
     fn acc(&self) -> &[f64] {
         &self.dynamics.acc
     }
-    fn row(&self, r: usize) -> (&[f64], &[usize]) {
+    fn row(&self, r: usize) -> (&[f64], &[u32]) {
         let (pattern, range) = (self.model.pattern(), self.model.pattern().row(r));
         (&self.dynamics.jac[range.clone()], &pattern.cols[range])
     }

@@ -61,7 +61,7 @@ proptest! {
             let (p, m) = (phi(&model, &shifted(&q, &e, h), t), phi(&model, &shifted(&q, &e, -h), t));
             for r in 0..model.m() {
                 let fd = (p[r] - m[r]) / (2.0 * h);
-                let ad = pattern.row(r).find(|&j| pattern.cols[j] == c).map_or(0.0, |j| d.jac[j]);
+                let ad = pattern.row(r).find(|&j| pattern.cols[j] as usize == c).map_or(0.0, |j| d.jac[j]);
                 prop_assert!(close(ad, fd, 1e-7), "Φ_q[{r},{c}]: AD {ad} vs FD {fd}");
             }
         }
