@@ -72,7 +72,7 @@ impl Probe {
         self.grad.fill(0.0);
         let potential = model.potential(q, Some(&mut self.grad));
         let pattern = model.pattern();
-        let mut out = Measures { psi: energy::psi(model, v, potential, e, e0), ..Measures::default() };
+        let mut out = Measures { psi: energy::psi(model.mass(), v, potential, e, e0), ..Measures::default() };
         for r in 0..model.m() {
             let y: f64 = pattern.row(r).map(|j| self.grad[pattern.cols[j] as usize] * self.jac[j]).sum();
             out.add_row(self.phi[r], self.phi_dot[r], y);

@@ -8,11 +8,11 @@
 //! mistaken for an energy input.
 
 use crate::dynamics::Dynamics;
-use crate::model::Model;
 
-/// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e`, with `V` taken from the dynamics.
-pub fn psi(model: &Model, v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
-    kinetic(model.mass(), v) + potential - e0 - e
+/// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e` for the diagonal `mass`, with `V` evaluated elsewhere.
+#[inline(always)]
+pub fn psi(mass: &[f64], v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
+    kinetic(mass, v) + potential - e0 - e
 }
 
 /// Kinetic energy `½ vᵀ M v` for the diagonal `mass`.
@@ -23,7 +23,13 @@ pub fn kinetic(mass: &[f64], v: &[f64]) -> f64 {
 
 /// `Ė = F·v + λᵀ Φ_t`, from an evaluated [`Dynamics`].
 pub fn energy_input(d: &Dynamics) -> f64 {
-    d.force_power + d.lambda.iter().zip(&d.phi_t).map(|(l, p)| l * p).sum::<f64>()
+    power(d.force_power, &d.lambda, &d.phi_t)
+}
+
+/// `Ė = F·v + λᵀ Φ_t` from its parts.
+#[inline(always)]
+pub fn power(force_power: f64, lambda: &[f64], phi_t: &[f64]) -> f64 {
+    force_power + lambda.iter().zip(phi_t).map(|(l, p)| l * p).sum::<f64>()
 }
 
 /// `|Ψ_v|² = |M v|²` for the diagonal `mass`.

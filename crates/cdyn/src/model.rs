@@ -119,9 +119,6 @@ impl ModelBuilder {
         if self.mass.is_empty() {
             return Err(Error::InvalidModel("a model needs at least one coordinate".into()));
         }
-        for &m in &self.mass {
-            crate::error::positive("mass", m)?;
-        }
         let n = self.mass.len();
         let nnz: usize = self.constraints.iter().map(|b| b.rows() * b.width()).sum();
         if u32::try_from(n.max(nnz)).is_err() {
@@ -139,13 +136,7 @@ impl ModelBuilder {
                 pattern.start.push(last + b.width() as u32);
             }
         }
-        let m = pattern.start.len() - 1;
-        // m = n is allowed: a fully driven (kinematic) mechanism.
-        if m > n {
-            return Err(Error::InvalidModel(format!(
-                "{m} constraints on {n} coordinates: more constraints than coordinates"
-            )));
-        }
+        check_sizes(&self.mass, pattern.start.len() - 1)?;
         Ok(Model {
             inv_mass: self.mass.iter().map(|m| 1.0 / m).collect(),
             mass: self.mass,
@@ -156,6 +147,21 @@ impl ModelBuilder {
             offsets,
         })
     }
+}
+
+/// Checks every mass is positive and there are no more constraint rows
+/// `m` than coordinates (`m = n` is allowed: a fully driven, kinematic mechanism).
+pub(crate) fn check_sizes(mass: &[f64], m: usize) -> Result<()> {
+    for &x in mass {
+        crate::error::positive("mass", x)?;
+    }
+    let n = mass.len();
+    if m > n {
+        return Err(Error::InvalidModel(format!(
+            "{m} constraints on {n} coordinates: more constraints than coordinates"
+        )));
+    }
+    Ok(())
 }
 
 impl Model {

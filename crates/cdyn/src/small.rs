@@ -15,11 +15,11 @@ use crate::constraint::{Constraint, local};
 use crate::control::{Control, Evaluation};
 use crate::diagnostics::Measures;
 use crate::energy;
-use crate::error::{Error, Result, positive};
+use crate::error::Result;
 use crate::force::{Force, Potential, energy_and_gradient};
 use crate::integrate::{Buffer, Rhs};
 use crate::linalg::{Breakdown, PIVOT_TOLERANCE};
-use crate::model::Model;
+use crate::model::{Model, check_sizes};
 use crate::scalar::Scalar;
 use crate::simulate::{Settings, Stepper, check_initial_state};
 use crate::system::{EvalError, System};
@@ -89,14 +89,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
         settings.validate()?;
         check_initial_state(N, &q0, &v0)?;
         let mass = system.mass();
-        for &m in &mass {
-            positive("mass", m)?;
-        }
-        if M > N {
-            return Err(Error::InvalidModel(format!(
-                "{M} constraints on {N} coordinates: more constraints than coordinates"
-            )));
-        }
+        check_sizes(&mass, M)?;
         let system = Whole(Arc::new(system));
         let e0 = energy::kinetic(&mass, &v0) + system.energy(q0);
         let controlled =
@@ -319,12 +312,12 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
         self.evaluations += 1;
         let d = &mut self.d;
         d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let e_dot = d.force_power + (0..M).map(|r| d.lambda[r] * d.phi_t[r]).sum::<f64>();
+        let e_dot = energy::power(d.force_power, &d.lambda, &d.phi_t);
         f[..N].copy_from_slice(&v);
         f[N..2 * N].copy_from_slice(&d.acc);
         f[2 * N] = e_dot;
         if let Some(u) = u {
-            let psi = energy::kinetic(&d.mass, &v) + d.potential - self.e0 - e;
+            let psi = energy::psi(&d.mass, &v, d.potential, e, self.e0);
             let (u_q, rest) = u.split_at_mut(N);
             let (u_v, u_e) = rest.split_at_mut(N);
             u_e[0] = 0.0;
@@ -355,8 +348,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         let (q, v, e) = split(x);
         let l = local(&self.system, q, v, [0.0; N], t);
         let (potential, grad) = energy_and_gradient(&self.system, q);
-        let mut out =
-            Measures { psi: energy::kinetic(&self.d.mass, &v) + potential - self.e0 - e, ..Measures::default() };
+        let mut out = Measures { psi: energy::psi(&self.d.mass, &v, potential, e, self.e0), ..Measures::default() };
         for r in 0..M {
             out.add_row(l.phi[r], l.phi_dot[r], (0..N).map(|c| grad[c] * l.jac[r][c]).sum());
         }

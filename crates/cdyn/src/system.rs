@@ -112,7 +112,7 @@ impl Rhs for ControlledSystem<'_> {
         f[n..2 * n].copy_from_slice(&self.dynamics.acc);
         f[2 * n] = e_dot;
         if let Some(u) = u {
-            let psi = energy::psi(self.model, v, self.dynamics.potential, e, self.e0);
+            let psi = energy::psi(self.model.mass(), v, self.dynamics.potential, e, self.e0);
             let (u_q, rest) = u.split_at_mut(n);
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;

@@ -7,7 +7,9 @@ use cdyn::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
 use cdyn::dynamics::LinearSolver;
 use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
 use cdyn::planar::{Coordinate, Element, Mechanism};
+use cdyn::simulate::Stepper;
 use cdyn::small::SmallSimulation;
+use cdyn::system::System as Controlled;
 use cdyn::timefn::TimeFn;
 use cdyn::{Scheme, Settings, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -90,22 +92,17 @@ fn controls() -> Vec<Control> {
 
 /// Allocations during `steps` steps (and samples) after `warm_up` steps.
 fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: usize) -> usize {
-    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
-    for _ in 0..warm_up {
-        sim.step().unwrap();
-    }
-    let before = count();
-    for _ in 0..steps {
-        sim.step().unwrap();
-        std::hint::black_box(sim.measure());
-    }
-    count() - before
+    allocations_stepping(Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap(), warm_up, steps)
 }
 
 /// As [`allocations_per_run`], for the Example 1 pendulum as a small system.
 fn small_allocations_per_run(settings: Settings, warm_up: usize, steps: usize) -> usize {
     let (system, q0, v0) = small_pendulum(PendulumParams::default()).unwrap();
-    let mut sim = SmallSimulation::new(system, settings, q0, v0).unwrap();
+    allocations_stepping(SmallSimulation::new(system, settings, q0, v0).unwrap(), warm_up, steps)
+}
+
+/// Allocations of any simulation during `steps` steps (and samples) after `warm_up` steps.
+fn allocations_stepping<S: Controlled>(mut sim: Stepper<S>, warm_up: usize, steps: usize) -> usize {
     for _ in 0..warm_up {
         sim.step().unwrap();
     }
