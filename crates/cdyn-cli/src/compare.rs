@@ -13,7 +13,7 @@ use std::path::Path;
 pub fn cases(scenario: &Scenario, path: &Path) -> Result<Vec<Case>> {
     let file = path.display().to_string();
     let base = scenario.case(path)?;
-    let gains = scenario.method.gains(&file, base.settings.h)?;
+    let gains = scenario.method.gains(base.settings.h).map_err(|e| anyhow::anyhow!("{file}: [method] {e}"))?;
     // A model without constraints has nothing for geometric control to do.
     let methods = if base.example.model.m() == 0 { independent_cases(&gains) } else { redundant_cases(&gains) };
     methods

@@ -6,9 +6,10 @@ use crate::mechanism_spec::{BodySpec, ElementSpec, MechanismSpec};
 use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
 use cdyn::assemble::assemble;
-use cdyn::methods::MethodGains;
+use cdyn::error::Part;
+use cdyn::methods::MethodKeys;
 use cdyn::models::{Example, PendulumParams, cartesian_pendulum, theta_pendulum};
-use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings};
+use cdyn::{Scheme, Settings};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -19,7 +20,7 @@ pub struct Scenario {
     #[serde(default)]
     pub initial: InitialSpec,
     #[serde(default)]
-    pub method: MethodSpec,
+    pub method: MethodKeys,
     pub integrator: IntegratorSpec,
     #[serde(default)]
     pub output: OutputSpec,
@@ -84,67 +85,10 @@ pub struct InitialSpec {
     pub tolerance: Option<f64>,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum GeometricKind {
-    #[default]
-    None,
-    Baumgarte,
-    Cvsgf,
-}
-
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum EnergyKind {
-    #[default]
-    None,
-    Gradient,
-    Baumgarte,
-}
-
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum Apply {
-    #[default]
-    Rhs,
-    ForwardEuler,
-    BackwardEuler,
-}
-
-#[derive(Debug, Deserialize, Default, Clone)]
-#[serde(deny_unknown_fields)]
-pub struct MethodSpec {
-    #[serde(default)]
-    pub geometric: GeometricKind,
-    #[serde(default)]
-    pub energy: EnergyKind,
-    #[serde(default)]
-    pub apply: Apply,
-    pub zeta: Option<f64>,
-    pub alpha_g: Option<f64>,
-    pub alpha: Option<f64>,
-    pub beta: Option<f64>,
-    pub omega: Option<f64>,
-    pub damping_ratio: Option<f64>,
-    pub alpha_e: Option<f64>,
-    pub rho_q: Option<f64>,
-    pub rho_v: Option<f64>,
-    pub eta: Option<f64>,
-}
-
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq)]
-#[serde(rename_all = "snake_case")]
-pub enum SchemeName {
-    Euler,
-    Ab2,
-    Ab3,
-    Rk4,
-}
-
 #[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
-    pub scheme: SchemeName,
+    pub scheme: Scheme,
     pub h: f64,
     pub t_end: f64,
 }
@@ -189,20 +133,14 @@ impl Scenario {
     /// The case this scenario describes; `path` names it in errors.
     pub fn case(&self, path: &Path) -> Result<Case> {
         let file = &path.display().to_string();
-        let control = self.method.control(file)?;
+        let control = self.method.control().map_err(|e| anyhow!("{file}: [method] {e}"))?;
         let i = &self.integrator;
         let h = check(file, "[integrator] h", i.h, true)?;
         let t_end = check(file, "[integrator] t_end", i.t_end, true)?;
         if t_end / h > 1e9 {
             bail!("{file}: [integrator] t_end / h = {:e} steps is more than 1e9", t_end / h);
         }
-        let scheme = match i.scheme {
-            SchemeName::Euler => Scheme::Euler,
-            SchemeName::Ab2 => Scheme::AdamsBashforth2,
-            SchemeName::Ab3 => Scheme::AdamsBashforth3,
-            SchemeName::Rk4 => Scheme::RungeKutta4,
-        };
-        let mut settings = Settings::new(scheme, h, control);
+        let mut settings = Settings::new(i.scheme, h, control);
         let init = &self.initial;
         if let Some(tol) = init.tolerance {
             settings.consistency_tolerance = Some(check(file, "[initial] tolerance", tol, true)?);
@@ -344,8 +282,7 @@ impl Scenario {
                     forces: &self.forces,
                 };
                 let (mechanism, entries) = spec.build(file)?;
-                let built =
-                    mechanism.build().map_err(|e| anyhow!("{file}: {}", name_entry(&e.to_string(), &entries)))?;
+                let built = mechanism.build().map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
                 Ok((Example::from_mechanism(built, None), rows))
             }
@@ -353,16 +290,15 @@ impl Scenario {
     }
 }
 
-/// Replaces the library's `element K (kind)` by the scenario's entry name.
-fn name_entry(message: &str, entries: &[String]) -> String {
-    for (k, entry) in entries.iter().enumerate().rev() {
-        let kind = entry.split_once(" (").map_or("", |(_, kind)| kind.trim_end_matches(')'));
-        let lib = format!("element {k} ({kind})");
-        if message.contains(&lib) {
-            return message.replace(&lib, entry);
+/// The library's error, naming the scenario's entry (`joints[2] (revolute)`)
+/// where it is about an element of the mechanism.
+fn name_entry(error: cdyn::Error, entries: &[String]) -> String {
+    match error {
+        cdyn::Error::InvalidModel { at: Part::Element { index, .. }, problem } if index < entries.len() => {
+            format!("{}: {problem}", entries[index])
         }
+        other => other.to_string(),
     }
-    message.to_string()
 }
 
 /// The entry behind the worst-violated constraint row, if known.
@@ -372,113 +308,4 @@ fn worst_entry(example: &Example, rows: &[String]) -> String {
     model.constraint_values(&example.q0, 0.0, &mut phi);
     let worst = (0..phi.len()).max_by(|&a, &b| phi[a].abs().total_cmp(&phi[b].abs()));
     worst.and_then(|r| rows.get(r)).map_or(String::new(), |e| format!(" (worst: {e})"))
-}
-
-impl MethodSpec {
-    /// The CVSGF gain given, if any: `zeta` (fixed) or `alpha_g` (rate).
-    fn cvsgf_gain(&self, file: &str) -> Result<Option<Gain>> {
-        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
-        Ok(match (self.zeta, self.alpha_g) {
-            (Some(_), Some(_)) => bail!("{file}: [method] give one of zeta, alpha_g, not both"),
-            (Some(z), None) => Some(Gain::Fixed(num("zeta", z)?)),
-            (None, Some(a)) => Some(Gain::Rate(num("alpha_g", a)?)),
-            (None, None) => None,
-        })
-    }
-
-    /// The gradient energy gains given, if any: `alpha_e`, or `rho_v` (and `rho_q`).
-    fn energy_gain(&self, file: &str) -> Result<Option<EnergyGain>> {
-        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
-        Ok(match (self.alpha_e, self.rho_q, self.rho_v) {
-            (Some(a), None, None) => Some(EnergyGain::Rate { alpha_e: num("alpha_e", a)? }),
-            (None, q, Some(v)) => {
-                Some(EnergyGain::Fixed { rho_q: num("rho_q", q.unwrap_or(0.0))?, rho_v: num("rho_v", v)? })
-            }
-            (None, None, None) => None,
-            _ => bail!("{file}: [method] gradient energy control takes alpha_e, or rho_v (and rho_q, default 0)"),
-        })
-    }
-
-    /// Baumgarte's `(α, β)` given, if any: `alpha` and `beta`, or `omega` (and `damping_ratio`).
-    fn baumgarte_gains(&self, file: &str) -> Result<Option<(f64, f64)>> {
-        let num = |key: &str, v: f64| check(file, &format!("[method] {key}"), v, false);
-        Ok(match (self.alpha, self.beta, self.omega, self.damping_ratio) {
-            (Some(a), Some(b), None, None) => Some((num("alpha", a)?, num("beta", b)?)),
-            (None, None, Some(w), ratio) => {
-                let w = check(file, "[method] omega", w, true)?;
-                match Geometric::baumgarte_from(w, num("damping_ratio", ratio.unwrap_or(1.0))?)? {
-                    Geometric::Baumgarte { alpha, beta } => Some((alpha, beta)),
-                    _ => unreachable!("baumgarte_from makes Baumgarte gains"),
-                }
-            }
-            (None, None, None, None) => None,
-            _ => bail!("{file}: [method] Baumgarte takes alpha and beta, or omega (and damping_ratio, default 1)"),
-        })
-    }
-
-    /// Gains for `cdyn compare`: those the scenario gives, else target
-    /// rates `α_g = α_e = 0.2/h` (half the paper's `hα = 0.4`: coupled
-    /// constraints raise the effective rate of CVSGF above `α_g`) and Baumgarte
-    /// `β = 0.2/h`, critically damped.
-    pub fn gains(&self, file: &str, h: f64) -> Result<MethodGains> {
-        let rate = 0.2 / h;
-        let (alpha, beta) = self.baumgarte_gains(file)?.unwrap_or((2.0 * rate.sqrt(), rate));
-        Ok(MethodGains {
-            cvsgf: self.cvsgf_gain(file)?.unwrap_or(Gain::Rate(rate)),
-            energy: self.energy_gain(file)?.unwrap_or(EnergyGain::Rate { alpha_e: rate }),
-            baumgarte_alpha: alpha,
-            baumgarte_beta: beta,
-        })
-    }
-
-    /// The control law, refusing gains that the chosen methods do not use.
-    fn control(&self, file: &str) -> Result<Control> {
-        let used = |key: &str, value: Option<f64>, by: bool, method: &str| -> Result<()> {
-            if value.is_some() && !by {
-                bail!("{file}: [method] {key} is only used with {method}");
-            }
-            Ok(())
-        };
-        let g = self.geometric;
-        used("zeta", self.zeta, g == GeometricKind::Cvsgf, "geometric = \"cvsgf\"")?;
-        used("alpha_g", self.alpha_g, g == GeometricKind::Cvsgf, "geometric = \"cvsgf\"")?;
-        for (key, value) in
-            [("alpha", self.alpha), ("beta", self.beta), ("omega", self.omega), ("damping_ratio", self.damping_ratio)]
-        {
-            used(key, value, g == GeometricKind::Baumgarte, "geometric = \"baumgarte\"")?;
-        }
-        let e = self.energy;
-        for (key, value) in [("alpha_e", self.alpha_e), ("rho_q", self.rho_q), ("rho_v", self.rho_v)] {
-            used(key, value, e == EnergyKind::Gradient, "energy = \"gradient\"")?;
-        }
-        used("eta", self.eta, e == EnergyKind::Baumgarte, "energy = \"baumgarte\"")?;
-        let geometric = match g {
-            GeometricKind::None => Geometric::None,
-            GeometricKind::Cvsgf => match self.cvsgf_gain(file)? {
-                Some(gain) => Geometric::Gradient(gain),
-                None => bail!("{file}: [method] geometric = \"cvsgf\" needs one of zeta, alpha_g"),
-            },
-            GeometricKind::Baumgarte => match self.baumgarte_gains(file)? {
-                Some((alpha, beta)) => Geometric::Baumgarte { alpha, beta },
-                None => bail!("{file}: [method] geometric = \"baumgarte\" needs alpha and beta, or omega"),
-            },
-        };
-        let energy = match e {
-            EnergyKind::None => Energy::None,
-            EnergyKind::Baumgarte => match self.eta {
-                Some(eta) => Energy::Baumgarte { eta: check(file, "[method] eta", eta, false)? },
-                None => bail!("{file}: [method] energy = \"baumgarte\" needs eta"),
-            },
-            EnergyKind::Gradient => match self.energy_gain(file)? {
-                Some(gain) => Energy::Gradient(gain),
-                None => bail!("{file}: [method] energy = \"gradient\" needs alpha_e, or rho_v (and rho_q)"),
-            },
-        };
-        let application = match self.apply {
-            Apply::Rhs => Application::InRhs,
-            Apply::ForwardEuler => Application::ForwardEuler,
-            Apply::BackwardEuler => Application::BackwardEuler,
-        };
-        Ok(Control { geometric, energy, application })
-    }
 }

@@ -8,7 +8,7 @@
 //! the dynamics already need.
 
 use crate::dynamics::{Breakdown, Dynamics};
-use crate::error::{Error, Result};
+use crate::error::{Part, Problem, Result};
 use crate::model::Model;
 
 /// What the assembly changed.
@@ -38,11 +38,9 @@ pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: 
     let mut out = Assembly::default();
     let mut correction = vec![0.0; model.n()];
     let mut rhs = vec![0.0; model.m()];
-    let singular = |b: Breakdown, iterations: usize| match b {
-        Breakdown::Singular(row) => Error::InvalidModel(format!(
-            "assembly: the constraints are singular at the given positions (row {row}, iteration {iterations})"
-        )),
-        Breakdown::NonFinite => Error::InvalidModel("assembly: the positions are not finite".into()),
+    let singular = |b: Breakdown, iteration: usize| match b {
+        Breakdown::Singular(row) => Problem::SingularAssembly { row, iteration }.at(Part::Assembly),
+        Breakdown::NonFinite => Problem::NonFinitePositions.at(Part::Assembly),
     };
     loop {
         d.evaluate(model, q, v, t).map_err(|b| singular(b, out.newton_iterations))?;
@@ -56,10 +54,7 @@ pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: 
             break;
         }
         if out.newton_iterations == MAX_ITERATIONS || !phi.is_finite() {
-            return Err(Error::InvalidModel(format!(
-                "assembly did not converge: max |Φ| = {phi:.3e} after {} Newton iterations",
-                out.newton_iterations
-            )));
+            return Err(Problem::NoConvergence { phi, iterations: out.newton_iterations }.at(Part::Assembly));
         }
         rhs.copy_from_slice(&d.phi);
         correction.fill(0.0);

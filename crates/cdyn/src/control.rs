@@ -41,10 +41,16 @@ impl Geometric {
     /// Baumgarte gains from a natural frequency `ω` and damping ratio:
     /// `α = 2 ratio ω`, `β = ω²`. Critical damping is ratio 1.
     pub fn baumgarte_from(omega: f64, damping_ratio: f64) -> Result<Self> {
-        let omega = positive("omega", omega)?;
-        let ratio = non_negative("damping_ratio", damping_ratio)?;
-        Ok(Geometric::Baumgarte { alpha: 2.0 * ratio * omega, beta: omega * omega })
+        let (alpha, beta) = baumgarte_gains(omega, damping_ratio)?;
+        Ok(Geometric::Baumgarte { alpha, beta })
     }
+}
+
+/// Baumgarte's `(α, β)` from a natural frequency and damping ratio.
+pub(crate) fn baumgarte_gains(omega: f64, damping_ratio: f64) -> Result<(f64, f64)> {
+    let omega = positive("omega", omega)?;
+    let ratio = non_negative("damping_ratio", damping_ratio)?;
+    Ok((2.0 * ratio * omega, omega * omega))
 }
 
 /// Gains of the gradient energy control.
@@ -67,11 +73,15 @@ pub enum Energy {
     Gradient(EnergyGain),
 }
 
-/// Where the control term is integrated (Eqs. 54–59).
+/// Where the control term is integrated (Eqs. 54–59). Scenario files write
+/// `rhs`, `forward_euler` or `backward_euler`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Application {
     /// `U` is part of the right-hand side the scheme integrates.
     #[default]
+    #[cfg_attr(feature = "serde", serde(rename = "rhs"))]
     InRhs,
     /// The scheme integrates `f`; `U(x_k)` is added with one forward Euler step (Eq. 58).
     ForwardEuler,

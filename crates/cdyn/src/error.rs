@@ -1,5 +1,6 @@
 //! The library's one error type. Every variant says where (step, time,
-//! constraint row) and what, so a caller can print a one-line message.
+//! constraint row, the part of a model) and what, as data, so a caller can
+//! print a one-line message or name the entry of its own input at fault.
 
 use thiserror::Error;
 
@@ -8,32 +9,291 @@ use thiserror::Error;
 pub enum Error {
     /// A setting or parameter outside its domain.
     #[error("invalid {name} = {value}: {reason}")]
-    InvalidParameter { name: &'static str, value: f64, reason: &'static str },
+    InvalidParameter {
+        /// The parameter's name as the caller wrote it (`h`, `rod_length`).
+        name: &'static str,
+        /// The refused value.
+        value: f64,
+        /// Why it was refused, e.g. "must be finite and positive".
+        reason: &'static str,
+    },
     /// A model that cannot be simulated as described.
-    #[error("invalid model: {0}")]
-    InvalidModel(String),
+    #[error("invalid model: {at}{problem}")]
+    InvalidModel {
+        /// The part of the model at fault.
+        at: Part,
+        /// What is wrong with it.
+        problem: Problem,
+    },
     /// The initial state is off the constraints by more than the tolerance.
     #[error(
         "initial state violates the constraints: max |Φ| = {phi:.3e}, max |Φ̇| = {phi_dot:.3e} (tolerance {tolerance:.1e})"
     )]
-    InconsistentInitialState { phi: f64, phi_dot: f64, tolerance: f64 },
+    InconsistentInitialState {
+        /// Largest constraint violation.
+        phi: f64,
+        /// Largest velocity-constraint violation.
+        phi_dot: f64,
+        /// The tolerance it exceeds.
+        tolerance: f64,
+    },
     /// `Φ_q M⁻¹ Φ_qᵀ` is singular: the constraints are redundant or degenerate here.
     #[error(
         "singular constraint matrix at step {step}, t = {t}: constraint row {row} is linearly dependent on the others"
     )]
-    SingularConstraints { step: u64, t: f64, row: usize },
+    SingularConstraints {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+        /// The dependent constraint row.
+        row: usize,
+    },
     /// The state stopped being finite.
     #[error("simulation diverged at step {step}, t = {t}: the state is no longer finite")]
-    Diverged { step: u64, t: f64 },
+    Diverged {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+    },
     /// The constraint violation grew past the configured limit.
     #[error("simulation diverged at step {step}, t = {t}: max |Φ| = {phi:.3e} exceeds the limit {limit:.1e}")]
-    ViolationLimit { step: u64, t: f64, phi: f64, limit: f64 },
+    ViolationLimit {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+        /// The violation reached.
+        phi: f64,
+        /// The configured limit.
+        limit: f64,
+    },
+    /// Method keys that do not describe one method.
+    #[error("{0}")]
+    Method(#[from] crate::methods::KeyProblem),
+    /// The pendulum's energy lies within a relative 1e-10 of the upright
+    /// energy: the period diverges and the elliptic closed form of the
+    /// reference solution degenerates.
+    #[error("pendulum energy lies on the separatrix (just reaches the top); no elliptic closed form")]
+    Separatrix,
 }
 
+/// The part of a model an [`Error::InvalidModel`] is about.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum Part {
+    /// The model as a whole.
+    #[default]
+    Model,
+    /// A body of a mechanism, by position (from 0) and name.
+    Body {
+        /// Position in the mechanism's body list.
+        index: usize,
+        /// The body's name.
+        name: String,
+    },
+    /// A joint, drive or force of a mechanism, by position (from 0) in the
+    /// mechanism's element list and kind (`revolute`).
+    Element {
+        /// Position in the mechanism's element list.
+        index: usize,
+        /// The element's kind, as in scenario files.
+        kind: &'static str,
+    },
+    /// One block of constraint rows, potentials or forces added to a model builder.
+    Block {
+        /// What the block is: "a constraint", "a potential", "a force".
+        what: &'static str,
+    },
+    /// The initial positions and velocities.
+    InitialState,
+    /// Projecting the initial state onto the constraints.
+    Assembly,
+    /// One axis (`x` or `y`) of a moving support's prescribed motion.
+    Support(&'static str),
+}
+
+impl std::fmt::Display for Part {
+    /// The part followed by ": ", or nothing for the whole model.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Part::Model => Ok(()),
+            Part::Body { index, name } => write!(f, "body {index} ({name}): "),
+            Part::Element { index, kind } => write!(f, "element {index} ({kind}): "),
+            Part::Block { what } => write!(f, "{what}: "),
+            Part::InitialState => write!(f, "initial state: "),
+            Part::Assembly => write!(f, "assembly: "),
+            Part::Support(axis) => write!(f, "support {axis}(t): "),
+        }
+    }
+}
+
+/// What is wrong with a part of a model.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum Problem {
+    /// A number outside its domain.
+    #[error("{name} = {value} {reason}")]
+    Parameter {
+        /// The parameter's name.
+        name: &'static str,
+        /// The refused value.
+        value: f64,
+        /// Why, e.g. "must be finite and positive".
+        reason: &'static str,
+    },
+    /// A time function with a non-finite coefficient.
+    #[error("time function has a non-finite coefficient")]
+    NonFiniteFunction,
+    /// A model without coordinates.
+    #[error("a model needs at least one coordinate")]
+    NoCoordinates,
+    /// More coordinates or Jacobian entries than 32-bit indices can hold.
+    #[error("{n} coordinates and {nnz} Jacobian entries: at most 2³² − 1 of each are supported")]
+    TooLarge {
+        /// Coordinates.
+        n: usize,
+        /// Jacobian entries.
+        nnz: usize,
+    },
+    /// More constraint rows than coordinates.
+    #[error("{m} constraints on {n} coordinates: more constraints than coordinates")]
+    TooManyConstraints {
+        /// Constraint rows.
+        m: usize,
+        /// Coordinates.
+        n: usize,
+    },
+    /// An element reads a coordinate the model does not have.
+    #[error("reads coordinate {index}, but the model has only {n}")]
+    NoSuchCoordinate {
+        /// The coordinate read.
+        index: usize,
+        /// Coordinates of the model.
+        n: usize,
+    },
+    /// An element reads one coordinate twice.
+    #[error("reads coordinate {index} twice")]
+    CoordinateTwice {
+        /// The coordinate read twice.
+        index: usize,
+    },
+    /// An element refers to a body that does not exist.
+    #[error("body {index} does not exist")]
+    NoSuchBody {
+        /// The missing body's position.
+        index: usize,
+    },
+    /// An element connects a body to itself.
+    #[error("connects {body} to itself")]
+    SameBody {
+        /// The body's name (or `ground`).
+        body: String,
+    },
+    /// An element needs a body's angle, but the body is a point mass.
+    #[error("body {body} is a point mass and has no angle")]
+    NoAngle {
+        /// The point mass's name.
+        body: String,
+    },
+    /// An element is attached off the only point of a point mass.
+    #[error("body {body} is a point mass: its only point is [0, 0]")]
+    PointMassOffset {
+        /// The point mass's name.
+        body: String,
+    },
+    /// A drive, force or torque on the ground, which does not move.
+    #[error("the ground cannot be {0}")]
+    OnGround(&'static str),
+    /// A point mass given an angle or angular velocity.
+    #[error("a point mass (no inertia) has no angle or angular_velocity")]
+    PointMassRotation,
+    /// Initial positions or velocities of the wrong length.
+    #[error("{positions} positions and {velocities} velocities, the model has {n} coordinates")]
+    StateLength {
+        /// Positions given.
+        positions: usize,
+        /// Velocities given.
+        velocities: usize,
+        /// Coordinates of the model.
+        n: usize,
+    },
+    /// A non-finite initial position or velocity.
+    #[error("component {index} is {value}")]
+    NonFiniteState {
+        /// Index into positions followed by velocities.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// The constraints are singular where the state is to be projected.
+    #[error("the constraints are singular at the given positions (row {row}, iteration {iteration})")]
+    SingularAssembly {
+        /// The dependent row.
+        row: usize,
+        /// The Newton iteration.
+        iteration: usize,
+    },
+    /// A four-bar whose crank cannot turn through a full circle (Grashof).
+    #[error(
+        "four-bar a = {}, b = {}, c = {}, d = {}: the crank cannot turn fully (needs |b − c| < d − a and d + a < b + c)",
+        lengths[0], lengths[1], lengths[2], lengths[3]
+    )]
+    NoFullTurn {
+        /// Crank, coupler, rocker and ground lengths.
+        lengths: [f64; 4],
+    },
+    /// Positions that are not finite.
+    #[error("the positions are not finite")]
+    NonFinitePositions,
+    /// The projection onto the constraints did not converge.
+    #[error("did not converge: max |Φ| = {phi:.3e} after {iterations} Newton iterations")]
+    NoConvergence {
+        /// The violation left.
+        phi: f64,
+        /// Newton iterations taken.
+        iterations: usize,
+    },
+}
+
+impl Error {
+    /// The same error, said of `part`: a refused parameter becomes an
+    /// [`Error::InvalidModel`] at `part`; an invalid model error of the whole
+    /// model is moved to `part`; other errors are kept.
+    pub fn at(self, part: Part) -> Error {
+        match self {
+            Error::InvalidParameter { name, value, reason } => {
+                Error::InvalidModel { at: part, problem: Problem::Parameter { name, value, reason } }
+            }
+            Error::InvalidModel { at: Part::Model, problem } => Error::InvalidModel { at: part, problem },
+            other => other,
+        }
+    }
+}
+
+impl Problem {
+    /// This problem, said of `part`.
+    pub fn at(self, part: Part) -> Error {
+        Error::InvalidModel { at: part, problem: self }
+    }
+}
+
+impl From<Problem> for Error {
+    /// A problem of the whole model.
+    fn from(problem: Problem) -> Self {
+        Error::InvalidModel { at: Part::Model, problem }
+    }
+}
+
+/// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
+/// Checks that `value` is finite; names it otherwise.
+pub fn finite(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() { Ok(value) } else { Err(Error::InvalidParameter { name, value, reason: "must be finite" }) }
+}
+
 /// Checks that `value` is finite and positive; names it otherwise.
-pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
+pub fn positive(name: &'static str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
@@ -42,7 +302,7 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
 }
 
 /// Checks that `value` is finite and not negative; names it otherwise.
-pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64> {
+pub fn non_negative(name: &'static str, value: f64) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {

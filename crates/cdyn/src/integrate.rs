@@ -7,8 +7,11 @@
 
 use crate::control::Application;
 
-/// A fixed-step scheme.
+/// A fixed-step scheme. In scenario files it is written by its
+/// [`SchemeInfo::name`]: `euler`, `ab2`, `ab3`, `rk4`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "String", into = "&'static str"))]
 pub enum Scheme {
     Euler,
     AdamsBashforth2,
@@ -86,6 +89,24 @@ impl Scheme {
     /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`).
     pub fn from_name(name: &str) -> Option<Scheme> {
         Scheme::ALL.into_iter().find(|s| s.info().name == name)
+    }
+}
+
+impl TryFrom<String> for Scheme {
+    type Error = String;
+
+    /// The scheme of this name, or a message listing the names.
+    fn try_from(name: String) -> std::result::Result<Self, String> {
+        Scheme::from_name(&name).ok_or_else(|| {
+            let names: Vec<&str> = Scheme::ALL.iter().map(|s| s.info().name).collect();
+            format!("unknown scheme `{name}`; expected one of {}", names.join(", "))
+        })
+    }
+}
+
+impl From<Scheme> for &'static str {
+    fn from(scheme: Scheme) -> Self {
+        scheme.info().name
     }
 }
 

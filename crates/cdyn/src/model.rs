@@ -7,7 +7,7 @@
 //! `Φ_q M⁻¹ Φ_qᵀ` inherits the sparsity of the constraints.
 
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
-use crate::error::{Error, Result};
+use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
 
 /// Sparsity of `Φ_q`: row `r` has entries at `cols[start[r]..start[r + 1]]`.
@@ -52,19 +52,18 @@ pub struct ModelBuilder {
 }
 
 impl ModelBuilder {
-    fn check_indices<const K: usize>(&mut self, what: &str, at: &[usize; K]) -> bool {
+    fn check_indices<const K: usize>(&mut self, what: &'static str, at: &[usize; K]) -> bool {
         if self.error.is_some() {
             return false;
         }
         let n = self.mass.len();
         for (j, &i) in at.iter().enumerate() {
             if i >= n {
-                self.error =
-                    Some(Error::InvalidModel(format!("{what} reads coordinate {i}, but the model has only {n}")));
+                self.error = Some(Problem::NoSuchCoordinate { index: i, n }.at(Part::Block { what }));
                 return false;
             }
             if at[..j].contains(&i) {
-                self.error = Some(Error::InvalidModel(format!("{what} reads coordinate {i} twice")));
+                self.error = Some(Problem::CoordinateTwice { index: i }.at(Part::Block { what }));
                 return false;
             }
         }
@@ -117,14 +116,12 @@ impl ModelBuilder {
             return Err(e);
         }
         if self.mass.is_empty() {
-            return Err(Error::InvalidModel("a model needs at least one coordinate".into()));
+            return Err(Problem::NoCoordinates.into());
         }
         let n = self.mass.len();
         let nnz: usize = self.constraints.iter().map(|b| b.rows() * b.width()).sum();
         if u32::try_from(n.max(nnz)).is_err() {
-            return Err(Error::InvalidModel(format!(
-                "{n} coordinates and {nnz} Jacobian entries: at most 2³² − 1 of each are supported"
-            )));
+            return Err(Problem::TooLarge { n, nnz }.into());
         }
         let mut pattern = Pattern { start: vec![0], cols: Vec::with_capacity(nnz) };
         let mut offsets = Vec::with_capacity(self.constraints.len());
@@ -157,9 +154,7 @@ pub(crate) fn check_sizes(mass: &[f64], m: usize) -> Result<()> {
     }
     let n = mass.len();
     if m > n {
-        return Err(Error::InvalidModel(format!(
-            "{m} constraints on {n} coordinates: more constraints than coordinates"
-        )));
+        return Err(Problem::TooManyConstraints { m, n }.into());
     }
     Ok(())
 }

@@ -7,7 +7,7 @@
 //! mass. Joints, springs and dampers are written once, generic over the
 //! scalar, on the coordinates of the one or two bodies they connect.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Part, Problem, Result, finite, non_negative, positive};
 use crate::model::{Model, ModelBuilder};
 use crate::scalar::Scalar;
 use crate::timefn::TimeFn;
@@ -142,24 +142,29 @@ impl Mechanism {
         }
     }
 
+    /// A body's name for messages: its own, `ground`, or its position if it does not exist.
+    fn name(&self, id: BodyId) -> String {
+        match id {
+            BodyId::Ground => "ground".into(),
+            BodyId::Body(i) => self.bodies.get(i).map_or_else(|| format!("body {i}"), |b| b.name.clone()),
+        }
+    }
+
     /// The model, its initial state and coordinate names. Errors name the
     /// body or element (by position, from 0) at fault.
     pub fn build(&self) -> Result<Built> {
         if !self.gravity.iter().all(|g| g.is_finite()) {
-            return Err(Error::InvalidModel(format!("gravity {:?} must be finite", self.gravity)));
+            let value = self.gravity.into_iter().find(|g| !g.is_finite()).unwrap_or(f64::NAN);
+            return Err(Error::InvalidParameter { name: "gravity", value, reason: "must be finite" });
         }
         let mut mass = Vec::new();
         let (mut q0, mut v0, mut names, mut offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (i, b) in self.bodies.iter().enumerate() {
-            let bad = |what: &str, x: f64| {
-                Error::InvalidModel(format!("body {i} ({}): {what} = {x} must be finite and positive", b.name))
-            };
-            if !(b.mass.is_finite() && b.mass > 0.0) {
-                return Err(bad("mass", b.mass));
-            }
+            let at = || Part::Body { index: i, name: b.name.clone() };
+            positive("mass", b.mass).map_err(|e| e.at(at()))?;
             let state = b.position.iter().chain(&b.velocity).chain([&b.angle, &b.angular_velocity]);
-            if let Some(x) = state.clone().find(|x| !x.is_finite()) {
-                return Err(Error::InvalidModel(format!("body {i} ({}): initial state contains {x}", b.name)));
+            if let Some((index, &value)) = state.enumerate().find(|(_, x)| !x.is_finite()) {
+                return Err(Problem::NonFiniteState { index, value }.at(at()));
             }
             offsets.push(mass.len());
             mass.extend([b.mass, b.mass]);
@@ -167,9 +172,7 @@ impl Mechanism {
             v0.extend(b.velocity);
             names.extend([format!("{}.x", b.name), format!("{}.y", b.name)]);
             if let Some(inertia) = b.inertia {
-                if !(inertia.is_finite() && inertia > 0.0) {
-                    return Err(bad("inertia", inertia));
-                }
+                positive("inertia", inertia).map_err(|e| e.at(at()))?;
                 mass.push(inertia);
                 q0.push(b.angle);
                 v0.push(b.angular_velocity);
@@ -187,21 +190,21 @@ impl Mechanism {
         for (k, e) in self.elements.iter().enumerate() {
             builder = self
                 .add_element(builder, e, &offsets)
-                .map_err(|why| Error::InvalidModel(format!("element {k} ({}): {why}", e.kind())))?;
+                .map_err(|why| why.at(Part::Element { index: k, kind: e.kind() }))?;
             row_elements.resize(builder.rows(), k);
         }
         Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements })
     }
 
     /// Where a body's coordinates are and what it is, for one end of an element.
-    fn attach(&self, id: BodyId, point: [f64; 2], offsets: &[usize], idx: &mut Vec<usize>) -> Result<End, String> {
-        if !point.iter().all(|p| p.is_finite()) {
-            return Err(format!("point {point:?} must be finite"));
+    fn attach(&self, id: BodyId, point: [f64; 2], offsets: &[usize], idx: &mut Vec<usize>) -> Result<End> {
+        for p in point {
+            finite("point", p)?;
         }
         match id {
             BodyId::Ground => Ok(End::Ground { point }),
             BodyId::Body(i) => {
-                let b = self.bodies.get(i).ok_or_else(|| format!("body {i} does not exist"))?;
+                let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
                 let at = idx.len();
                 let first = offsets[i];
                 match b.inertia {
@@ -213,20 +216,20 @@ impl Mechanism {
                         idx.extend([first, first + 1]);
                         Ok(End::Point { at })
                     }
-                    None => Err(format!("body {} is a point mass: its only point is [0, 0]", b.name)),
+                    None => Err(Problem::PointMassOffset { body: b.name.clone() }.into()),
                 }
             }
         }
     }
 
     /// The angle coordinate of a body, for elements on relative angles.
-    fn attach_angle(&self, id: BodyId, offsets: &[usize], idx: &mut Vec<usize>) -> Result<Option<usize>, String> {
+    fn attach_angle(&self, id: BodyId, offsets: &[usize], idx: &mut Vec<usize>) -> Result<Option<usize>> {
         match id {
             BodyId::Ground => Ok(None),
             BodyId::Body(i) => {
-                let b = self.bodies.get(i).ok_or_else(|| format!("body {i} does not exist"))?;
+                let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
                 if b.inertia.is_none() {
-                    return Err(format!("body {} is a point mass and has no angle", b.name));
+                    return Err(Problem::NoAngle { body: b.name.clone() }.into());
                 }
                 idx.push(offsets[i] + 2);
                 Ok(Some(idx.len() - 1))
@@ -234,20 +237,12 @@ impl Mechanism {
         }
     }
 
-    fn add_element(&self, builder: ModelBuilder, e: &Element, offsets: &[usize]) -> Result<ModelBuilder, String> {
+    fn add_element(&self, builder: ModelBuilder, e: &Element, offsets: &[usize]) -> Result<ModelBuilder> {
         let mut idx = Vec::new();
         let same = |a: &BodyId, b: &BodyId| {
-            if a == b { Err(format!("connects {a:?} to itself")) } else { Ok(()) }
+            if a == b { Err(Problem::SameBody { body: self.name(*a) }) } else { Ok(()) }
         };
-        let positive = |name: &str, x: f64| {
-            if x.is_finite() && x > 0.0 { Ok(x) } else { Err(format!("{name} = {x} must be finite and positive")) }
-        };
-        let non_negative = |name: &str, x: f64| {
-            if x.is_finite() && x >= 0.0 { Ok(x) } else { Err(format!("{name} = {x} must be finite and not negative")) }
-        };
-        let finite_fn = |f: &TimeFn| {
-            if f.is_finite() { Ok(()) } else { Err("time function has a non-finite coefficient".to_string()) }
-        };
+        let finite_fn = |f: &TimeFn| if f.is_finite() { Ok(()) } else { Err(Problem::NonFiniteFunction) };
         Ok(match e {
             Element::Revolute { a, pa, b, pb } => {
                 same(a, b)?;
@@ -290,9 +285,7 @@ impl Mechanism {
             }
             Element::FixedAngle { a, b, angle } => {
                 same(a, b)?;
-                if !angle.is_finite() {
-                    return Err(format!("angle = {angle} must be finite"));
-                }
+                finite("angle", *angle)?;
                 self.relative_angle(builder, *a, *b, TimeFn::constant(*angle), offsets)?
             }
             Element::DriveAngle { a, b, f } => {
@@ -303,15 +296,15 @@ impl Mechanism {
             Element::DriveCoordinate { body, coordinate, f } => {
                 finite_fn(f)?;
                 let BodyId::Body(i) = *body else {
-                    return Err("the ground cannot be driven".into());
+                    return Err(Problem::OnGround("driven").into());
                 };
-                let b = self.bodies.get(i).ok_or_else(|| format!("body {i} does not exist"))?;
+                let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
                 let k = match coordinate {
                     Coordinate::X => 0,
                     Coordinate::Y => 1,
                     Coordinate::Angle if b.inertia.is_some() => 2,
                     Coordinate::Angle => {
-                        return Err(format!("body {} is a point mass and has no angle", b.name));
+                        return Err(Problem::NoAngle { body: b.name.clone() }.into());
                     }
                 };
                 builder.constrain(Prescribed { f: f.clone() }, [offsets[i] + k])
@@ -325,9 +318,7 @@ impl Mechanism {
             Element::TorsionSpring { a, b, stiffness, rest_angle } => {
                 same(a, b)?;
                 let k = non_negative("stiffness", *stiffness)?;
-                if !rest_angle.is_finite() {
-                    return Err(format!("rest_angle = {rest_angle} must be finite"));
-                }
+                finite("rest_angle", *rest_angle)?;
                 let (ia, ib) = (self.attach_angle(*a, offsets, &mut idx)?, self.attach_angle(*b, offsets, &mut idx)?);
                 with_k!(idx, K, builder.potential(Torsion::<K> { a: ia, b: ib, k, rest: *rest_angle }, idx_array(&idx)))
             }
@@ -347,7 +338,7 @@ impl Mechanism {
                 finite_fn(fx)?;
                 finite_fn(fy)?;
                 if *body == BodyId::Ground {
-                    return Err("a force on the ground does nothing".into());
+                    return Err(Problem::OnGround("pushed by a force").into());
                 }
                 let end = self.attach(*body, *point, offsets, &mut idx)?;
                 with_k!(idx, K, builder.force(PointLoad::<K> { end, fx: fx.clone(), fy: fy.clone() }, idx_array(&idx)))
@@ -355,7 +346,7 @@ impl Mechanism {
             Element::AppliedTorque { body, f } => {
                 finite_fn(f)?;
                 if *body == BodyId::Ground {
-                    return Err("a torque on the ground does nothing".into());
+                    return Err(Problem::OnGround("turned by a torque").into());
                 }
                 self.attach_angle(*body, offsets, &mut idx)?;
                 builder.force(Torque { f: f.clone() }, [idx[0]])
@@ -370,7 +361,7 @@ impl Mechanism {
         b: BodyId,
         f: TimeFn,
         offsets: &[usize],
-    ) -> Result<ModelBuilder, String> {
+    ) -> Result<ModelBuilder> {
         let mut idx = Vec::new();
         let (ia, ib) = (self.attach_angle(a, offsets, &mut idx)?, self.attach_angle(b, offsets, &mut idx)?);
         Ok(with_k!(idx, K, builder.constrain(RelativeAngle::<K> { a: ia, b: ib, f }, idx_array(&idx))))
@@ -431,7 +422,7 @@ macro_rules! with_k {
                 const $k: usize = 6;
                 $body
             }
-            n => return Err(format!("reads {n} coordinates; between 1 and 6 are supported")),
+            n => unreachable!("an element reads at most two bodies, 6 coordinates, not {n}"),
         }
     };
 }

@@ -17,8 +17,8 @@
 //! with FMA error-free products) rather than as √(1 − k²): near the separatrix
 //! K ≈ ln(4/k'), so a cancelled k' would cost many digits.
 
+use crate::error::{Error, Result, finite, positive};
 use std::f64::consts::FRAC_PI_2;
-use std::fmt;
 
 /// Half-width of the band |ε − 1| (ε = ½ψ'² − cos ψ, top energy 1) that is
 /// rejected as the separatrix, where the period diverges.
@@ -216,41 +216,6 @@ pub mod elliptic {
     }
 }
 
-/// Why [`PendulumExact::new`] refused its input.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ReferenceError {
-    /// The energy is within a relative 1e-10 of the upright energy: the period
-    /// diverges and the elliptic closed form degenerates.
-    Separatrix,
-    /// A parameter is non-finite or out of range.
-    InvalidParameter {
-        /// Argument name of [`PendulumExact::new`].
-        name: &'static str,
-        /// The rejected value.
-        value: f64,
-    },
-}
-
-impl fmt::Display for ReferenceError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Separatrix => {
-                write!(f, "pendulum energy lies on the separatrix (just reaches the top); no elliptic closed form")
-            }
-            Self::InvalidParameter { name, value } => {
-                let why = match *name {
-                    "w2" => "must be finite and positive",
-                    "omega0" => "must be finite, with omega0/sqrt(w2) representable",
-                    _ => "must be finite",
-                };
-                write!(f, "invalid parameter {name} = {value}: {why}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for ReferenceError {}
-
 /// D = ψ'(0)²/4 − cos²(ψr/2) = (ε − 1)/2 and √|D|, given h = |ψ'(0)|/2 and
 /// c = cos(ψr/2) ≥ 0.
 ///
@@ -298,24 +263,18 @@ pub struct PendulumExact {
 impl PendulumExact {
     /// w2 = g/L
     ///
-    /// Fails with [`ReferenceError::InvalidParameter`] for non-finite input,
+    /// Fails with [`Error::InvalidParameter`] for non-finite input,
     /// w2 ≤ 0 or an overflowing omega0/√w2, and with
-    /// [`ReferenceError::Separatrix`] when |ε − 1| ≤ 1e-10.
-    pub fn new(w2: f64, theta0: f64, omega0: f64) -> Result<Self, ReferenceError> {
-        let invalid = |name, value| Err(ReferenceError::InvalidParameter { name, value });
-        if !(w2.is_finite() && w2 > 0.0) {
-            return invalid("w2", w2);
-        }
-        if !theta0.is_finite() {
-            return invalid("theta0", theta0);
-        }
-        if !omega0.is_finite() {
-            return invalid("omega0", omega0);
-        }
+    /// [`Error::Separatrix`] when |ε − 1| ≤ 1e-10.
+    pub fn new(w2: f64, theta0: f64, omega0: f64) -> Result<Self> {
+        positive("w2", w2)?;
+        finite("theta0", theta0)?;
+        finite("omega0", omega0)?;
         let w = w2.sqrt();
         let dpsi = omega0 / w; // ψ'(0) in scaled time τ = w t
         if !dpsi.is_finite() {
-            return invalid("omega0", omega0);
+            let reason = "must be finite, with omega0/sqrt(w2) representable";
+            return Err(Error::InvalidParameter { name: "omega0", value: omega0, reason });
         }
 
         let (s, c) = (0.5 * (theta0 + FRAC_PI_2)).sin_cos();
@@ -325,7 +284,7 @@ impl PendulumExact {
         let h = 0.5 * dpsi.abs();
         let (d, root_d) = separatrix_gap(w2, omega0, h, c);
         if (2.0 * d).abs() <= SEPARATRIX_TOL {
-            return Err(ReferenceError::Separatrix);
+            return Err(Error::Separatrix);
         }
 
         let (modulus, regime, u0) = if d < 0.0 {
@@ -762,7 +721,7 @@ mod tests {
 
     #[test]
     fn errors() {
-        let sep = Err(ReferenceError::Separatrix);
+        let sep = Err(Error::Separatrix);
         assert_eq!(PendulumExact::new(1.0, -FRAC_PI_2, 2.0).map(|_| ()), sep);
         assert_eq!(PendulumExact::new(1.0, -FRAC_PI_2, -2.0).map(|_| ()), sep);
         assert_eq!(PendulumExact::new(1.0, FRAC_PI_2, 0.0).map(|_| ()), sep);
@@ -778,13 +737,13 @@ mod tests {
             (1e-300, 0.0, 1e300, "omega0"),
         ] {
             match PendulumExact::new(w2, th, om) {
-                Err(ReferenceError::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+                Err(Error::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
                 other => panic!("expected InvalidParameter({name}), got {other:?}"),
             }
         }
-        let msg = ReferenceError::InvalidParameter { name: "w2", value: -1.0 }.to_string();
+        let msg = PendulumExact::new(-1.0, 0.0, 1.0).err().unwrap().to_string();
         assert!(msg.contains("w2") && !msg.contains('\n'));
-        assert!(!ReferenceError::Separatrix.to_string().contains('\n'));
+        assert!(!Error::Separatrix.to_string().contains('\n'));
     }
 
     #[test]

@@ -7,7 +7,7 @@
 use crate::control::Control;
 use crate::diagnostics::Measures;
 use crate::dynamics::LinearSolver;
-use crate::error::{Error, Result, positive};
+use crate::error::{Error, Part, Problem, Result, positive};
 use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
 use crate::system::{ControlledSystem, EvalError, System};
@@ -86,14 +86,11 @@ impl<'m> Simulation<'m> {
 /// Checks an initial state has `n` finite positions and velocities.
 pub(crate) fn check_initial_state(n: usize, q0: &[f64], v0: &[f64]) -> Result<()> {
     if q0.len() != n || v0.len() != n {
-        return Err(Error::InvalidModel(format!(
-            "initial state has {} positions and {} velocities, the model has {n} coordinates",
-            q0.len(),
-            v0.len()
-        )));
+        let (positions, velocities) = (q0.len(), v0.len());
+        return Err(Problem::StateLength { positions, velocities, n }.at(Part::InitialState));
     }
     if let Some((i, &x)) = q0.iter().chain(v0).enumerate().find(|(_, x)| !x.is_finite()) {
-        return Err(Error::InvalidModel(format!("initial state component {i} is {x}")));
+        return Err(Problem::NonFiniteState { index: i, value: x }.at(Part::InitialState));
     }
     Ok(())
 }

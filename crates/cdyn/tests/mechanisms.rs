@@ -747,5 +747,5 @@ fn bad_parameters_are_refused() {
         support_x: TimeFn { polynomial: vec![0.0, f64::NAN], sines: Vec::new() },
         ..Default::default()
     });
-    assert!(matches!(shaky, Err(Error::InvalidModel(_))));
+    assert!(matches!(shaky, Err(Error::InvalidModel { .. })));
 }

@@ -29,7 +29,7 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use super::{Example, Observe, Reference};
-use crate::error::{Error, Result, non_negative, positive};
+use crate::error::{Error, Part, Problem, Result, non_negative, positive};
 use crate::planar::{Body, BodyId, Coordinate, Element, Mechanism};
 use crate::reference::PendulumExact;
 use crate::timefn::TimeFn;
@@ -648,10 +648,7 @@ impl FourBarParams {
         let c = positive("rocker_length", self.rocker_length)?;
         let d = positive("ground_length", self.ground_length)?;
         if (b - c).abs() >= d - a || d + a >= b + c {
-            return Err(Error::InvalidModel(format!(
-                "four-bar a = {a}, b = {b}, c = {c}, d = {d}: the crank cannot turn fully \
-                 (needs |b − c| < d − a and d + a < b + c)"
-            )));
+            return Err(Problem::NoFullTurn { lengths: [a, b, c, d] }.into());
         }
         positive("crank_mass", self.crank_mass)?;
         positive("crank_inertia", self.crank_inertia)?;
@@ -865,7 +862,7 @@ impl MovingSupportParams {
         finite("omega0", self.omega0)?;
         for (axis, f) in [("x", &self.support_x), ("y", &self.support_y)] {
             if !f.is_finite() {
-                return Err(Error::InvalidModel(format!("support {axis}(t) has a non-finite coefficient")));
+                return Err(Problem::NonFiniteFunction.at(Part::Support(axis)));
             }
         }
         Ok(())
