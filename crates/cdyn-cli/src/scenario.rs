@@ -109,14 +109,67 @@ pub fn load(path: &Path) -> Result<Scenario> {
     if text.trim().is_empty() {
         bail!("{file}: the scenario is empty");
     }
-    toml::from_str(&text).map_err(|e| {
+    let table: toml::Table = toml::from_str(&text).map_err(|e| {
         let at = e.span().map_or(String::new(), |s| {
             let line = text[..s.start].matches('\n').count() + 1;
             let col = s.start - text[..s.start].rfind('\n').map_or(0, |i| i + 1) + 1;
             format!(":{line}:{col}")
         });
         anyhow!("{file}{at}: {}", e.message().trim().replace('\n', " "))
+    })?;
+    // The library's types check every key; the path to a refused one names
+    // the table, entry and key as the file writes them.
+    serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
+        let place = locate(&table, e.path());
+        let why = e.inner().message().trim().replace('\n', " ").replace('`', "");
+        anyhow!("{file}: {place}{why}")
     })
+}
+
+/// Where a deserialization error is, as the file writes it: the table
+/// (`[model.parameters] `), the entry (`joints[2] (revolute): `) and the key
+/// with its value (`n = 2.5: `).
+fn locate(table: &toml::Table, path: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    let (mut tables, mut entry, mut key) = (Vec::new(), String::new(), None);
+    let mut value = Some(toml::Value::Table(table.clone()));
+    for segment in path.iter() {
+        let here = value.take();
+        match segment {
+            Segment::Map { key: k } => {
+                value = here.as_ref().and_then(|v| v.get(k)).cloned();
+                match &value {
+                    Some(toml::Value::Table(_)) if entry.is_empty() => tables.push(k.clone()),
+                    Some(toml::Value::Array(_)) if entry.is_empty() => entry.clone_from(k),
+                    _ => key = Some(k.clone()),
+                }
+            }
+            Segment::Seq { index } => {
+                value = here.as_ref().and_then(|v| v.get(*index)).cloned();
+                let kind = value.as_ref().and_then(|v| v.get("kind")).and_then(|k| k.as_str());
+                entry = match kind {
+                    Some(kind) => format!("{entry}[{index}] ({kind})"),
+                    None => format!("{entry}[{index}]"),
+                };
+            }
+            Segment::Enum { .. } | Segment::Unknown => value = here,
+        }
+    }
+    let mut out = String::new();
+    if !tables.is_empty() {
+        out = format!("[{}] ", tables.join("."));
+    }
+    if !entry.is_empty() {
+        out += &format!("{entry}: ");
+    }
+    match (key, value) {
+        (Some(k), Some(v)) if !v.is_table() && !v.is_array() || v.as_array().is_some_and(|a| a.len() <= 4) => {
+            out += &format!("{k} = {v}: ")
+        }
+        (Some(k), _) => out += &format!("{k}: "),
+        _ => {}
+    }
+    out
 }
 
 /// Checks one number: finite and positive, or finite and not negative.
