@@ -35,7 +35,7 @@ pub fn write_figure(dir: &Path, stem: &str, title: &str, quantity: Quantity, cas
             let y = match quantity {
                 Quantity::Phi => &s.phi,
                 Quantity::Psi => &s.psi,
-                Quantity::Err => &s.err,
+                Quantity::Err => &s.error,
             };
             let points: Vec<(f64, f64)> = s.t.iter().copied().zip(y.iter().copied()).collect();
             (points.iter().any(|p| p.1 != 0.0)).then(|| plot::Series { label: c.name.clone(), points })
@@ -60,7 +60,7 @@ pub const RUN_FIGURES: Stems = ["phi", "psi", "err"];
 pub fn write_figures(dir: &Path, title: &str, cases: &[CaseResult], stems: Stems) -> Result<()> {
     write_figure(dir, stems[0], &format!("{title}: geometric constraint violation"), Quantity::Phi, cases)?;
     write_figure(dir, stems[1], &format!("{title}: energy constraint violation"), Quantity::Psi, cases)?;
-    if let Some(c) = cases.iter().find(|c| !c.series.err.is_empty()) {
+    if let Some(c) = cases.iter().find(|c| !c.series.error.is_empty()) {
         write_figure(dir, stems[2], &format!("{title}: error in {}", c.error_observable), Quantity::Err, cases)?;
     }
     Ok(())

@@ -1,9 +1,10 @@
-//! Runs one case and records it: a CSV row per sample, written as the run
-//! goes so that a run which fails keeps what it wrote, plus the series and
-//! statistics the summary and figures need.
+//! Runs one case and records it with the library's [`Recorder`]: a CSV row
+//! per sample, written as the run goes so that a run which fails keeps what
+//! it wrote, plus the series and statistics the summary and figures need.
 
 use anyhow::{Context, Result};
 use cdyn::models::Example;
+use cdyn::record::{Record, Recorder, Sample, Series, Sink};
 use cdyn::{Settings, Simulation};
 use serde::Serialize;
 use std::fs::File;
@@ -29,7 +30,7 @@ impl Case {
     }
 }
 
-/// What a case produced.
+/// What a case produced, as `summary.json` reports it.
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
     pub name: String,
@@ -50,29 +51,70 @@ pub struct CaseResult {
     pub v_end: Vec<f64>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
+    /// Sampled time histories, for the figures (empty for sweeps).
     #[serde(skip)]
     pub series: Series,
 }
 
-/// Sampled time histories, for the figures.
-#[derive(Debug, Clone, Default)]
-pub struct Series {
-    pub t: Vec<f64>,
-    pub phi: Vec<f64>,
-    pub psi: Vec<f64>,
-    pub err: Vec<f64>,
+impl CaseResult {
+    /// The summary of `case` from its record.
+    fn new(case: &Case, record: Record) -> Self {
+        CaseResult {
+            name: case.name.clone(),
+            error_observable: case.example.observables[0].clone(),
+            scheme: case.settings.scheme.info().name,
+            h: case.settings.h,
+            max_abs_phi: record.max_abs_phi,
+            max_abs_psi: record.max_abs_psi,
+            max_abs_err_x: record.max_abs_error,
+            err_x_final: record.final_error,
+            max_abs_coupling: record.max_abs_coupling,
+            steps: record.steps,
+            t_final: record.t_final,
+            rhs_evals: record.evaluations,
+            q_end: record.q_end,
+            v_end: record.v_end,
+            error: record.error.map(|e| format!("case {}: {e}", case.name)),
+            series: record.series.unwrap_or_default(),
+        }
+    }
 }
 
-/// Header of a case's CSV: `t`, the observables, `phi`, `psi`, and
-/// `err_<first observable>` when there is a reference.
-fn header(example: &Example) -> String {
-    let mut cols = vec!["t".to_string()];
-    cols.extend(example.observables.iter().cloned());
-    cols.extend(["phi".into(), "psi".into()]);
-    if example.reference.is_some() {
-        cols.push(format!("err_{}", example.observables[0].to_lowercase()));
+/// Writes each sample as a CSV row: `t`, the observables, `phi`, `psi`,
+/// and the error when there is a reference.
+struct CsvRows<'w, W: Write> {
+    out: &'w mut W,
+}
+
+impl<'w, W: Write> CsvRows<'w, W> {
+    /// Writes the header row for `example` and returns the writer of the rows.
+    fn start(out: &'w mut W, example: &Example) -> std::io::Result<Self> {
+        write!(out, "t")?;
+        for name in &example.observables {
+            write!(out, ",{name}")?;
+        }
+        write!(out, ",phi,psi")?;
+        if example.reference.is_some() {
+            write!(out, ",err_{}", example.observables[0].to_lowercase())?;
+        }
+        writeln!(out)?;
+        Ok(CsvRows { out })
     }
-    cols.join(",")
+}
+
+impl<W: Write> Sink for CsvRows<'_, W> {
+    type Error = std::io::Error;
+    fn sample(&mut self, s: &Sample<'_>) -> std::io::Result<()> {
+        write!(self.out, "{:e}", s.t)?;
+        for o in s.observables {
+            write!(self.out, ",{o:e}")?;
+        }
+        write!(self.out, ",{:e},{:e}", s.measures.phi, s.measures.psi)?;
+        if let Some(e) = s.error {
+            write!(self.out, ",{e:e}")?;
+        }
+        writeln!(self.out)
+    }
 }
 
 /// Runs `case`, writing `dir/<name>.csv`. A simulation error is recorded in
@@ -81,79 +123,25 @@ pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     let path = dir.join(format!("{}.csv", case.name));
     let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut csv = BufWriter::new(file);
-    writeln!(csv, "{}", header(&case.example))?;
-    let result = simulate(case, &mut csv);
+    let record = CsvRows::start(&mut csv, &case.example)
+        .and_then(|rows| simulate(case, Recorder::example(&case.example).keep_series(true).sink(rows)));
     csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
-    result.map_err(|e| e.context(format!("cannot write {}", path.display())))
+    let record = record.with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(CaseResult::new(case, record))
 }
 
 /// Runs `case` keeping only its statistics (for sweeps).
 pub fn run_case_quietly(case: &Case) -> CaseResult {
-    simulate(case, &mut std::io::sink()).expect("writing to a sink cannot fail")
+    let Ok(record) = simulate(case, Recorder::example(&case.example));
+    CaseResult::new(case, record)
 }
 
-/// Runs `case`, writing CSV rows to `csv`; simulation errors are recorded in
-/// the result, write errors returned.
-fn simulate(case: &Case, csv: &mut impl Write) -> Result<CaseResult> {
+/// Runs `case` into `recorder`; an error of the simulation, also one
+/// starting it, is kept in the record, an error of the sink returned.
+fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<Record, K::Error> {
     let ex = &case.example;
-    let mut result = CaseResult {
-        name: case.name.clone(),
-        error_observable: ex.observables[0].clone(),
-        scheme: case.settings.scheme.info().name,
-        h: case.settings.h,
-        max_abs_phi: 0.0,
-        max_abs_psi: 0.0,
-        max_abs_err_x: ex.reference.as_ref().map(|_| 0.0),
-        err_x_final: None,
-        max_abs_coupling: 0.0,
-        steps: 0,
-        t_final: 0.0,
-        rhs_evals: 0,
-        q_end: Vec::new(),
-        v_end: Vec::new(),
-        error: None,
-        series: Series::default(),
-    };
-    let outcome =
-        Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0).map_err(anyhow::Error::from).and_then(|mut sim| {
-            let run = sim.run(case.t_end, case.every, |s| record(s, ex, csv, &mut result));
-            result.steps = sim.steps();
-            result.t_final = sim.t();
-            result.rhs_evals = sim.evaluations();
-            result.q_end = sim.q().to_vec();
-            result.v_end = sim.v().to_vec();
-            run
-        });
-    if let Err(e) = outcome {
-        if e.downcast_ref::<cdyn::Error>().is_none() {
-            return Err(e);
-        }
-        result.error = Some(format!("case {}: {e}", case.name));
+    match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
+        Ok(mut sim) => recorder.run(&mut sim, case.t_end, case.every),
+        Err(e) => Ok(recorder.abandon(e)),
     }
-    Ok(result)
-}
-
-fn record(sim: &mut Simulation, ex: &Example, csv: &mut impl Write, r: &mut CaseResult) -> Result<()> {
-    let m = sim.measure();
-    let (t, q, v) = (sim.t(), sim.q(), sim.v());
-    let err = ex.error(q, v, t);
-    write!(csv, "{t:e}")?;
-    for o in ex.observe(q, v) {
-        write!(csv, ",{o:e}")?;
-    }
-    write!(csv, ",{:e},{:e}", m.phi, m.psi)?;
-    if let Some(e) = err {
-        write!(csv, ",{e:e}")?;
-        r.max_abs_err_x = Some(r.max_abs_err_x.unwrap_or(0.0).max(e.abs()));
-        r.err_x_final = Some(e);
-        r.series.err.push(e);
-    }
-    writeln!(csv)?;
-    r.max_abs_phi = r.max_abs_phi.max(m.phi.abs());
-    r.max_abs_psi = r.max_abs_psi.max(m.psi.abs());
-    r.max_abs_coupling = r.max_abs_coupling.max(m.coupling);
-    r.series.t.push(t);
-    r.series.phi.push(m.phi);
-    r.series.psi.push(m.psi);
-    Ok(())
 }

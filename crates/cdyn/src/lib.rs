@@ -15,6 +15,7 @@ pub mod methods;
 pub mod model;
 pub mod models;
 pub mod planar;
+pub mod record;
 pub mod reference;
 pub mod scalar;
 pub mod simulate;

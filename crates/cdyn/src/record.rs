@@ -1,0 +1,280 @@
+//! Recording a run: the statistics a summary reports (largest violations
+//! and error, steps, evaluations, end state), optionally the sampled time
+//! series for figures, and each sample handed to a [`Sink`] (a CSV writer,
+//! say) as the run goes, so that a run which fails keeps what it recorded.
+//!
+//! A sample is taken at the start, after every `k`-th step and after the
+//! last step (see [`Stepper::run`]).
+//!
+//! ```
+//! use cdyn::models::{PendulumParams, cartesian_pendulum};
+//! use cdyn::record::{Recorder, Sample};
+//! use cdyn::{Control, Scheme, Settings, Simulation};
+//!
+//! let example = cartesian_pendulum(PendulumParams::default())?;
+//! let settings = Settings::new(Scheme::RungeKutta4, 0.01, Control::none());
+//! let mut sim = Simulation::new(&example.model, settings, &example.q0, &example.v0)?;
+//! let mut rows = Vec::new();
+//! let record = Recorder::example(&example)
+//!     .keep_series(true)
+//!     .sink(|s: &Sample<'_>| -> Result<(), std::convert::Infallible> {
+//!         rows.push((s.t, s.observables[0], s.measures.phi));
+//!         Ok(())
+//!     })
+//!     .run(&mut sim, 1.0, 10)?;
+//! assert!(record.error.is_none());
+//! assert_eq!(record.steps, 100);
+//! assert_eq!(rows.len(), 11); // t = 0, 0.1, …, 1
+//! assert!(record.max_abs_phi < 1e-6 && record.max_abs_error.unwrap() < 1e-6);
+//! assert_eq!(record.series.unwrap().t.len(), 11);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use crate::diagnostics::Measures;
+use crate::error::Error;
+use crate::models::Example;
+use crate::simulate::Stepper;
+use crate::system::System;
+use std::convert::Infallible;
+
+/// One sample of a run, as a [`Sink`] sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample<'a> {
+    /// Steps taken.
+    pub step: u64,
+    /// Time.
+    pub t: f64,
+    /// The observables: an [`Example`]'s named quantities, or the coordinates `q`.
+    pub observables: &'a [f64],
+    /// Violations `Φ`, `Φ̇`, `Ψ` and the coupling measure.
+    pub measures: Measures,
+    /// Error of the first observable against the reference, when there is one.
+    pub error: Option<f64>,
+}
+
+/// Where samples go as they are taken.
+///
+/// Any closure `FnMut(&Sample) -> Result<(), E>` is a sink; an error stops the run.
+pub trait Sink {
+    /// What taking in a sample can fail with (I/O, for a writer).
+    type Error;
+    /// Takes in one sample.
+    fn sample(&mut self, sample: &Sample<'_>) -> Result<(), Self::Error>;
+}
+
+impl<E, F: FnMut(&Sample<'_>) -> Result<(), E>> Sink for F {
+    type Error = E;
+    fn sample(&mut self, sample: &Sample<'_>) -> Result<(), E> {
+        self(sample)
+    }
+}
+
+/// A sink that drops every sample: only the statistics are kept.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoSink;
+
+impl Sink for NoSink {
+    type Error = Infallible;
+    fn sample(&mut self, _: &Sample<'_>) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// Sampled time histories, for figures: one entry per sample.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// Times.
+    pub t: Vec<f64>,
+    /// The constraint value of largest magnitude, with its sign.
+    pub phi: Vec<f64>,
+    /// The energy constraint `Ψ`.
+    pub psi: Vec<f64>,
+    /// Error of the first observable against the reference; empty without one.
+    pub error: Vec<f64>,
+}
+
+/// What a recorded run produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// Largest `|Φ|` over the samples.
+    pub max_abs_phi: f64,
+    /// Largest `|Ψ|` over the samples.
+    pub max_abs_psi: f64,
+    /// Largest coupling measure `max_i |Y_ci|` over the samples.
+    pub max_abs_coupling: f64,
+    /// Largest error of the first observable against the reference; `None` without one.
+    pub max_abs_error: Option<f64>,
+    /// That error at the last sample; `None` without a reference or a sample.
+    pub final_error: Option<f64>,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time reached.
+    pub t_final: f64,
+    /// Right-hand-side evaluations.
+    pub evaluations: u64,
+    /// Positions at the end (after a failure: where the run stopped).
+    pub q_end: Vec<f64>,
+    /// Velocities at the end.
+    pub v_end: Vec<f64>,
+    /// The sampled series, when asked for with [`Recorder::keep_series`].
+    pub series: Option<Series>,
+    /// Why the run stopped early; `None` when it reached the end.
+    pub error: Option<Error>,
+}
+
+/// What a sample observes besides the violations.
+enum Observed<'a> {
+    /// The coordinates `q`; no reference.
+    Coordinates,
+    /// An example's observables, and its reference when it has one.
+    Example {
+        example: &'a Example,
+        /// The observables of the current state.
+        values: Vec<f64>,
+        /// The reference state and its observables at the current time.
+        reference: Option<(Vec<f64>, Vec<f64>, Vec<f64>)>,
+    },
+}
+
+/// Gathers a [`Record`] from the samples of a run and hands each to a [`Sink`].
+///
+/// Buffers are allocated once, so a sample allocates nothing beyond
+/// growing the series when they are kept.
+pub struct Recorder<'a, K: Sink = NoSink> {
+    observed: Observed<'a>,
+    sink: K,
+    record: Record,
+}
+
+impl Recorder<'static> {
+    /// Records a bare model: the observables are the coordinates, there is no reference.
+    pub fn coordinates() -> Self {
+        Recorder { observed: Observed::Coordinates, sink: NoSink, record: empty_record(false) }
+    }
+}
+
+impl<'a> Recorder<'a> {
+    /// Records a run of `example`'s model: its observables and, when it has
+    /// a reference solution, the error of the first observable against it.
+    pub fn example(example: &'a Example) -> Self {
+        let n = example.model.n();
+        let count = example.observables.len();
+        let reference = example.reference.as_ref().map(|_| (vec![0.0; n], vec![0.0; n], vec![0.0; count]));
+        let has_reference = reference.is_some();
+        Recorder {
+            observed: Observed::Example { example, values: vec![0.0; count], reference },
+            sink: NoSink,
+            record: empty_record(has_reference),
+        }
+    }
+}
+
+/// A record before any sample: zeros, and a zero error when there is a reference.
+fn empty_record(has_reference: bool) -> Record {
+    Record {
+        max_abs_phi: 0.0,
+        max_abs_psi: 0.0,
+        max_abs_coupling: 0.0,
+        max_abs_error: has_reference.then_some(0.0),
+        final_error: None,
+        steps: 0,
+        t_final: 0.0,
+        evaluations: 0,
+        q_end: Vec::new(),
+        v_end: Vec::new(),
+        series: None,
+        error: None,
+    }
+}
+
+/// Why [`Recorder::run`] stopped early: the simulation (recorded) or the sink (returned).
+enum Stop<E> {
+    Simulation(Error),
+    Sink(E),
+}
+
+impl<E> From<Error> for Stop<E> {
+    fn from(e: Error) -> Self {
+        Stop::Simulation(e)
+    }
+}
+
+impl<'a, K: Sink> Recorder<'a, K> {
+    /// Whether to keep the sampled series (figures need them; sweeps do not).
+    pub fn keep_series(mut self, keep: bool) -> Self {
+        self.record.series = keep.then(Series::default);
+        self
+    }
+
+    /// Hands every sample to `sink` as well.
+    pub fn sink<L: Sink>(self, sink: L) -> Recorder<'a, L> {
+        Recorder { observed: self.observed, sink, record: self.record }
+    }
+
+    /// Runs `sim` until `t_end`, sampling at the start, after every
+    /// `every`-th step and after the last. An error of the simulation stops
+    /// the run and is kept in [`Record::error`], with everything sampled
+    /// before it; an error of the sink is returned.
+    pub fn run<S: System>(mut self, sim: &mut Stepper<S>, t_end: f64, every: u64) -> Result<Record, K::Error> {
+        let outcome = sim.run(t_end, every, |sim| self.sample(sim).map_err(Stop::Sink));
+        let error = match outcome {
+            Ok(()) => None,
+            Err(Stop::Simulation(e)) => Some(e),
+            Err(Stop::Sink(e)) => return Err(e),
+        };
+        Ok(Record { error, ..self.finish(sim) })
+    }
+
+    /// Samples the current state of `sim`: updates the statistics and
+    /// series and hands the sample to the sink.
+    pub fn sample<S: System>(&mut self, sim: &mut Stepper<S>) -> Result<(), K::Error> {
+        let measures = sim.measure();
+        let (t, q, v) = (sim.t(), sim.q(), sim.v());
+        let (observables, error) = match &mut self.observed {
+            Observed::Coordinates => (q, None),
+            Observed::Example { example, values, reference } => {
+                (example.observe)(q, v, values);
+                // As `Example::error`, into buffers allocated once.
+                let error = reference.as_mut().zip(example.reference.as_ref()).map(|((qr, vr, at_ref), exact)| {
+                    exact(t, qr, vr);
+                    (example.observe)(qr, vr, at_ref);
+                    values[0] - at_ref[0]
+                });
+                (&values[..], error)
+            }
+        };
+        let r = &mut self.record;
+        r.max_abs_phi = r.max_abs_phi.max(measures.phi.abs());
+        r.max_abs_psi = r.max_abs_psi.max(measures.psi.abs());
+        r.max_abs_coupling = r.max_abs_coupling.max(measures.coupling);
+        if let Some(e) = error {
+            r.max_abs_error = Some(r.max_abs_error.unwrap_or(0.0).max(e.abs()));
+            r.final_error = Some(e);
+        }
+        if let Some(s) = &mut r.series {
+            s.t.push(t);
+            s.phi.push(measures.phi);
+            s.psi.push(measures.psi);
+            s.error.extend(error);
+        }
+        self.sink.sample(&Sample { step: sim.steps(), t, observables, measures, error })
+    }
+
+    /// The record so far, with the end state of `sim`.
+    pub fn finish<S: System>(self, sim: &Stepper<S>) -> Record {
+        Record {
+            steps: sim.steps(),
+            t_final: sim.t(),
+            evaluations: sim.evaluations(),
+            q_end: sim.q().to_vec(),
+            v_end: sim.v().to_vec(),
+            ..self.record
+        }
+    }
+
+    /// The record so far, without an end state: for a run that could not
+    /// start, with the reason.
+    pub fn abandon(self, error: Error) -> Record {
+        Record { error: Some(error), ..self.record }
+    }
+}
