@@ -5,8 +5,6 @@
 //! The integrator knows nothing of models: it sees a right-hand side split
 //! into `f` (what the scheme integrates) and the control term `U`.
 
-use crate::control::Application;
-
 /// A fixed-step scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Scheme {
@@ -14,6 +12,18 @@ pub enum Scheme {
     AdamsBashforth2,
     AdamsBashforth3,
     RungeKutta4,
+}
+
+/// Where the control term is integrated (Eqs. 54–59).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Application {
+    /// `U` is part of the right-hand side the scheme integrates.
+    #[default]
+    InRhs,
+    /// The scheme integrates `f`; `U(x_k)` is added with one forward Euler step (Eq. 58).
+    ForwardEuler,
+    /// The scheme integrates `f`; `U(x̂_{k+1})` is added with one backward Euler step (Eq. 59).
+    BackwardEuler,
 }
 
 /// How a scheme combines evaluations.

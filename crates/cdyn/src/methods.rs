@@ -1,6 +1,11 @@
 //! The stabilization methods compared in the paper's test, as named cases.
+//!
+//! For benchmarks and comparisons: the command line's `paper`, `compare`
+//! and `bench` and the scenario files' gains are built from these cases.
+//! A simulation itself needs only a [`Control`].
 
-use crate::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+use crate::control::{Control, Energy, EnergyGain, Gain, Geometric};
+use crate::integrate::Application;
 
 /// The gains every case draws from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -9,8 +14,9 @@ pub struct MethodGains {
     pub cvsgf: Gain,
     /// Gradient energy control gains.
     pub energy: EnergyGain,
-    /// Baumgarte `α`, `β`.
+    /// Baumgarte `α`.
     pub baumgarte_alpha: f64,
+    /// Baumgarte `β`.
     pub baumgarte_beta: f64,
 }
 
