@@ -65,6 +65,7 @@ pub struct ControlledSystem<'m> {
 }
 
 impl<'m> ControlledSystem<'m> {
+    /// A controlled `model` with initial energy `e0`, factoring `Φ_q M⁻¹ Φ_qᵀ` dense or sparse by its size.
     pub fn new(model: &'m Model, control: Control, e0: f64) -> Self {
         Self::with_solver(model, control, e0, LinearSolver::Auto)
     }

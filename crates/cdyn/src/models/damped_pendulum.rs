@@ -12,6 +12,7 @@ use crate::reference::fine_ode::FineOde;
 /// counter-clockwise from +X, as in [`super::PendulumParams`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DampedPendulumParams {
+    /// Mass of the bar.
     pub mass: f64,
     /// Moment of inertia about the centre of mass.
     pub inertia: f64,
@@ -23,6 +24,7 @@ pub struct DampedPendulumParams {
     pub damping: f64,
     /// Initial angle from +X.
     pub theta0: f64,
+    /// Initial angular velocity.
     pub omega0: f64,
 }
 

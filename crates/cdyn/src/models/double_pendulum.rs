@@ -12,9 +12,13 @@ use crate::planar::{BodyId, Element, Mechanism};
 /// vertical; `theta2` is the second rod's absolute angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DoublePendulumParams {
+    /// Mass of the first bob.
     pub m1: f64,
+    /// Mass of the second bob.
     pub m2: f64,
+    /// Length of the first rod (pivot to first bob).
     pub l1: f64,
+    /// Length of the second rod (first bob to second).
     pub l2: f64,
     /// Gravitational acceleration, along −Y.
     pub gravity: f64,
@@ -22,7 +26,9 @@ pub struct DoublePendulumParams {
     pub theta1: f64,
     /// Initial angle of the second rod from the downward vertical.
     pub theta2: f64,
+    /// Initial angular velocity of the first rod.
     pub omega1: f64,
+    /// Initial angular velocity of the second rod.
     pub omega2: f64,
 }
 

@@ -17,6 +17,7 @@ pub enum FourBarBranch {
     /// C to the left of B→D (with A left of D: the "open", C-above assembly).
     #[default]
     Left,
+    /// C to the right of B→D: the other assembly.
     Right,
 }
 
@@ -39,11 +40,17 @@ pub struct FourBarParams {
     pub rocker_length: f64,
     /// Ground length `d` (AD).
     pub ground_length: f64,
+    /// Mass of the crank.
     pub crank_mass: f64,
+    /// Moment of inertia of the crank about its centre.
     pub crank_inertia: f64,
+    /// Mass of the coupler.
     pub coupler_mass: f64,
+    /// Moment of inertia of the coupler about its centre.
     pub coupler_inertia: f64,
+    /// Mass of the rocker.
     pub rocker_mass: f64,
+    /// Moment of inertia of the rocker about its centre.
     pub rocker_inertia: f64,
     /// Constant crank speed `ω`.
     pub omega: f64,
@@ -51,6 +58,7 @@ pub struct FourBarParams {
     pub theta0: f64,
     /// Gravitational acceleration, along −Y.
     pub gravity: f64,
+    /// Which of the two assemblies the linkage starts in (and keeps).
     pub branch: FourBarBranch,
     /// Pendulum hanging from joint C.
     pub load: Option<LoadPendulum>,

@@ -41,8 +41,8 @@ pub use double_pendulum::{DoublePendulumParams, double_pendulum};
 pub use four_bar::{FourBarBranch, FourBarParams, four_bar};
 pub use moving_support::{MovingSupportParams, moving_support_pendulum};
 pub use parts::LoadPendulum;
-pub use slider_crank::{SliderCrankParams, slider_crank};
 pub use pendulum::{PendulumParams, SmallPendulum, cartesian_pendulum, small_pendulum, theta_pendulum};
+pub use slider_crank::{SliderCrankParams, slider_crank};
 
 /// `(q, v)` of the exact solution at time `t`, in the model's coordinates.
 pub type Reference = Box<dyn Fn(f64, &mut [f64], &mut [f64]) + Send + Sync>;

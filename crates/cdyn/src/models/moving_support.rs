@@ -20,6 +20,7 @@ pub struct MovingSupportParams {
     pub support_mass: f64,
     /// Mass of the bob.
     pub mass: f64,
+    /// Length of the rod.
     pub length: f64,
     /// Gravitational acceleration, along −Y.
     pub gravity: f64,

@@ -80,7 +80,9 @@ pub(super) fn example(
 /// mechanism. The angle is counter-clockwise from the downward vertical.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoadPendulum {
+    /// Mass of the bob.
     pub mass: f64,
+    /// Length of the rod.
     pub length: f64,
     /// Initial angle of the rod from the downward vertical.
     pub angle: f64,

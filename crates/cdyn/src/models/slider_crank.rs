@@ -24,13 +24,17 @@ pub struct SliderCrankParams {
     pub crank_radius: f64,
     /// Connecting rod length `l > r`.
     pub rod_length: f64,
+    /// Mass of the crank.
     pub crank_mass: f64,
     /// About the crank's centre (its midpoint).
     pub crank_inertia: f64,
+    /// Mass of the connecting rod.
     pub rod_mass: f64,
     /// About the rod's centre (its midpoint).
     pub rod_inertia: f64,
+    /// Mass of the slider.
     pub slider_mass: f64,
+    /// Moment of inertia of the slider (it does not turn, but every planar body has one).
     pub slider_inertia: f64,
     /// Constant crank speed `ω`.
     pub omega: f64,
