@@ -44,10 +44,10 @@ pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: 
     };
     loop {
         d.evaluate(model, q, v, t).map_err(|b| singular(b, out.newton_iterations))?;
-        let phi = max_abs(&d.phi);
+        let phi = max_abs(d.phi());
         if out.newton_iterations == 0 {
             out.phi_before = phi;
-            out.phi_dot_before = max_abs(&d.phi_dot);
+            out.phi_dot_before = max_abs(d.phi_dot());
         }
         if phi <= tolerance {
             out.phi_after = phi;
@@ -56,7 +56,7 @@ pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: 
         if out.newton_iterations == MAX_ITERATIONS || !phi.is_finite() {
             return Err(Problem::NoConvergence { phi, iterations: out.newton_iterations }.at(Part::Assembly));
         }
-        rhs.copy_from_slice(&d.phi);
+        rhs.copy_from_slice(d.phi());
         correction.fill(0.0);
         d.add_constraint_response(model, &mut rhs, &mut correction);
         for (q, c) in q.iter_mut().zip(&correction) {
@@ -65,14 +65,14 @@ pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: 
         out.newton_iterations += 1;
     }
     // Φ_q v + Φ_t = Φ̇ at the assembled positions; remove it in one linear step.
-    rhs.copy_from_slice(&d.phi_dot);
+    rhs.copy_from_slice(d.phi_dot());
     correction.fill(0.0);
     d.add_constraint_response(model, &mut rhs, &mut correction);
     for (v, c) in v.iter_mut().zip(&correction) {
         *v += c;
     }
     d.evaluate(model, q, v, t).map_err(|b| singular(b, out.newton_iterations))?;
-    out.phi_dot_after = max_abs(&d.phi_dot);
+    out.phi_dot_after = max_abs(d.phi_dot());
     out.max_dq = q.iter().zip(&q_start).fold(0.0, |a, (x, y)| a.max((x - y).abs()));
     out.max_dv = v.iter().zip(&v_start).fold(0.0, |a, (x, y)| a.max((x - y).abs()));
     Ok(out)

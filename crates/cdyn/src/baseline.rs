@@ -3,6 +3,10 @@
 //! accelerations, no automatic differentiation, no generic code, no
 //! buffers. It is what the benchmark measures cdyn's abstraction overhead
 //! against, and a test holds it to cdyn's trajectory.
+//!
+//! For benchmarks and comparisons only: it is public because the benches
+//! and the command line's `bench` use it, and hidden from the documentation
+//! because it is not a capability of the library.
 
 /// State `(X, Y, V_X, V_Y)`.
 pub type State = [f64; 4];
@@ -10,7 +14,9 @@ pub type State = [f64; 4];
 /// The hand-written integrator.
 #[derive(Debug, Clone)]
 pub struct HandWritten {
+    /// The current state.
     pub x: State,
+    /// The step.
     pub h: f64,
     zeta: f64,
     alpha_e: f64,
@@ -46,6 +52,7 @@ impl HandWritten {
         [-2.0 * self.zeta * phi * x[0], -2.0 * self.zeta * phi * x[1], -k * x[2], -k * x[3]]
     }
 
+    /// Advances [`x`](Self::x) by one step `h`.
     pub fn step(&mut self) {
         let h = self.h;
         let x = self.x;

@@ -4,6 +4,7 @@
 
 use crate::energy;
 use crate::error::{Result, non_negative, positive};
+use crate::integrate::Application;
 
 /// A gain either fixed, or set at every evaluation from a target decay rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,22 +72,6 @@ pub enum Energy {
     Baumgarte { eta: f64 },
     /// Steepest descent on `Ψ²` (Eqs. 20, 22, 44).
     Gradient(EnergyGain),
-}
-
-/// Where the control term is integrated (Eqs. 54–59). Scenario files write
-/// `rhs`, `forward_euler` or `backward_euler`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum Application {
-    /// `U` is part of the right-hand side the scheme integrates.
-    #[default]
-    #[cfg_attr(feature = "serde", serde(rename = "rhs"))]
-    InRhs,
-    /// The scheme integrates `f`; `U(x_k)` is added with one forward Euler step (Eq. 58).
-    ForwardEuler,
-    /// The scheme integrates `f`; `U(x̂_{k+1})` is added with one backward Euler step (Eq. 59).
-    BackwardEuler,
 }
 
 /// A complete stabilization method: one row of the table in `equations.md`.

@@ -19,13 +19,28 @@ pub struct Measures {
 }
 
 impl Measures {
-    /// Takes in one constraint row: its `Φᵢ`, `Φ̇ᵢ` and `Y_ci`.
-    pub(crate) fn add_row(&mut self, phi: f64, phi_dot: f64, coupling: f64) {
-        if phi.abs() > self.phi.abs() {
-            self.phi = phi;
+    /// The measures of one state, for general and small systems alike:
+    /// `psi` is `Ψ`, `grad_potential` is `∇V = Ψ_q`, and constraint row `i`
+    /// has `phi[i]`, `phi_dot[i]` and the entries of `Φ_q` that `row(i)`
+    /// returns with their coordinates.
+    pub(crate) fn of<'a>(
+        psi: f64,
+        grad_potential: &[f64],
+        phi: &[f64],
+        phi_dot: &[f64],
+        row: impl Fn(usize) -> (&'a [f64], &'a [u32]),
+    ) -> Self {
+        let mut out = Measures { psi, ..Measures::default() };
+        for (r, (&phi, &phi_dot)) in phi.iter().zip(phi_dot).enumerate() {
+            let (jac, cols) = row(r);
+            let coupling: f64 = jac.iter().zip(cols).map(|(j, &c)| grad_potential[c as usize] * j).sum();
+            if phi.abs() > out.phi.abs() {
+                out.phi = phi;
+            }
+            out.phi_dot = out.phi_dot.max(phi_dot.abs());
+            out.coupling = out.coupling.max(coupling.abs());
         }
-        self.phi_dot = self.phi_dot.max(phi_dot.abs());
-        self.coupling = self.coupling.max(coupling.abs());
+        out
     }
 }
 
@@ -43,6 +58,7 @@ pub struct Probe {
 }
 
 impl Probe {
+    /// Buffers sized for `model`.
     pub fn new(model: &Model) -> Self {
         let m = model.m();
         Self {
@@ -72,11 +88,11 @@ impl Probe {
         self.grad.fill(0.0);
         let potential = model.potential(q, Some(&mut self.grad));
         let pattern = model.pattern();
-        let mut out = Measures { psi: energy::psi(model.mass(), v, potential, e, e0), ..Measures::default() };
-        for r in 0..model.m() {
-            let y: f64 = pattern.row(r).map(|j| self.grad[pattern.cols[j] as usize] * self.jac[j]).sum();
-            out.add_row(self.phi[r], self.phi_dot[r], y);
-        }
-        out
+        let psi = energy::psi(model.mass(), v, potential, e, e0);
+        let jac = &self.jac;
+        Measures::of(psi, &self.grad, &self.phi, &self.phi_dot, |r| {
+            let range = pattern.row(r);
+            (&jac[range.clone()], &pattern.cols[range])
+        })
     }
 }

@@ -2,39 +2,31 @@
 //! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
 
 use crate::constraint::ConstraintValues;
+use crate::energy;
 use crate::linalg::Schur;
 pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
 use crate::model::{Model, Pattern};
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
-/// model; `evaluate` never allocates.
+/// model; `evaluate` never allocates. The results are read through the
+/// accessors below, so only [`evaluate`](Self::evaluate) writes them.
 pub struct Dynamics {
-    /// `Φ(q, t)`
-    pub phi: Vec<f64>,
-    /// `Φ̇ = Φ_q v + Φ_t`
-    pub phi_dot: Vec<f64>,
-    /// `Φ_t`, as `Φ̇ − Φ_q v` (zero up to round-off without drives).
-    pub phi_t: Vec<f64>,
-    /// `γ` of Eq. 5
-    pub gamma: Vec<f64>,
-    /// Values of `Φ_q` in the model's [`Pattern`] order.
-    pub jac: Vec<f64>,
-    /// Generalized applied force `G = −∇V + F`.
-    pub force: Vec<f64>,
-    /// `∇V`, which is also `Ψ_q`.
-    pub grad_potential: Vec<f64>,
-    /// `V(q)`
-    pub potential: f64,
-    /// Power of the non-conservative forces, `F·v`.
-    pub force_power: f64,
-    /// `λ` of Eq. 7.
-    pub lambda: Vec<f64>,
-    /// `A = M⁻¹ (G − Φ_qᵀ λ)` of Eq. 8.
-    pub acc: Vec<f64>,
+    phi: Vec<f64>,
+    phi_dot: Vec<f64>,
+    phi_t: Vec<f64>,
+    gamma: Vec<f64>,
+    jac: Vec<f64>,
+    force: Vec<f64>,
+    grad_potential: Vec<f64>,
+    potential: f64,
+    force_power: f64,
+    lambda: Vec<f64>,
+    acc: Vec<f64>,
     schur: Schur,
 }
 
 impl Dynamics {
+    /// A workspace for `model`, factoring `Φ_q M⁻¹ Φ_qᵀ` dense or sparse by its size.
     pub fn new(model: &Model) -> Self {
         Self::with_solver(model, LinearSolver::Auto)
     }
@@ -98,6 +90,56 @@ impl Dynamics {
     pub fn add_constraint_response(&self, model: &Model, b: &mut [f64], out: &mut [f64]) {
         self.schur.solve(b);
         add_weighted_jt(model.pattern(), &self.jac, b, model.inv_mass(), -1.0, out);
+    }
+
+    /// The energy input `Ė = F·v + λᵀ Φ_t` of the last evaluation (see [`crate::energy`]).
+    pub fn energy_input(&self) -> f64 {
+        energy::power(self.force_power, &self.lambda, &self.phi_t)
+    }
+
+    /// `Φ(q, t)`
+    pub fn phi(&self) -> &[f64] {
+        &self.phi
+    }
+    /// `Φ̇ = Φ_q v + Φ_t`
+    pub fn phi_dot(&self) -> &[f64] {
+        &self.phi_dot
+    }
+    /// `Φ_t`, as `Φ̇ − Φ_q v` (zero up to round-off without drives).
+    pub fn phi_t(&self) -> &[f64] {
+        &self.phi_t
+    }
+    /// `γ` of Eq. 5
+    pub fn gamma(&self) -> &[f64] {
+        &self.gamma
+    }
+    /// Values of `Φ_q` in the model's [`Pattern`] order.
+    pub fn jac(&self) -> &[f64] {
+        &self.jac
+    }
+    /// Generalized applied force `G = −∇V + F`.
+    pub fn force(&self) -> &[f64] {
+        &self.force
+    }
+    /// `∇V`, which is also `Ψ_q`.
+    pub fn grad_potential(&self) -> &[f64] {
+        &self.grad_potential
+    }
+    /// `V(q)`
+    pub fn potential(&self) -> f64 {
+        self.potential
+    }
+    /// Power of the non-conservative forces, `F·v`.
+    pub fn force_power(&self) -> f64 {
+        self.force_power
+    }
+    /// `λ` of Eq. 7.
+    pub fn lambda(&self) -> &[f64] {
+        &self.lambda
+    }
+    /// `A = M⁻¹ (G − Φ_qᵀ λ)` of Eq. 8.
+    pub fn acc(&self) -> &[f64] {
+        &self.acc
     }
 }
 

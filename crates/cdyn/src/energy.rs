@@ -7,8 +7,6 @@
 //! scleronomic system `Φ_t = 0` exactly, so drift off `Φ̇ = 0` is not
 //! mistaken for an energy input.
 
-use crate::dynamics::Dynamics;
-
 /// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e` for the diagonal `mass`, with `V` evaluated elsewhere.
 #[inline(always)]
 pub fn psi(mass: &[f64], v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
@@ -19,11 +17,6 @@ pub fn psi(mass: &[f64], v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
 #[inline(always)]
 pub fn kinetic(mass: &[f64], v: &[f64]) -> f64 {
     0.5 * mass.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
-}
-
-/// `Ė = F·v + λᵀ Φ_t`, from an evaluated [`Dynamics`].
-pub fn energy_input(d: &Dynamics) -> f64 {
-    power(d.force_power, &d.lambda, &d.phi_t)
 }
 
 /// `Ė = F·v + λᵀ Φ_t` from its parts.

@@ -5,8 +5,6 @@
 //! The integrator knows nothing of models: it sees a right-hand side split
 //! into `f` (what the scheme integrates) and the control term `U`.
 
-use crate::control::Application;
-
 /// A fixed-step scheme. In scenario files it is written by its
 /// [`SchemeInfo::name`]: `euler`, `ab2`, `ab3`, `rk4`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -17,6 +15,22 @@ pub enum Scheme {
     AdamsBashforth2,
     AdamsBashforth3,
     RungeKutta4,
+}
+
+/// Where the control term is integrated (Eqs. 54–59). Scenario files write
+/// `rhs`, `forward_euler` or `backward_euler`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Application {
+    /// `U` is part of the right-hand side the scheme integrates.
+    #[default]
+    #[cfg_attr(feature = "serde", serde(rename = "rhs"))]
+    InRhs,
+    /// The scheme integrates `f`; `U(x_k)` is added with one forward Euler step (Eq. 58).
+    ForwardEuler,
+    /// The scheme integrates `f`; `U(x̂_{k+1})` is added with one backward Euler step (Eq. 59).
+    BackwardEuler,
 }
 
 /// How a scheme combines evaluations.

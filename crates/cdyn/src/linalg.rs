@@ -13,7 +13,7 @@
 //! the pattern faer's symbolic Cholesky finds (`sparse.rs`), with an AMD
 //! ordering when it fills less than the natural one.
 
-use crate::model::Pattern;
+use crate::sparse::{Pattern, Structure};
 
 /// Why `S` could not be factored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,24 +64,6 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
         }
     }
     out
-}
-
-/// A symmetric elimination order and the pattern of the strictly lower
-/// triangle of `L` in it, by columns with rows ascending.
-pub(crate) struct Structure {
-    /// `perm[i]` is the original row eliminated `i`-th; `None` for the natural order.
-    pub perm: Option<Vec<usize>>,
-    pub col_ptr: Vec<usize>,
-    pub row_idx: Vec<usize>,
-}
-
-impl Structure {
-    /// The full lower triangle in the natural order.
-    fn dense(m: usize) -> Self {
-        let col_ptr = (0..=m).map(|j| j * m - j * (j + 1) / 2).collect();
-        let row_idx = (0..m).flat_map(|j| j + 1..m).collect();
-        Self { perm: None, col_ptr, row_idx }
-    }
 }
 
 /// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the

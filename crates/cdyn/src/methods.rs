@@ -1,9 +1,11 @@
 //! Stabilization methods by name: the flat table of keys in which scenario
 //! files write a method (`geometric = "cvsgf"`, `zeta = 20.0`, …), and the
-//! named cases of the paper's comparison (`cdyn compare`, benchmarks).
+//! named cases of the paper's comparison, for `cdyn paper`, `compare`,
+//! `bench` and benchmarks. A simulation itself needs only a [`Control`].
 
-use crate::control::{Application, Control, Energy, EnergyGain, Gain, Geometric, baumgarte_gains};
+use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, baumgarte_gains};
 use crate::error::{Error, Result, non_negative};
+use crate::integrate::Application;
 
 /// The geometric control a [`MethodKeys`] names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

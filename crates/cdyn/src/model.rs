@@ -9,26 +9,9 @@
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
-
-/// Sparsity of `Φ_q`: row `r` has entries at `cols[start[r]..start[r + 1]]`.
-///
-/// Indices are `u32`: the pattern is read in every step, and for large
-/// models (a 10 000-body chain) half the bytes is a measurable share of the
-/// memory traffic. [`ModelBuilder::build`] checks that they fit.
-#[derive(Debug, Clone, Default)]
-pub struct Pattern {
-    pub start: Vec<u32>,
-    pub cols: Vec<u32>,
-}
-
-impl Pattern {
-    pub fn row(&self, r: usize) -> std::ops::Range<usize> {
-        self.start[r] as usize..self.start[r + 1] as usize
-    }
-    pub fn nnz(&self) -> usize {
-        self.cols.len()
-    }
-}
+/// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
+/// other sparse structures in `sparse.rs`).
+pub use crate::sparse::Pattern;
 
 /// A constrained mechanical system, ready to simulate.
 pub struct Model {

@@ -348,10 +348,8 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         let (q, v, e) = split(x);
         let l = local(&self.system, q, v, [0.0; N], t);
         let (potential, grad) = energy_and_gradient(&self.system, q);
-        let mut out = Measures { psi: energy::psi(&self.d.mass, &v, potential, e, self.e0), ..Measures::default() };
-        for r in 0..M {
-            out.add_row(l.phi[r], l.phi_dot[r], (0..N).map(|c| grad[c] * l.jac[r][c]).sum());
-        }
-        out
+        let psi = energy::psi(&self.d.mass, &v, potential, e, self.e0);
+        let columns = &SmallDynamics::<N, M>::COLUMNS;
+        Measures::of(psi, &grad, &l.phi, &l.phi_dot, |r| (l.jac[r].as_slice(), columns.as_slice()))
     }
 }

@@ -55,16 +55,17 @@ pub struct ControlledSystem<'m> {
     model: &'m Model,
     control: Control,
     /// The dynamics of the latest evaluation.
-    pub dynamics: Dynamics,
+    dynamics: Dynamics,
     /// `E₀ = T₀ + V₀`
-    pub e0: f64,
+    e0: f64,
     scratch: Vec<f64>,
     probe: Probe,
     /// Right-hand-side evaluations so far.
-    pub evaluations: u64,
+    evaluations: u64,
 }
 
 impl<'m> ControlledSystem<'m> {
+    /// A controlled `model` with initial energy `e0`, factoring `Φ_q M⁻¹ Φ_qᵀ` dense or sparse by its size.
     pub fn new(model: &'m Model, control: Control, e0: f64) -> Self {
         Self::with_solver(model, control, e0, LinearSolver::Auto)
     }
@@ -82,12 +83,20 @@ impl<'m> ControlledSystem<'m> {
         }
     }
 
+    /// The model it evaluates.
     pub fn model(&self) -> &'m Model {
         self.model
     }
 
+    /// The control law it adds.
     pub fn control(&self) -> &Control {
         &self.control
+    }
+
+    /// The dynamics of the latest evaluation. `E₀` and the evaluation count
+    /// are read through [`System::e0`] and [`System::evaluations`].
+    pub fn dynamics(&self) -> &Dynamics {
+        &self.dynamics
     }
 }
 
@@ -107,12 +116,12 @@ impl Rhs for ControlledSystem<'_> {
         let (q, v, e) = split_state(x, n);
         self.evaluations += 1;
         self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let e_dot = energy::energy_input(&self.dynamics);
+        let e_dot = self.dynamics.energy_input();
         f[..n].copy_from_slice(v);
-        f[n..2 * n].copy_from_slice(&self.dynamics.acc);
+        f[n..2 * n].copy_from_slice(self.dynamics.acc());
         f[2 * n] = e_dot;
         if let Some(u) = u {
-            let psi = energy::psi(self.model.mass(), v, self.dynamics.potential, e, self.e0);
+            let psi = energy::psi(self.model.mass(), v, self.dynamics.potential(), e, self.e0);
             let (u_q, rest) = u.split_at_mut(n);
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
@@ -138,7 +147,7 @@ impl System for ControlledSystem<'_> {
         self.evaluations
     }
     fn last_violation(&self) -> f64 {
-        self.dynamics.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
+        self.dynamics.phi().iter().fold(0.0_f64, |a, p| a.max(p.abs()))
     }
     fn measure(&mut self, x: &[f64], t: f64) -> Measures {
         let (q, v, e) = split_state(x, self.model.n());
@@ -157,20 +166,20 @@ impl Evaluation for Evaluated<'_> {
         self.model.mass()
     }
     fn phi(&self) -> &[f64] {
-        &self.dynamics.phi
+        self.dynamics.phi()
     }
     fn phi_dot(&self) -> &[f64] {
-        &self.dynamics.phi_dot
+        self.dynamics.phi_dot()
     }
     fn grad_potential(&self) -> &[f64] {
-        &self.dynamics.grad_potential
+        self.dynamics.grad_potential()
     }
     fn acc(&self) -> &[f64] {
-        &self.dynamics.acc
+        self.dynamics.acc()
     }
     fn row(&self, r: usize) -> (&[f64], &[u32]) {
         let (pattern, range) = (self.model.pattern(), self.model.pattern().row(r));
-        (&self.dynamics.jac[range.clone()], &pattern.cols[range])
+        (&self.dynamics.jac()[range.clone()], &pattern.cols[range])
     }
     fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
         self.dynamics.add_constraint_response(self.model, b, out);

@@ -3,8 +3,9 @@
 //! Example 1 (as a general model and as a small system) and on a mechanism
 //! with every kind of element.
 
-use cdyn::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric};
 use cdyn::dynamics::LinearSolver;
+use cdyn::integrate::Application;
 use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
 use cdyn::planar::{Coordinate, Element, Mechanism};
 use cdyn::simulate::Stepper;

@@ -61,7 +61,7 @@ proptest! {
             let (p, m) = (phi(&model, &shifted(&q, &e, h), t), phi(&model, &shifted(&q, &e, -h), t));
             for r in 0..model.m() {
                 let fd = (p[r] - m[r]) / (2.0 * h);
-                let ad = pattern.row(r).find(|&j| pattern.cols[j] as usize == c).map_or(0.0, |j| d.jac[j]);
+                let ad = pattern.row(r).find(|&j| pattern.cols[j] as usize == c).map_or(0.0, |j| d.jac()[j]);
                 prop_assert!(close(ad, fd, 1e-7), "Φ_q[{r},{c}]: AD {ad} vs FD {fd}");
             }
         }
@@ -72,16 +72,16 @@ proptest! {
         for r in 0..model.m() {
             let first = (p1[r] - m1[r]) / (2.0 * hs);
             let second = (p1[r] - 2.0 * p0[r] + m1[r]) / (hs * hs);
-            prop_assert!(close(d.phi[r], p0[r], 1e-14));
-            prop_assert!(close(d.phi_dot[r], first, 1e-6), "Φ̇[{r}]: AD {} vs FD {first}", d.phi_dot[r]);
-            prop_assert!(close(-d.gamma[r], second, 1e-5), "γ[{r}]: AD {} vs FD {}", d.gamma[r], -second);
+            prop_assert!(close(d.phi()[r], p0[r], 1e-14));
+            prop_assert!(close(d.phi_dot()[r], first, 1e-6), "Φ̇[{r}]: AD {} vs FD {first}", d.phi_dot()[r]);
+            prop_assert!(close(-d.gamma()[r], second, 1e-5), "γ[{r}]: AD {} vs FD {}", d.gamma()[r], -second);
         }
         // ∇V.
         for c in 0..4 {
             let mut e = vec![0.0; 4];
             e[c] = 1.0;
             let fd = (model.potential(&shifted(&q, &e, h), None) - model.potential(&shifted(&q, &e, -h), None)) / (2.0 * h);
-            prop_assert!(close(d.grad_potential[c], fd, 1e-7), "∇V[{c}]: AD {} vs FD {fd}", d.grad_potential[c]);
+            prop_assert!(close(d.grad_potential()[c], fd, 1e-7), "∇V[{c}]: AD {} vs FD {fd}", d.grad_potential()[c]);
         }
     }
 }
@@ -94,14 +94,14 @@ fn accelerations_satisfy_the_constraint_equations() {
     let mut d = Dynamics::new(&model);
     d.evaluate(&model, &q, &v, t).unwrap();
     let mut ja = vec![0.0; model.m()];
-    cdyn::dynamics::jac_mul(model.pattern(), &d.jac, &d.acc, &mut ja);
+    cdyn::dynamics::jac_mul(model.pattern(), d.jac(), d.acc(), &mut ja);
     for r in 0..model.m() {
-        assert!((ja[r] - d.gamma[r]).abs() < 1e-12, "row {r}: Φ_q A = {} vs γ = {}", ja[r], d.gamma[r]);
+        assert!((ja[r] - d.gamma()[r]).abs() < 1e-12, "row {r}: Φ_q A = {} vs γ = {}", ja[r], d.gamma()[r]);
     }
     let mut jt = vec![0.0; model.n()];
-    cdyn::dynamics::add_weighted_jt(model.pattern(), &d.jac, &d.lambda, &[1.0; 4], 1.0, &mut jt);
+    cdyn::dynamics::add_weighted_jt(model.pattern(), d.jac(), d.lambda(), &[1.0; 4], 1.0, &mut jt);
     for i in 0..model.n() {
-        let residual = model.mass()[i] * d.acc[i] + jt[i] - d.force[i];
+        let residual = model.mass()[i] * d.acc()[i] + jt[i] - d.force()[i];
         assert!(residual.abs() < 1e-12, "coordinate {i}: residual {residual}");
     }
 }

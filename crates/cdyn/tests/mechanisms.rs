@@ -634,7 +634,7 @@ fn damped_pendulum_matches_its_equation_and_loses_energy_to_the_damper() {
         e_end = m.psi + s.energy_input() + s.initial_energy() - bottom;
         // Ė = −c ω² ≤ 0: the damper's power, nothing else.
         d.evaluate(s.model(), s.q(), s.v(), s.t()).unwrap();
-        let edot = cdyn::energy::energy_input(&d);
+        let edot = d.energy_input();
         let w = s.v()[2];
         assert!(edot <= 0.0, "Ė = {edot} at t = {}", s.t());
         worst_edot = worst_edot.max((edot + p.damping * w * w).abs());

@@ -2,7 +2,8 @@
 //! the general path (`Simulation` of the same system as a `Model`): the
 //! same trajectories, measures and errors, for every scheme and control.
 
-use cdyn::control::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::integrate::Application;
 use cdyn::models::{PendulumParams, small_pendulum};
 use cdyn::small::{SmallSimulation, SmallSystem, to_model};
 use cdyn::{Error, Scalar, Scheme, Settings, Simulation};

@@ -36,11 +36,11 @@ fn sparse_and_dense_solvers_agree() {
     let mut sparse = Dynamics::with_solver(&model, LinearSolver::Sparse);
     dense.evaluate(&model, &q, &v, 0.0).unwrap();
     sparse.evaluate(&model, &q, &v, 0.0).unwrap();
-    let scale = dense.lambda.iter().fold(0.0_f64, |a, l| a.max(l.abs()));
-    for (a, b) in dense.lambda.iter().zip(&sparse.lambda) {
+    let scale = dense.lambda().iter().fold(0.0_f64, |a, l| a.max(l.abs()));
+    for (a, b) in dense.lambda().iter().zip(sparse.lambda()) {
         assert!((a - b).abs() <= 1e-10 * scale, "λ: {a} vs {b}");
     }
-    for (a, b) in dense.acc.iter().zip(&sparse.acc) {
+    for (a, b) in dense.acc().iter().zip(sparse.acc()) {
         assert!((a - b).abs() <= 1e-9 * (1.0 + a.abs()), "A: {a} vs {b}");
     }
     // The Baumgarte response uses the same factorization.

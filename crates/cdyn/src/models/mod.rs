@@ -1,13 +1,48 @@
 //! Built-in systems, each with its initial state and, where one exists,
 //! its reference solution. Tests, benchmarks and the command line share them.
+//!
+//! The planar mechanisms are described with [`Mechanism`](crate::planar::Mechanism)
+//! (the same joints, drives and forces users get), one file each; the
+//! pieces they share are in `parts.rs`.
+//!
+//! | model | free motion | reference |
+//! |---|---|---|
+//! | [`double_pendulum`] | 2 DOF | none (chaotic in general) |
+//! | [`chain`] | N DOF | rigid rotation when `g = 0`; the exact pendulum when `N = 1` |
+//! | [`slider_crank`] | none (driven); 1 DOF with a load | exact kinematics; a load pendulum by a fine RK-4 |
+//! | [`four_bar`] | none (driven); 1 DOF with a load | exact kinematics (circle intersection); a load by a fine RK-4 |
+//! | [`moving_support_pendulum`] | 1 DOF, driven support | exact pendulum in the accelerated frame, or a fine RK-4 |
+//! | [`damped_pendulum`] | 1 DOF, rotary damper | exact pendulum when undamped, else a fine RK-4 |
+//!
+//! Angle conventions: the multi-link models (double pendulum, chain, load
+//! pendulums) measure link angles counter-clockwise from the downward
+//! vertical (−Y); the single pendulums ([`moving_support_pendulum`],
+//! [`damped_pendulum`]) measure the angle counter-clockwise from +X, as
+//! [`PendulumParams`] and [`PendulumExact`](crate::reference::PendulumExact)
+//! do. Gravity acts along −Y.
+//!
+//! Fine references: where no closed form exists, a 1-D equation of motion
+//! is integrated by [`crate::reference`]'s fine RK-4 (error about 1e-13).
 
 pub mod andrews;
-mod mechanisms;
+mod chain;
+mod damped_pendulum;
+mod double_pendulum;
+mod four_bar;
+mod moving_support;
+mod parts;
 mod pendulum;
+mod slider_crank;
 
 pub use andrews::andrews;
-pub use mechanisms::*;
+pub use chain::{ChainParams, chain};
+pub use damped_pendulum::{DampedPendulumParams, damped_pendulum};
+pub use double_pendulum::{DoublePendulumParams, double_pendulum};
+pub use four_bar::{FourBarBranch, FourBarParams, four_bar};
+pub use moving_support::{MovingSupportParams, moving_support_pendulum};
+pub use parts::LoadPendulum;
 pub use pendulum::{PendulumParams, SmallPendulum, cartesian_pendulum, small_pendulum, theta_pendulum};
+pub use slider_crank::{SliderCrankParams, slider_crank};
 
 /// `(q, v)` of the exact solution at time `t`, in the model's coordinates.
 pub type Reference = Box<dyn Fn(f64, &mut [f64], &mut [f64]) + Send + Sync>;

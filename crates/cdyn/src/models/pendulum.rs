@@ -4,7 +4,7 @@
 //! counter-clockwise from +X.
 
 use super::Example;
-use crate::error::{Result, non_negative, positive};
+use crate::error::{Result, finite, non_negative, positive};
 use crate::reference::PendulumExact;
 use crate::small::SmallSystem;
 use crate::{Constraint, Model, Potential, Scalar};
@@ -33,11 +33,8 @@ impl PendulumParams {
         positive("mass", self.mass)?;
         positive("length", self.length)?;
         non_negative("gravity", self.gravity)?;
-        for (name, x) in [("theta0", self.theta0), ("omega0", self.omega0)] {
-            if !x.is_finite() {
-                return Err(crate::Error::InvalidParameter { name, value: x, reason: "must be finite" });
-            }
-        }
+        finite("theta0", self.theta0)?;
+        finite("omega0", self.omega0)?;
         Ok(())
     }
 
