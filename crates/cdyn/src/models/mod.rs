@@ -57,13 +57,18 @@ pub type Observe = Box<dyn Fn(&[f64], &[f64], &mut [f64]) + Send + Sync>;
 
 /// A built-in system ready to simulate.
 pub struct Example {
+    /// The equations of motion.
     pub model: crate::Model,
+    /// Initial positions, on the constraints.
     pub q0: Vec<f64>,
+    /// Initial velocities, on the velocity constraints.
     pub v0: Vec<f64>,
     /// Names of the observables, e.g. `X, Y, VX, VY`; errors against the
     /// reference are reported for the first of them.
     pub observables: Vec<String>,
+    /// Computes the observables of a state (see [`Example::observe`]).
     pub observe: Observe,
+    /// The exact (or finely integrated) solution, where one exists.
     pub reference: Option<Reference>,
 }
 
