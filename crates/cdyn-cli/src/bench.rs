@@ -15,7 +15,7 @@
 use crate::alloc_count::allocations;
 use anyhow::Result;
 use cdyn::baseline::HandWritten;
-use cdyn::methods::{MethodGains, redundant_cases};
+use cdyn::methods::MethodGains;
 use cdyn::models::{ChainParams, PendulumParams, cartesian_pendulum, chain, small_pendulum};
 use cdyn::small::SmallSimulation;
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
@@ -90,7 +90,7 @@ fn example1(light: bool) -> Result<Example1> {
     let (steps, runs, trials) = if light { (10_000, 2, 2) } else { (10_000, 50, 7) };
     let ex = cartesian_pendulum(PendulumParams::default())?;
     let (small, q0, v0) = small_pendulum(PendulumParams::default())?;
-    let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
+    let control = MethodGains::paper().cvsgf_energy();
     let settings = Settings::new(Scheme::AdamsBashforth3, 0.01, control);
     let [cdyn, general, hand] = [0, 1, 2];
     let (mut best, mut allocs) = ([f64::INFINITY; 3], 0);

@@ -3,7 +3,6 @@
 
 mod alloc_count;
 mod bench;
-mod builtin_spec;
 mod compare;
 mod heatmap;
 mod mechanism_spec;

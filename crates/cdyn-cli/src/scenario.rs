@@ -6,9 +6,9 @@ use crate::mechanism_spec::{BodySpec, ElementSpec, MechanismSpec};
 use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
 use cdyn::assemble::assemble;
-use cdyn::error::Part;
+use cdyn::error::{Part, positive};
 use cdyn::methods::MethodKeys;
-use cdyn::models::{Example, PendulumParams, cartesian_pendulum, theta_pendulum};
+use cdyn::models::{Example, Kind};
 use cdyn::{Scheme, Settings};
 use serde::Deserialize;
 use std::path::Path;
@@ -36,21 +36,6 @@ pub struct Scenario {
     pub sweep: Option<toml::Table>,
 }
 
-#[derive(Debug, Deserialize, serde::Serialize, Clone, Copy, PartialEq)]
-#[serde(rename_all = "snake_case")]
-pub enum ModelKind {
-    Pendulum,
-    PendulumTheta,
-    Mechanism,
-    Andrews,
-    DoublePendulum,
-    Chain,
-    SliderCrank,
-    FourBar,
-    MovingSupportPendulum,
-    DampedPendulum,
-}
-
 /// `gravity`: a magnitude for the pendulums, a vector for mechanisms.
 #[derive(Debug, Deserialize, Clone, Copy)]
 #[serde(untagged)]
@@ -59,17 +44,20 @@ pub enum GravitySpec {
     Vector([f64; 2]),
 }
 
+/// `[model]`: the kind and, for the pendulums, their parameters; the other
+/// built-in models take theirs in `[model.parameters]`. Both are read by the
+/// library's parameter types when the model is built, so the keys live in
+/// one place; unknown ones are refused there.
 #[derive(Debug, Deserialize, Clone)]
-#[serde(deny_unknown_fields)]
 pub struct ModelSpec {
-    pub kind: ModelKind,
-    pub mass: Option<f64>,
-    pub length: Option<f64>,
+    pub kind: Kind,
     pub gravity: Option<GravitySpec>,
-    pub theta0: Option<f64>,
-    pub omega0: Option<f64>,
     /// Parameters of the other built-in models.
     pub parameters: Option<toml::Table>,
+    /// The other keys of `[model]`: the pendulum's parameters (so no
+    /// `deny_unknown_fields` here: this table takes every other key).
+    #[serde(flatten)]
+    pub pendulum_keys: toml::Table,
 }
 
 #[derive(Debug, Deserialize, Default, Clone)]
@@ -120,18 +108,38 @@ pub fn load(path: &Path) -> Result<Scenario> {
     // The library's types check every key; the path to a refused one names
     // the table, entry and key as the file writes them.
     serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
-        let place = locate(&table, e.path());
-        let why = e.inner().message().trim().replace('\n', " ").replace('`', "");
-        anyhow!("{file}: {place}{why}")
+        let place = locate(&[], &table, e.path());
+        anyhow!("{file}: {place}{}", reason(e.inner()))
     })
+}
+
+/// A deserialization error's message on one line, without the backticks
+/// serde puts around names.
+fn reason(error: &toml::de::Error) -> String {
+    error.message().trim().replace('\n', " ").replace('`', "")
+}
+
+/// The built-in model `kind`, its parameters read from `parameters`, which
+/// the file writes as the table `[within]`; errors name the table, the key
+/// and the value.
+fn builtin(file: &str, kind: Kind, within: &str, parameters: toml::Table) -> Result<Example> {
+    let mut track = serde_path_to_error::Track::new();
+    let tracked = serde_path_to_error::Deserializer::new(toml::Value::Table(parameters.clone()), &mut track);
+    let built = kind.example(tracked).map_err(|e| {
+        let place = locate(&[within], &parameters, &track.path());
+        anyhow!("{file}: {place}{}", reason(&e))
+    })?;
+    built.map_err(|e| anyhow!("{file}: [{within}]: {e}"))
 }
 
 /// Where a deserialization error is, as the file writes it: the table
 /// (`[model.parameters] `), the entry (`joints[2] (revolute): `) and the key
-/// with its value (`n = 2.5: `).
-fn locate(table: &toml::Table, path: &serde_path_to_error::Path) -> String {
+/// with its value (`n = 2.5: `). `table` is the file's table `[within]`
+/// (nothing for the whole file).
+fn locate(within: &[&str], table: &toml::Table, path: &serde_path_to_error::Path) -> String {
     use serde_path_to_error::Segment;
-    let (mut tables, mut entry, mut key) = (Vec::new(), String::new(), None);
+    let mut tables: Vec<String> = within.iter().map(|t| t.to_string()).collect();
+    let (mut entry, mut key) = (String::new(), None);
     let mut value = Some(toml::Value::Table(table.clone()));
     for segment in path.iter() {
         let here = value.take();
@@ -172,31 +180,23 @@ fn locate(table: &toml::Table, path: &serde_path_to_error::Path) -> String {
     out
 }
 
-/// Checks one number: finite and positive, or finite and not negative.
-fn check(file: &str, key: &str, value: f64, positive: bool) -> Result<f64> {
-    let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
-    if !ok {
-        let what = if positive { "finite and positive" } else { "finite and not negative" };
-        bail!("{file}: {key} = {value}: must be {what}");
-    }
-    Ok(value)
-}
-
 impl Scenario {
     /// The case this scenario describes; `path` names it in errors.
     pub fn case(&self, path: &Path) -> Result<Case> {
         let file = &path.display().to_string();
         let control = self.method.control().map_err(|e| anyhow!("{file}: [method] {e}"))?;
         let i = &self.integrator;
-        let h = check(file, "[integrator] h", i.h, true)?;
-        let t_end = check(file, "[integrator] t_end", i.t_end, true)?;
+        let integrator = |e| anyhow!("{file}: [integrator] {e}");
+        let h = positive("h", i.h).map_err(integrator)?;
+        let t_end = positive("t_end", i.t_end).map_err(integrator)?;
         if t_end / h > 1e9 {
             bail!("{file}: [integrator] t_end / h = {:e} steps is more than 1e9", t_end / h);
         }
         let mut settings = Settings::new(i.scheme, h, control);
         let init = &self.initial;
         if let Some(tol) = init.tolerance {
-            settings.consistency_tolerance = Some(check(file, "[initial] tolerance", tol, true)?);
+            settings.consistency_tolerance =
+                Some(positive("tolerance", tol).map_err(|e| anyhow!("{file}: [initial] {e}"))?);
         }
         if init.off_constraint {
             settings.consistency_tolerance = None;
@@ -217,7 +217,7 @@ impl Scenario {
                 default.clone_from(given);
             }
         }
-        let assembly = if init.assemble.unwrap_or(self.model.kind == ModelKind::Mechanism) {
+        let assembly = if init.assemble.unwrap_or(self.model.kind == Kind::Mechanism) {
             let tolerance = settings.consistency_tolerance.unwrap_or(1e-9).min(1e-10);
             let Example { model, q0, v0, .. } = &mut example;
             Some(
@@ -258,70 +258,35 @@ impl Scenario {
         let m = &self.model;
         let mechanism_tables =
             !(self.bodies.is_empty() && self.joints.is_empty() && self.drives.is_empty() && self.forces.is_empty());
-        if mechanism_tables && m.kind != ModelKind::Mechanism {
+        if mechanism_tables && m.kind != Kind::Mechanism {
             bail!("{file}: [[bodies]], [[joints]], [[drives]] and [[forces]] need [model] kind = \"mechanism\"");
         }
-        let pendulum = matches!(m.kind, ModelKind::Pendulum | ModelKind::PendulumTheta);
-        if m.parameters.is_some() && (pendulum || matches!(m.kind, ModelKind::Mechanism | ModelKind::Andrews)) {
+        let pendulum = matches!(m.kind, Kind::Pendulum | Kind::PendulumTheta);
+        if m.parameters.is_some() && matches!(m.kind, Kind::Pendulum | Kind::PendulumTheta | Kind::Mechanism) {
             bail!(
                 "{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none"
             );
         }
-        for (key, set) in [
-            ("mass", m.mass.is_some()),
-            ("length", m.length.is_some()),
-            ("theta0", m.theta0.is_some()),
-            ("omega0", m.omega0.is_some()),
-        ] {
-            if set && !pendulum {
-                bail!("{file}: [model] {key} is only used by the pendulum models");
-            }
+        if !pendulum && let Some(key) = m.pendulum_keys.keys().next() {
+            bail!(
+                "{file}: [model] {key}: only the pendulum models take parameters in [model]; the other built-in models take theirs in [model.parameters]"
+            );
         }
         match m.kind {
-            ModelKind::Pendulum | ModelKind::PendulumTheta => {
-                let d = PendulumParams::default();
-                let gravity = match m.gravity {
-                    None => d.gravity,
-                    Some(GravitySpec::Magnitude(g)) => check(file, "[model] gravity", g, false)?,
+            Kind::Pendulum | Kind::PendulumTheta => {
+                let mut parameters = m.pendulum_keys.clone();
+                match m.gravity {
+                    None => {}
+                    Some(GravitySpec::Magnitude(g)) => {
+                        parameters.insert("gravity".into(), toml::Value::Float(g));
+                    }
                     Some(GravitySpec::Vector(_)) => {
                         bail!("{file}: [model] gravity: the pendulum takes a magnitude (gravity acts along −Y)")
                     }
-                };
-                let p = PendulumParams {
-                    mass: check(file, "[model] mass", m.mass.unwrap_or(d.mass), true)?,
-                    length: check(file, "[model] length", m.length.unwrap_or(d.length), true)?,
-                    gravity,
-                    theta0: m.theta0.unwrap_or(d.theta0),
-                    omega0: m.omega0.unwrap_or(d.omega0),
-                };
-                for (key, x) in [("theta0", p.theta0), ("omega0", p.omega0)] {
-                    if !x.is_finite() {
-                        bail!("{file}: [model] {key} = {x}: must be finite");
-                    }
                 }
-                let example = if m.kind == ModelKind::Pendulum { cartesian_pendulum(p)? } else { theta_pendulum(p)? };
-                Ok((example, Vec::new()))
+                Ok((builtin(file, m.kind, "model", parameters)?, Vec::new()))
             }
-            ModelKind::DoublePendulum
-            | ModelKind::Chain
-            | ModelKind::SliderCrank
-            | ModelKind::FourBar
-            | ModelKind::MovingSupportPendulum
-            | ModelKind::DampedPendulum => {
-                if m.gravity.is_some() {
-                    bail!("{file}: [model] gravity: set it in [model.parameters] for this model");
-                }
-                let kind = serde_json::to_value(m.kind)?.as_str().unwrap_or_default().to_string();
-                let table = m.parameters.clone().unwrap_or_default();
-                Ok((crate::builtin_spec::example(file, &kind, &table)?, Vec::new()))
-            }
-            ModelKind::Andrews => {
-                if m.gravity.is_some() {
-                    bail!("{file}: [model] gravity: Andrews' mechanism is defined without gravity");
-                }
-                Ok((cdyn::models::andrews()?, Vec::new()))
-            }
-            ModelKind::Mechanism => {
+            Kind::Mechanism => {
                 let gravity = match m.gravity {
                     None => [0.0, 0.0],
                     Some(GravitySpec::Vector(g)) if g.iter().all(|x| x.is_finite()) => g,
@@ -338,6 +303,13 @@ impl Scenario {
                 let built = mechanism.build().map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
                 Ok((Example::from_mechanism(built, None), rows))
+            }
+            built_in => {
+                if m.gravity.is_some() {
+                    bail!("{file}: [model] gravity: this model takes its parameters in [model.parameters]");
+                }
+                let parameters = m.parameters.clone().unwrap_or_default();
+                Ok((builtin(file, built_in, "model.parameters", parameters)?, Vec::new()))
             }
         }
     }

@@ -6,7 +6,7 @@
 //! as JSON.
 
 use cdyn::baseline::HandWritten;
-use cdyn::methods::{MethodGains, redundant_cases};
+use cdyn::methods::MethodGains;
 use cdyn::models::{ChainParams, PendulumParams, cartesian_pendulum, chain, small_pendulum};
 use cdyn::small::SmallSimulation;
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
@@ -15,7 +15,7 @@ use std::hint::black_box;
 
 fn example1(c: &mut Criterion) {
     let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
-    let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
+    let control = MethodGains::paper().cvsgf_energy();
     let settings = Settings::new(Scheme::AdamsBashforth3, 0.01, control);
     let mut group = c.benchmark_group("example1_cvsgf_energy_ab3");
     // Every 10 000 steps (100 s) a run starts afresh: much later these gains

@@ -31,7 +31,9 @@ use crate::planar::{BodyId, Element, Mechanism};
 use crate::timefn::TimeFn;
 
 /// The test set's constants (SI units), from `andrews.f`, with every published digit.
-#[allow(clippy::excessive_precision)]
+// The names are the test set's own (see its problem description); a doc
+// line each would only repeat them.
+#[allow(clippy::excessive_precision, missing_docs)]
 pub mod constants {
     pub const M: [f64; 7] = [0.04325, 0.00365, 0.02373, 0.00706, 0.07050, 0.00706, 0.05498];
     pub const I: [f64; 7] = [2.194e-6, 4.410e-7, 5.255e-6, 5.667e-7, 1.169e-5, 5.667e-7, 1.912e-5];

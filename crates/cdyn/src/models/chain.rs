@@ -13,8 +13,11 @@ use crate::reference::PendulumExact;
 /// `theta0` from the downward vertical, rotating rigidly at `omega0` about
 /// the pivot (`v_i = ω × r_i`; at rest when `omega0 = 0`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct ChainParams {
-    /// Number of links (and of masses), at least 1.
+    /// Number of links (and of masses), from 1 to 1 000 000.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "whole_number"))]
     pub n: usize,
     /// Mass of each point mass.
     pub mass: f64,
@@ -40,12 +43,38 @@ impl ChainParams {
         if self.n == 0 {
             return Err(Error::InvalidParameter { name: "n", value: 0.0, reason: "a chain needs at least one link" });
         }
+        // A bound well above any chain worth simulating, so that a slip of the
+        // keyboard is refused instead of exhausting the memory.
+        if self.n > MAX_LINKS {
+            return Err(Error::InvalidParameter {
+                name: "n",
+                value: self.n as f64,
+                reason: "a chain has at most 1000000 links",
+            });
+        }
         positive("mass", self.mass)?;
         positive("length", self.length)?;
         non_negative("gravity", self.gravity)?;
         finite("theta0", self.theta0)?;
         finite("omega0", self.omega0)?;
         Ok(())
+    }
+}
+
+/// The most links [`chain`] accepts.
+const MAX_LINKS: usize = 1_000_000;
+
+/// The number of links as scenario files write it: an integer, or a number
+/// without a fractional part (`n = 20.0` has always been accepted).
+#[cfg(feature = "serde")]
+fn whole_number<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<usize, D::Error> {
+    use serde::Deserialize;
+    use serde::de::{Error as _, Unexpected};
+    let x = f64::deserialize(deserializer)?;
+    if x.fract() == 0.0 && (0.0..=usize::MAX as f64).contains(&x) {
+        Ok(x as usize)
+    } else {
+        Err(D::Error::invalid_value(Unexpected::Float(x), &"a whole number of links"))
     }
 }
 

@@ -11,6 +11,8 @@ use crate::reference::fine_ode::FineOde;
 /// `−c ω`) between it and the ground. The angle of the pivot→centre line is
 /// counter-clockwise from +X, as in [`super::PendulumParams`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct DampedPendulumParams {
     /// Mass of the bar.
     pub mass: f64,

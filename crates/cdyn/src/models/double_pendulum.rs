@@ -11,6 +11,8 @@ use crate::planar::{BodyId, Element, Mechanism};
 /// pinned at the origin. Angles are counter-clockwise from the downward
 /// vertical; `theta2` is the second rod's absolute angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct DoublePendulumParams {
     /// Mass of the first bob.
     pub m1: f64,

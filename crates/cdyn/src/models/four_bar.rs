@@ -13,6 +13,8 @@ use crate::timefn::TimeFn;
 /// left or to the right of the directed line from B (crank tip) to D
 /// (rocker pivot).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum FourBarBranch {
     /// C to the left of B→D (with A left of D: the "open", C-above assembly).
     #[default]
@@ -31,6 +33,8 @@ pub enum FourBarBranch {
 /// As for [`SliderCrankParams`], the driven linkage has no free motion of
 /// its own; an optional `load` pendulum hanging from joint C adds one.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct FourBarParams {
     /// Crank length `a` (AB).
     pub crank_length: f64,
@@ -58,9 +62,12 @@ pub struct FourBarParams {
     pub theta0: f64,
     /// Gravitational acceleration, along −Y.
     pub gravity: f64,
-    /// Which of the two assemblies the linkage starts in (and keeps).
+    /// Which of the two assemblies the linkage starts in (and keeps); in
+    /// scenario files `branch = "left"` or `"right"`.
     pub branch: FourBarBranch,
-    /// Pendulum hanging from joint C.
+    /// Pendulum hanging from joint C; none by default. In scenario files a
+    /// `[model.parameters.load]` table (an empty one is the default
+    /// [`LoadPendulum`]).
     pub load: Option<LoadPendulum>,
 }
 

@@ -21,6 +21,9 @@
 //! [`PendulumParams`] and [`PendulumExact`](crate::reference::PendulumExact)
 //! do. Gravity acts along −Y.
 //!
+//! Every built-in model has a [`Kind`], the name scenario files give it;
+//! [`Kind::example`] builds it from its parameters (with the `serde` feature).
+//!
 //! Fine references: where no closed form exists, a 1-D equation of motion
 //! is integrated by [`crate::reference`]'s fine RK-4 (error about 1e-13).
 
@@ -29,6 +32,7 @@ mod chain;
 mod damped_pendulum;
 mod double_pendulum;
 mod four_bar;
+mod kind;
 mod moving_support;
 mod parts;
 mod pendulum;
@@ -39,6 +43,7 @@ pub use chain::{ChainParams, chain};
 pub use damped_pendulum::{DampedPendulumParams, damped_pendulum};
 pub use double_pendulum::{DoublePendulumParams, double_pendulum};
 pub use four_bar::{FourBarBranch, FourBarParams, four_bar};
+pub use kind::Kind;
 pub use moving_support::{MovingSupportParams, moving_support_pendulum};
 pub use parts::LoadPendulum;
 pub use pendulum::{PendulumParams, SmallPendulum, cartesian_pendulum, small_pendulum, theta_pendulum};
@@ -52,13 +57,18 @@ pub type Observe = Box<dyn Fn(&[f64], &[f64], &mut [f64]) + Send + Sync>;
 
 /// A built-in system ready to simulate.
 pub struct Example {
+    /// The equations of motion.
     pub model: crate::Model,
+    /// Initial positions, on the constraints.
     pub q0: Vec<f64>,
+    /// Initial velocities, on the velocity constraints.
     pub v0: Vec<f64>,
     /// Names of the observables, e.g. `X, Y, VX, VY`; errors against the
     /// reference are reported for the first of them.
     pub observables: Vec<String>,
+    /// Computes the observables of a state (see [`Example::observe`]).
     pub observe: Observe,
+    /// The exact (or finely integrated) solution, where one exists.
     pub reference: Option<Reference>,
 }
 

@@ -15,6 +15,8 @@ use crate::timefn::TimeFn;
 /// exercise `Φ_t` and `Φ_tt`. The rod angle is counter-clockwise from +X,
 /// as in [`super::PendulumParams`].
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct MovingSupportParams {
     /// Mass of the (driven) support point.
     pub support_mass: f64,

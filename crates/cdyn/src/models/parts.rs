@@ -75,6 +75,8 @@ pub(super) fn example(
 /// A point mass on a massless rod hanging from a driven point of a
 /// mechanism. The angle is counter-clockwise from the downward vertical.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct LoadPendulum {
     /// Mass of the bob.
     pub mass: f64,
@@ -87,6 +89,7 @@ pub struct LoadPendulum {
 }
 
 impl Default for LoadPendulum {
+    /// Half a kilogram on a 1 m rod, released at rest 0.2 rad from the bottom.
     fn default() -> Self {
         Self { mass: 0.5, length: 1.0, angle: 0.2, omega: 0.0 }
     }

@@ -11,9 +11,14 @@ use crate::{Constraint, Model, Potential, Scalar};
 
 /// Parameters of the pendulum; the default is the paper's Example 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct PendulumParams {
+    /// Mass of the bob.
     pub mass: f64,
+    /// Length of the rod.
     pub length: f64,
+    /// Gravitational acceleration, along −Y.
     pub gravity: f64,
     /// Initial angle from +X, counter-clockwise.
     pub theta0: f64,

@@ -19,6 +19,8 @@ use crate::timefn::TimeFn;
 /// `load` pendulum hanging from the slider adds one free degree of freedom
 /// that the drive has to shake.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct SliderCrankParams {
     /// Crank radius `r`.
     pub crank_radius: f64,
@@ -42,7 +44,9 @@ pub struct SliderCrankParams {
     pub theta0: f64,
     /// Gravitational acceleration, along −Y.
     pub gravity: f64,
-    /// Pendulum hanging from the slider's centre.
+    /// Pendulum hanging from the slider's centre; none by default. In
+    /// scenario files a `[model.parameters.load]` table (an empty one is the
+    /// default [`LoadPendulum`]).
     pub load: Option<LoadPendulum>,
 }
 
