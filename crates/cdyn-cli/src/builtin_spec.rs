@@ -1,7 +1,6 @@
 //! Built-in mechanisms in scenario files: `[model] kind = "chain"` with
 //! their parameters in `[model.parameters]`; unset ones keep the defaults.
 
-use crate::mechanism_spec::FunctionSpec;
 use anyhow::{Result, anyhow, bail};
 use cdyn::models::{
     ChainParams, DampedPendulumParams, DoublePendulumParams, Example, FourBarParams, MovingSupportParams,
@@ -138,9 +137,8 @@ pub fn example(file: &str, kind: &str, table: &toml::Table) -> Result<Example> {
             let mut numbers = table.clone();
             for (key, slot) in [("support_x", &mut p.support_x), ("support_y", &mut p.support_y)] {
                 if let Some(v) = numbers.remove(key) {
-                    let f = FunctionSpec::deserialize(v)
+                    *slot = cdyn::timefn::TimeFn::deserialize(v)
                         .map_err(|e| anyhow!("{file}: [model.parameters] {key}: {}", e.message()))?;
-                    *slot = f.time_fn();
                 }
             }
             read(

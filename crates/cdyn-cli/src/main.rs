@@ -6,7 +6,6 @@ mod bench;
 mod builtin_spec;
 mod compare;
 mod heatmap;
-mod mechanism_spec;
 mod paper;
 mod plot;
 mod report;
