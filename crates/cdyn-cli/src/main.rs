@@ -5,7 +5,6 @@ mod alloc_count;
 mod bench;
 mod compare;
 mod heatmap;
-mod mechanism_spec;
 mod paper;
 mod plot;
 mod report;

@@ -2,13 +2,13 @@
 //! integrator and the output sampling, in TOML. Every mistake becomes one
 //! line naming the file and the key.
 
-use crate::mechanism_spec::{BodySpec, ElementSpec, MechanismSpec};
 use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
 use cdyn::assemble::assemble;
 use cdyn::error::{Part, positive};
 use cdyn::methods::MethodKeys;
 use cdyn::models::{Example, Kind};
+use cdyn::planar::{Body, Element, Group, Mechanism};
 use cdyn::{Scheme, Settings};
 use serde::Deserialize;
 use std::path::Path;
@@ -25,13 +25,13 @@ pub struct Scenario {
     #[serde(default)]
     pub output: OutputSpec,
     #[serde(default)]
-    pub bodies: Vec<BodySpec>,
-    #[serde(default)]
-    pub joints: Vec<ElementSpec>,
-    #[serde(default)]
-    pub drives: Vec<ElementSpec>,
-    #[serde(default)]
-    pub forces: Vec<ElementSpec>,
+    pub bodies: Vec<Body>,
+    #[serde(default, deserialize_with = "cdyn::planar::format::joints")]
+    pub joints: Vec<Element<String>>,
+    #[serde(default, deserialize_with = "cdyn::planar::format::drives")]
+    pub drives: Vec<Element<String>>,
+    #[serde(default, deserialize_with = "cdyn::planar::format::forces")]
+    pub forces: Vec<Element<String>>,
     /// Axes of a parameter sweep (`cdyn sweep`): key → values.
     pub sweep: Option<toml::Table>,
 }
@@ -292,15 +292,12 @@ impl Scenario {
                     Some(GravitySpec::Vector(g)) if g.iter().all(|x| x.is_finite()) => g,
                     Some(g) => bail!("{file}: [model] gravity = {g:?}: a mechanism takes a finite vector [gx, gy]"),
                 };
-                let spec = MechanismSpec {
-                    gravity,
-                    bodies: &self.bodies,
-                    joints: &self.joints,
-                    drives: &self.drives,
-                    forces: &self.forces,
-                };
-                let (mechanism, entries) = spec.build(file)?;
-                let built = mechanism.build().map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
+                if self.bodies.is_empty() {
+                    bail!("{file}: a mechanism needs at least one [[bodies]] entry");
+                }
+                let entries = self.entries();
+                let built = self.mechanism(gravity).and_then(|m| m.build());
+                let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
                 Ok((Example::from_mechanism(built, None), rows))
             }
@@ -315,12 +312,46 @@ impl Scenario {
     }
 }
 
-/// The library's error, naming the scenario's entry (`joints[2] (revolute)`)
-/// where it is about an element of the mechanism.
+impl Scenario {
+    /// The element lists in the order the mechanism takes them.
+    fn element_lists(&self) -> [(Group, &[Element<String>]); 3] {
+        [(Group::Joints, &self.joints), (Group::Drives, &self.drives), (Group::Forces, &self.forces)]
+    }
+
+    /// For every element of the mechanism, the entry that describes it (`joints[2] (revolute)`).
+    fn entries(&self) -> Vec<String> {
+        let entry = |group: Group, (i, e): (usize, &Element<String>)| format!("{}[{i}] ({})", group.name(), e.kind());
+        self.element_lists()
+            .into_iter()
+            .flat_map(|(group, list)| list.iter().enumerate().map(move |e| entry(group, e)))
+            .collect()
+    }
+
+    /// The mechanism of the `[[bodies]]`, `[[joints]]`, `[[drives]]` and
+    /// `[[forces]]` entries, its elements in the order of [`Scenario::entries`].
+    fn mechanism(&self, gravity: [f64; 2]) -> cdyn::Result<Mechanism> {
+        let mut m = Mechanism::new(gravity);
+        for body in &self.bodies {
+            m.push(body.clone());
+        }
+        for (_, list) in self.element_lists() {
+            for element in list {
+                m.add_named(element.clone())?;
+            }
+        }
+        Ok(m)
+    }
+}
+
+/// The library's error, naming the scenario's entry (`joints[2] (revolute)`,
+/// `bodies[0] (crank)`) where it is about a part of the mechanism.
 fn name_entry(error: cdyn::Error, entries: &[String]) -> String {
     match error {
         cdyn::Error::InvalidModel { at: Part::Element { index, .. }, problem } if index < entries.len() => {
             format!("{}: {problem}", entries[index])
+        }
+        cdyn::Error::InvalidModel { at: Part::Body { index, name }, problem } => {
+            format!("bodies[{index}] ({name}): {problem}")
         }
         other => other.to_string(),
     }

@@ -125,3 +125,28 @@ fn mechanism_mistakes_name_the_entry() {
         }
     }
 }
+
+#[test]
+fn scenario_format_mistakes_fail_cleanly() {
+    let drive = |function: &str| {
+        format!("{CRANK}[[drives]]\nkind = \"relative_angle\"\na = \"ground\"\nb = \"crank\"\nfunction = {function}\n")
+    };
+    let cases: Vec<(String, &[&str])> = vec![
+        (drive("{ polynom = [1.0] }"), &["drives[0] (relative_angle)", "polynom"]),
+        (drive("{ }"), &["drives[0] (relative_angle)", "polynomial"]),
+        (
+            format!("{CRANK}[[joints]]\nkind = \"spring\"\na = \"ground\"\nb = \"crank\"\nstiffness = 1.0\n"),
+            &["joints[1] (spring)", "[[forces]]"],
+        ),
+        (
+            format!("{CRANK}[[bodies]]\nname = \"crank\"\nmass = 1.0\nposition = [0.0, 0.0]\n"),
+            &["bodies[1] (crank)", "already exists"],
+        ),
+    ];
+    for (text, needles) in cases {
+        let line = error_of(&text);
+        for n in needles {
+            assert!(line.contains(n), "{line:?} should mention {n:?} for:\n{text}");
+        }
+    }
+}

@@ -183,6 +183,23 @@ pub enum Problem {
         /// The missing body's position.
         index: usize,
     },
+    /// An element names a body that is neither a body of the mechanism nor the ground.
+    #[error("{key} = {name:?}: no body of that name (and not \"ground\")")]
+    UnknownBody {
+        /// The key naming the body (`a`, `b`, `body`).
+        key: &'static str,
+        /// The name given.
+        name: String,
+    },
+    /// A body named `ground` (which elements use for the world frame) or nothing.
+    #[error("name {name:?} is reserved or empty")]
+    ReservedName {
+        /// The name given.
+        name: String,
+    },
+    /// A second body with the name of an earlier one.
+    #[error("a body with this name already exists")]
+    DuplicateName,
     /// An element connects a body to itself.
     #[error("connects {body} to itself")]
     SameBody {

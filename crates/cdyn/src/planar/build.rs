@@ -1,0 +1,312 @@
+//! Turning a [`Mechanism`] into a [`Model`]: bodies become coordinates and
+//! masses, every element becomes the constraint, potential or force block
+//! of its kind on the coordinates of the bodies it connects.
+
+use super::body::{Body, BodyId};
+use super::constraints::{AnchoredRod, Distance, OnLine, PointRod, Prescribed, RelativeAngle, Revolute};
+use super::element::{Coordinate, Element};
+use super::ends::{End, idx_array, with_k};
+use super::loads::{Damper, Gravity, PointLoad, RotaryDamper, Spring, Torque, Torsion};
+use super::mechanism::Mechanism;
+use crate::error::{Error, Part, Problem, Result, finite, non_negative, positive};
+use crate::model::{Model, ModelBuilder};
+use crate::timefn::TimeFn;
+
+/// A mechanism turned into a model, with its initial state.
+pub struct Built {
+    /// The model: coordinates `x, y[, angle]` per body, in body order.
+    pub model: Model,
+    /// Initial positions.
+    pub q0: Vec<f64>,
+    /// Initial velocities.
+    pub v0: Vec<f64>,
+    /// `body.x`, `body.y`, `body.angle` for every coordinate.
+    pub names: Vec<String>,
+    /// Index of each body's first coordinate.
+    pub offsets: Vec<usize>,
+    /// For every constraint row, the index of the element it comes from.
+    pub row_elements: Vec<usize>,
+}
+
+impl Mechanism {
+    /// The model, its initial state and coordinate names. Errors name the
+    /// body or element (by position, from 0) at fault.
+    pub fn build(&self) -> Result<Built> {
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            let value = self.gravity.into_iter().find(|g| !g.is_finite()).unwrap_or(f64::NAN);
+            return Err(Error::InvalidParameter { name: "gravity", value, reason: "must be finite" });
+        }
+        let mut mass = Vec::new();
+        let (mut q0, mut v0, mut names, mut offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (i, b) in self.bodies.iter().enumerate() {
+            b.check(i, &self.bodies[..i])?;
+            offsets.push(mass.len());
+            mass.extend([b.mass, b.mass]);
+            q0.extend(b.position);
+            v0.extend(b.velocity);
+            names.extend([format!("{}.x", b.name), format!("{}.y", b.name)]);
+            if let Some(inertia) = b.inertia {
+                mass.push(inertia);
+                q0.push(b.angle);
+                v0.push(b.angular_velocity);
+                names.push(format!("{}.angle", b.name));
+            }
+        }
+        let mut builder = Model::builder(mass);
+        for (i, b) in self.bodies.iter().enumerate() {
+            if self.gravity != [0.0, 0.0] {
+                let w = [-b.mass * self.gravity[0], -b.mass * self.gravity[1]];
+                builder = builder.potential(Gravity { w }, [offsets[i], offsets[i] + 1]);
+            }
+        }
+        let layout = Layout { bodies: &self.bodies, offsets: &offsets };
+        let mut row_elements = Vec::new();
+        for (k, e) in self.elements.iter().enumerate() {
+            builder = layout.add(builder, e).map_err(|why| why.at(Part::Element { index: k, kind: e.kind() }))?;
+            row_elements.resize(builder.rows(), k);
+        }
+        Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements })
+    }
+}
+
+/// The checked bodies and where each one's coordinates start: what an
+/// element needs to find the coordinates it reads.
+struct Layout<'a> {
+    bodies: &'a [Body],
+    offsets: &'a [usize],
+}
+
+impl Layout<'_> {
+    /// Adds element `e` to the model.
+    fn add(&self, builder: ModelBuilder, e: &Element) -> Result<ModelBuilder> {
+        match *e {
+            Element::Revolute { a, pa, b, pb } => self.revolute(builder, a, pa, b, pb),
+            Element::Prismatic { a, pa, b, pb, axis } => self.prismatic(builder, a, pa, b, pb, axis),
+            Element::Distance { a, pa, b, pb, length } => self.distance(builder, a, pa, b, pb, length),
+            Element::FixedAngle { a, b, angle } => {
+                finite("angle", angle)?;
+                self.relative_angle(builder, a, b, TimeFn::constant(angle))
+            }
+            Element::DriveCoordinate { body, coordinate, ref f } => self.coordinate(builder, body, coordinate, f),
+            Element::DriveAngle { a, b, ref f } => {
+                finite_fn(f)?;
+                self.relative_angle(builder, a, b, f.clone())
+            }
+            Element::Spring { a, pa, b, pb, stiffness, rest_length } => {
+                let (k, l0) = (non_negative("stiffness", stiffness)?, non_negative("rest_length", rest_length)?);
+                let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
+                Ok(with_k!(idx, K, builder.potential(Spring::<K> { a: ea, b: eb, k, l0 }, idx_array(&idx))))
+            }
+            Element::TorsionSpring { a, b, stiffness, rest_angle } => {
+                let k = non_negative("stiffness", stiffness)?;
+                let rest = finite("rest_angle", rest_angle)?;
+                let (ia, ib, idx) = self.two_angles(a, b)?;
+                Ok(with_k!(idx, K, builder.potential(Torsion::<K> { a: ia, b: ib, k, rest }, idx_array(&idx))))
+            }
+            Element::Damper { a, pa, b, pb, damping } => {
+                let c = non_negative("damping", damping)?;
+                let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
+                Ok(with_k!(idx, K, builder.force(Damper::<K> { a: ea, b: eb, c }, idx_array(&idx))))
+            }
+            Element::RotaryDamper { a, b, damping } => {
+                let c = non_negative("damping", damping)?;
+                let (ia, ib, idx) = self.two_angles(a, b)?;
+                Ok(with_k!(idx, K, builder.force(RotaryDamper::<K> { a: ia, b: ib, c }, idx_array(&idx))))
+            }
+            Element::AppliedForce { body, point, ref fx, ref fy } => self.applied_force(builder, body, point, fx, fy),
+            Element::AppliedTorque { body, ref f } => {
+                finite_fn(f)?;
+                if body == BodyId::Ground {
+                    return Err(Problem::OnGround("turned by a torque").into());
+                }
+                let mut idx = Vec::new();
+                self.attach_angle(body, &mut idx)?;
+                Ok(builder.force(Torque { f: f.clone() }, [idx[0]]))
+            }
+        }
+    }
+
+    fn revolute(
+        &self,
+        builder: ModelBuilder,
+        a: BodyId,
+        pa: [f64; 2],
+        b: BodyId,
+        pb: [f64; 2],
+    ) -> Result<ModelBuilder> {
+        let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
+        Ok(with_k!(idx, K, builder.constrain(Revolute::<K> { a: ea, b: eb }, idx_array(&idx))))
+    }
+
+    /// A rod between two point masses, or a point mass and the ground, gets
+    /// its fixed-layout form (`PointRod`, `AnchoredRod`): chains are made of
+    /// them and their derivative passes are the hot path.
+    fn distance(
+        &self,
+        builder: ModelBuilder,
+        a: BodyId,
+        pa: [f64; 2],
+        b: BodyId,
+        pb: [f64; 2],
+        length: f64,
+    ) -> Result<ModelBuilder> {
+        self.distinct(a, b)?;
+        let length = positive("length", length)?;
+        let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
+        Ok(match (ea, eb) {
+            (End::Point { .. }, End::Point { .. }) => builder.constrain(PointRod { length }, idx_array(&idx)),
+            (End::Ground { point: anchor }, End::Point { .. }) | (End::Point { .. }, End::Ground { point: anchor }) => {
+                builder.constrain(AnchoredRod { anchor, length }, idx_array(&idx))
+            }
+            _ => with_k!(idx, K, builder.constrain(Distance::<K> { a: ea, b: eb, length }, idx_array(&idx))),
+        })
+    }
+
+    /// The point stays on the line; when both ends can turn (or one is the
+    /// ground) their relative angle is also held at its initial value, as
+    /// a slider in a guide does.
+    fn prismatic(
+        &self,
+        builder: ModelBuilder,
+        a: BodyId,
+        pa: [f64; 2],
+        b: BodyId,
+        pb: [f64; 2],
+        axis: [f64; 2],
+    ) -> Result<ModelBuilder> {
+        self.distinct(a, b)?;
+        let norm = positive("|axis|", axis[0].hypot(axis[1]))?;
+        let normal = [-axis[1] / norm, axis[0] / norm];
+        let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
+        let builder = with_k!(idx, K, builder.constrain(OnLine::<K> { a: ea, b: eb, normal }, idx_array(&idx)));
+        let body = |id| match id {
+            BodyId::Ground => None,
+            BodyId::Body(i) => self.bodies.get(i),
+        };
+        if [a, b].into_iter().all(|id| body(id).is_none_or(|b| b.inertia.is_some())) {
+            let angle = |id| body(id).map_or(0.0, |b: &Body| b.angle);
+            self.relative_angle(builder, a, b, TimeFn::constant(angle(b) - angle(a)))
+        } else {
+            Ok(builder)
+        }
+    }
+
+    /// `φ_b − φ_a = f(t)`: fixed angles, angle drives and prismatic guides.
+    fn relative_angle(&self, builder: ModelBuilder, a: BodyId, b: BodyId, f: TimeFn) -> Result<ModelBuilder> {
+        let (ia, ib, idx) = self.two_angles(a, b)?;
+        Ok(with_k!(idx, K, builder.constrain(RelativeAngle::<K> { a: ia, b: ib, f }, idx_array(&idx))))
+    }
+
+    fn coordinate(
+        &self,
+        builder: ModelBuilder,
+        body: BodyId,
+        coordinate: Coordinate,
+        f: &TimeFn,
+    ) -> Result<ModelBuilder> {
+        finite_fn(f)?;
+        let BodyId::Body(i) = body else {
+            return Err(Problem::OnGround("driven").into());
+        };
+        let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
+        let k = match coordinate {
+            Coordinate::X => 0,
+            Coordinate::Y => 1,
+            Coordinate::Angle if b.inertia.is_some() => 2,
+            Coordinate::Angle => return Err(Problem::NoAngle { body: b.name.clone() }.into()),
+        };
+        Ok(builder.constrain(Prescribed { f: f.clone() }, [self.offsets[i] + k]))
+    }
+
+    fn applied_force(
+        &self,
+        builder: ModelBuilder,
+        body: BodyId,
+        point: [f64; 2],
+        fx: &TimeFn,
+        fy: &TimeFn,
+    ) -> Result<ModelBuilder> {
+        finite_fn(fx)?;
+        finite_fn(fy)?;
+        if body == BodyId::Ground {
+            return Err(Problem::OnGround("pushed by a force").into());
+        }
+        let mut idx = Vec::new();
+        let end = self.attach(body, point, &mut idx)?;
+        Ok(with_k!(idx, K, builder.force(PointLoad::<K> { end, fx: fx.clone(), fy: fy.clone() }, idx_array(&idx))))
+    }
+
+    /// Both ends of a two-point element, on two different bodies, and the
+    /// coordinates they read (`a`'s first).
+    fn two_points(&self, a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2]) -> Result<(End, End, Vec<usize>)> {
+        self.distinct(a, b)?;
+        let mut idx = Vec::new();
+        let ea = self.attach(a, pa, &mut idx)?;
+        let eb = self.attach(b, pb, &mut idx)?;
+        Ok((ea, eb, idx))
+    }
+
+    /// The angle coordinates of two different bodies (`None` for the
+    /// ground), and the coordinates they read.
+    fn two_angles(&self, a: BodyId, b: BodyId) -> Result<(Option<usize>, Option<usize>, Vec<usize>)> {
+        self.distinct(a, b)?;
+        let mut idx = Vec::new();
+        let ia = self.attach_angle(a, &mut idx)?;
+        let ib = self.attach_angle(b, &mut idx)?;
+        Ok((ia, ib, idx))
+    }
+
+    /// Where a body's coordinates are and what it is, for one end of an element.
+    fn attach(&self, id: BodyId, point: [f64; 2], idx: &mut Vec<usize>) -> Result<End> {
+        for p in point {
+            finite("point", p)?;
+        }
+        let BodyId::Body(i) = id else {
+            return Ok(End::Ground { point });
+        };
+        let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
+        let (at, first) = (idx.len(), self.offsets[i]);
+        match b.inertia {
+            Some(_) => {
+                idx.extend([first, first + 1, first + 2]);
+                Ok(End::Rigid { at, local: point })
+            }
+            None if point == [0.0, 0.0] => {
+                idx.extend([first, first + 1]);
+                Ok(End::Point { at })
+            }
+            None => Err(Problem::PointMassOffset { body: b.name.clone() }.into()),
+        }
+    }
+
+    /// The angle coordinate of a body, for elements on relative angles.
+    fn attach_angle(&self, id: BodyId, idx: &mut Vec<usize>) -> Result<Option<usize>> {
+        let BodyId::Body(i) = id else {
+            return Ok(None);
+        };
+        let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
+        if b.inertia.is_none() {
+            return Err(Problem::NoAngle { body: b.name.clone() }.into());
+        }
+        idx.push(self.offsets[i] + 2);
+        Ok(Some(idx.len() - 1))
+    }
+
+    /// An element connects two different bodies.
+    fn distinct(&self, a: BodyId, b: BodyId) -> Result<()> {
+        if a == b { Err(Problem::SameBody { body: self.name(a) }.into()) } else { Ok(()) }
+    }
+
+    /// A body's name for messages: its own, `ground`, or its position if it does not exist.
+    fn name(&self, id: BodyId) -> String {
+        match id {
+            BodyId::Ground => "ground".into(),
+            BodyId::Body(i) => self.bodies.get(i).map_or_else(|| format!("body {i}"), |b| b.name.clone()),
+        }
+    }
+}
+
+/// Drives and loads need finite coefficients: a NaN would only show up mid-run.
+fn finite_fn(f: &TimeFn) -> Result<()> {
+    if f.is_finite() { Ok(()) } else { Err(Problem::NonFiniteFunction.into()) }
+}

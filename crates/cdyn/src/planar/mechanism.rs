@@ -1,0 +1,90 @@
+//! A mechanism under construction: its bodies, elements and gravity, and
+//! the ways to add to it — by [`BodyId`] in code, by name from a scenario
+//! file.
+
+use super::body::{Body, BodyId, GROUND};
+use super::element::Element;
+use crate::error::{Part, Problem, Result};
+
+/// A planar mechanism under construction; [`Mechanism::build`] turns it into a model.
+#[derive(Debug, Clone, Default)]
+pub struct Mechanism {
+    /// The bodies, in coordinate order.
+    pub bodies: Vec<Body>,
+    /// The joints, drives and forces, in the order their rows and terms are added.
+    pub elements: Vec<Element>,
+    /// Gravitational acceleration, world axes.
+    pub gravity: [f64; 2],
+}
+
+impl Mechanism {
+    /// An empty mechanism under `gravity`.
+    pub fn new(gravity: [f64; 2]) -> Self {
+        Self { gravity, ..Self::default() }
+    }
+
+    /// Adds a rigid body at `position` with angle `angle`, at rest.
+    pub fn rigid(&mut self, name: &str, mass: f64, inertia: f64, position: [f64; 2], angle: f64) -> BodyId {
+        self.push(Body {
+            name: name.into(),
+            mass,
+            inertia: Some(inertia),
+            position,
+            angle,
+            velocity: [0.0; 2],
+            angular_velocity: 0.0,
+        })
+    }
+
+    /// Adds a point mass at `position`, at rest.
+    pub fn point(&mut self, name: &str, mass: f64, position: [f64; 2]) -> BodyId {
+        self.push(Body {
+            name: name.into(),
+            mass,
+            inertia: None,
+            position,
+            angle: 0.0,
+            velocity: [0.0; 2],
+            angular_velocity: 0.0,
+        })
+    }
+
+    /// Adds a body; it is checked by [`Mechanism::build`].
+    pub fn push(&mut self, body: Body) -> BodyId {
+        self.bodies.push(body);
+        BodyId::Body(self.bodies.len() - 1)
+    }
+
+    /// Adds an element; it is checked by [`Mechanism::build`].
+    pub fn add(&mut self, element: Element) -> &mut Self {
+        self.elements.push(element);
+        self
+    }
+
+    /// Adds an element that names its bodies, as a scenario file does:
+    /// `"ground"` or the name of a body added before. An unknown name is
+    /// an error at the element's position in [`Mechanism::elements`].
+    pub fn add_named(&mut self, element: Element<String>) -> Result<&mut Self> {
+        let at = Part::Element { index: self.elements.len(), kind: element.kind() };
+        let element = element
+            .try_map_bodies(|key, name| self.find(&name).ok_or(Problem::UnknownBody { key, name }))
+            .map_err(|problem| problem.at(at))?;
+        Ok(self.add(element))
+    }
+
+    /// The body called `name`, or the ground for `"ground"`.
+    pub fn find(&self, name: &str) -> Option<BodyId> {
+        if name == GROUND {
+            return Some(BodyId::Ground);
+        }
+        self.bodies.iter().position(|b| b.name == name).map(BodyId::Body)
+    }
+
+    /// The body `id` refers to; `None` for the ground or a body that does not exist.
+    pub fn body(&self, id: BodyId) -> Option<&Body> {
+        match id {
+            BodyId::Ground => None,
+            BodyId::Body(i) => self.bodies.get(i),
+        }
+    }
+}
