@@ -216,6 +216,12 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     }
 
     /// Factors `S = Φ_q M⁻¹ Φ_qᵀ` as `L D Lᵀ`, with the pivot test of the general kernel.
+    ///
+    /// A second copy of the factorization on purpose: `linalg::Schur` reads
+    /// every entry through index arrays and eliminates left-looking with
+    /// `(L D)_jk`, so using it here would add indirection to the shortest
+    /// steps and change the rounding of `d_j` for `M ≥ 2` (final states no
+    /// longer bit-identical). What both must agree on, the pivot test, is shared.
     #[inline(always)]
     fn factor(&mut self) -> Result<(), Breakdown> {
         for j in 0..M {
