@@ -2,9 +2,9 @@
 //! data (Eqs. 13, 19, 20–27, 28–40, 48–53) and the control term `U(x, t)`
 //! they add to the uncontrolled state equations.
 
-use crate::energy;
 use crate::error::{Result, non_negative, positive};
 use crate::integrate::Application;
+use crate::mass::MassMatrix;
 
 /// A gain either fixed, or set at every evaluation from a target decay rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,8 +84,10 @@ pub struct Control {
 
 /// What the control laws read of one evaluation of the dynamics.
 pub(crate) trait Evaluation {
-    /// The diagonal of `M`.
-    fn mass(&self) -> &[f64];
+    /// The kind of mass matrix.
+    type Mass: MassMatrix;
+    /// The mass matrix `M`.
+    fn mass(&self) -> &Self::Mass;
     fn phi(&self) -> &[f64];
     fn phi_dot(&self) -> &[f64];
     /// `∇V`, which is also `Ψ_q`.
@@ -181,7 +183,7 @@ impl Control {
                 let (rho_q, rho_v) = match gain {
                     EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
                     EnergyGain::Rate { alpha_e } => {
-                        let g2 = energy::psi_v_norm2(mass, v);
+                        let g2 = mass.psi_v_norm2(v);
                         (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
                     }
                 };
@@ -191,24 +193,19 @@ impl Control {
                         *u -= 2.0 * rho_q * psi * g;
                     }
                 }
-                for ((u, m), v) in u_v.iter_mut().zip(mass).zip(v) {
-                    *u -= 2.0 * rho_v * psi * m * v;
-                }
+                mass.add_psi_v(v, -(2.0 * rho_v * psi), u_v);
             }
             Energy::Baumgarte { eta } => {
                 // μ = [Ψ_v A_geo + Ψ_q v − Ė + η Ψ] / (Ψ_v M⁻¹ Ψ_vᵀ), with
-                // A_geo = A + U_v so far, Ψ_v = Mv, M⁻¹ Ψ_vᵀ = v (Eqs. 17–19).
-                let two_t = 2.0 * energy::kinetic(mass, v);
+                // A_geo = A + U_v so far and Ψ_v M⁻¹ Ψ_vᵀ = vᵀ M v = 2T (Eqs. 17–19).
+                let two_t = 2.0 * mass.kinetic(v);
                 if two_t > REST {
                     let (acc, grad) = (d.acc(), d.grad_potential());
-                    let mut num = eta * psi - e_dot;
-                    for i in 0..v.len() {
-                        num += mass[i] * v[i] * (acc[i] + u_v[i]) + grad[i] * v[i];
-                    }
+                    let geometric = |i: usize| acc[i] + u_v[i];
+                    let num = mass.psi_v_dot(v, geometric, |i| grad[i] * v[i], eta * psi - e_dot);
                     let mu = num / two_t;
-                    for (u, v) in u_v.iter_mut().zip(v) {
-                        *u -= mu * v;
-                    }
+                    // U_v −= μ M⁻¹ Ψ_vᵀ   (Eq. 19)
+                    mass.add_inverse_psi_v(v, -mu, u_v);
                 }
             }
         }

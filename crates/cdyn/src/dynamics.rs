@@ -5,6 +5,7 @@ use crate::constraint::ConstraintValues;
 use crate::energy;
 use crate::linalg::Schur;
 pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
+use crate::mass::MassMatrix;
 use crate::model::{Model, Pattern};
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
@@ -46,7 +47,7 @@ impl Dynamics {
             force_power: 0.0,
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
-            schur: Schur::new(model.pattern(), model.inv_mass(), solver),
+            schur: Schur::new(model.pattern(), model.mass(), solver),
         }
     }
 
@@ -59,10 +60,8 @@ impl Dynamics {
             *f = -g;
         }
         self.force_power = model.add_forces(q, v, t, &mut self.force);
-        let w = model.inv_mass();
-        for ((a, f), w) in self.acc.iter_mut().zip(&self.force).zip(w) {
-            *a = f * w;
-        }
+        // The unconstrained acceleration M⁻¹ G, which the constraint pass needs for `Φ_q M⁻¹ G − γ`.
+        model.mass().solve(&self.force, &mut self.acc);
         // λ starts as the right-hand side of (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
         let out = ConstraintValues {
             free_acc: &self.acc,
@@ -79,7 +78,7 @@ impl Dynamics {
         }
         self.schur.factor_and_solve(&self.jac, &mut self.lambda)?;
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        add_weighted_jt(model.pattern(), &self.jac, &self.lambda, w, -1.0, &mut self.acc);
+        add_weighted_jt(model.pattern(), &self.jac, &self.lambda, model.mass().inverse(), -1.0, &mut self.acc);
         Ok(())
     }
 
@@ -89,7 +88,7 @@ impl Dynamics {
     /// Uses the factorization of the last [`evaluate`](Self::evaluate).
     pub fn add_constraint_response(&self, model: &Model, b: &mut [f64], out: &mut [f64]) {
         self.schur.solve(b);
-        add_weighted_jt(model.pattern(), &self.jac, b, model.inv_mass(), -1.0, out);
+        add_weighted_jt(model.pattern(), &self.jac, b, model.mass().inverse(), -1.0, out);
     }
 
     /// The energy input `Ė = F·v + λᵀ Φ_t` of the last evaluation (see [`crate::energy`]).

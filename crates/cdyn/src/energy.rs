@@ -6,27 +6,20 @@
 //! (the constraint force `−Φ_qᵀ λ` times `v`, with `Φ_q v = −Φ_t`). For a
 //! scleronomic system `Φ_t = 0` exactly, so drift off `Φ̇ = 0` is not
 //! mistaken for an energy input.
+//!
+//! The kinetic energy `T = ½ vᵀ M v` and `Ψ_v = (M v)ᵀ` are products with the
+//! mass matrix, so they live with it ([`crate::mass::MassMatrix`]).
 
-/// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e` for the diagonal `mass`, with `V` evaluated elsewhere.
-#[inline(always)]
-pub fn psi(mass: &[f64], v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
-    kinetic(mass, v) + potential - e0 - e
-}
+use crate::mass::MassMatrix;
 
-/// Kinetic energy `½ vᵀ M v` for the diagonal `mass`.
+/// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e`, with `V` evaluated elsewhere.
 #[inline(always)]
-pub fn kinetic(mass: &[f64], v: &[f64]) -> f64 {
-    0.5 * mass.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
+pub fn psi(mass: &impl MassMatrix, v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
+    mass.kinetic(v) + potential - e0 - e
 }
 
 /// `Ė = F·v + λᵀ Φ_t` from its parts.
 #[inline(always)]
 pub fn power(force_power: f64, lambda: &[f64], phi_t: &[f64]) -> f64 {
     force_power + lambda.iter().zip(phi_t).map(|(l, p)| l * p).sum::<f64>()
-}
-
-/// `|Ψ_v|² = |M v|²` for the diagonal `mass`.
-#[inline(always)]
-pub fn psi_v_norm2(mass: &[f64], v: &[f64]) -> f64 {
-    mass.iter().zip(v).map(|(m, v)| (m * v) * (m * v)).sum()
 }

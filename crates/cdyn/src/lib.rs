@@ -12,6 +12,7 @@ pub mod error;
 pub mod force;
 pub mod integrate;
 mod linalg;
+pub mod mass;
 pub mod methods;
 pub mod model;
 pub mod models;

@@ -13,6 +13,7 @@
 //! the pattern faer's symbolic Cholesky finds (`sparse.rs`), with an AMD
 //! ordering when it fills less than the natural one.
 
+use crate::mass::DiagonalMass;
 use crate::sparse::{Pattern, Structure};
 
 /// Why `S` could not be factored.
@@ -40,10 +41,25 @@ pub const SPARSE_FROM: usize = 48;
 
 /// Pivots below this fraction of the assembled diagonal mean the row
 /// depends on the rows before it.
-pub(crate) const PIVOT_TOLERANCE: f64 = 1e-12;
+const PIVOT_TOLERANCE: f64 = 1e-12;
+
+/// The pivot test of every `L D Lᵀ` of `S` (this module's and the small
+/// systems' one in `small.rs`): pivot `d` of the row `row()` whose assembled
+/// diagonal entry is `s_jj`, for the Jacobian values `jac`. A pivot that is
+/// not positive beyond round-off means a dependent row — unless the state
+/// has blown up, which is told apart so that it is not reported as singular.
+#[inline(always)]
+pub(crate) fn check_pivot(d: f64, s_jj: f64, jac: &[f64], row: impl FnOnce() -> usize) -> Result<(), Breakdown> {
+    if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
+        let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
+        return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(row()) });
+    }
+    Ok(())
+}
 
 /// For every pair of rows `(a ≥ b)` sharing a coordinate, the products
-/// that make `S_ab`, as `(a, b, ja, jb, col)`.
+/// that make `S_ab`, as `(a, b, ja, jb, col)`; `col` selects the weight
+/// `(M⁻¹)_col,col` of the product.
 pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize, usize, usize)> {
     let m = pattern.start.len() - 1;
     // For every coordinate, the Jacobian entries that touch it.
@@ -121,8 +137,11 @@ fn index(i: usize) -> u32 {
 }
 
 impl Schur {
-    pub fn new(pattern: &Pattern, inv_mass: &[f64], solver: LinearSolver) -> Self {
+    /// The structure of `S = Φ_q M⁻¹ Φ_qᵀ` for this Jacobian pattern, with
+    /// the weights of its products taken from the (constant) mass matrix.
+    pub fn new(pattern: &Pattern, mass: &DiagonalMass, solver: LinearSolver) -> Self {
         let m = pattern.start.len() - 1;
+        let inv_mass = mass.inverse();
         let products = products(pattern, inv_mass.len());
         let sparse = match solver {
             LinearSolver::Auto => m >= SPARSE_FROM,
@@ -286,10 +305,7 @@ impl Schur {
                     }
                 }
             }
-            if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
-                let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
-                return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(order[j] as usize) });
-            }
+            check_pivot(d, s_jj, jac, || order[j] as usize)?;
             let inv = 1.0 / d;
             unsafe {
                 *inv_d.get_unchecked_mut(j) = inv;
@@ -412,9 +428,10 @@ mod tests {
         for (name, (pattern, n)) in [("star", star(5, 12)), ("net", net(8, 17))] {
             let m = pattern.start.len() - 1;
             let jac = values(pattern.nnz(), 0.3);
-            let inv_mass: Vec<f64> = values(n, 1.1).iter().map(|x| 1.0 / (1.5 + x)).collect();
+            let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+            let inv_mass = mass.inverse();
             for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
-                let mut s = Schur::new(&pattern, &inv_mass, solver);
+                let mut s = Schur::new(&pattern, &mass, solver);
                 // The sparse analysis must have reordered (the natural order fills).
                 let natural = s.order.iter().enumerate().all(|(i, &o)| i == o as usize);
                 assert_eq!(!natural, solver == LinearSolver::Sparse, "{name}");
@@ -438,7 +455,7 @@ mod tests {
                     } else {
                         s.solve(&mut x);
                     }
-                    let r = residual(&pattern, &jac, &inv_mass, &x, &b);
+                    let r = residual(&pattern, &jac, inv_mass, &x, &b);
                     assert!(r < 1e-12, "{name} {solver:?}: relative residual {r:e}");
                 }
             }
@@ -458,10 +475,10 @@ mod tests {
         let tail = jac.len() - k;
         let copy = jac[tail - k..tail].to_vec();
         jac[tail..].copy_from_slice(&copy);
-        let inv_mass = vec![1.0; n];
+        let mass = DiagonalMass::new(vec![1.0; n]).unwrap();
         let m = pattern.start.len() - 1;
         for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
-            let mut s = Schur::new(&pattern, &inv_mass, solver);
+            let mut s = Schur::new(&pattern, &mass, solver);
             let err = s.factor_and_solve(&jac, &mut vec![1.0; m]).unwrap_err();
             assert!(matches!(err, Breakdown::Singular(r) if r == m - 1 || r == m - 2), "{solver:?}: {err:?}");
             let mut bad = values(pattern.nnz(), 0.7);

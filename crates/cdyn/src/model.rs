@@ -1,22 +1,18 @@
-//! What a system is: coordinates with a constant diagonal mass matrix,
-//! holonomic constraint elements, potentials and non-conservative forces.
-//!
-//! In redundant (Cartesian) coordinates every body's mass matrix is
-//! constant and diagonal — `(m, m, I)` for a planar body, `m` per axis for a
-//! point mass — which is what makes the formulation cheap: `M⁻¹` is free and
-//! `Φ_q M⁻¹ Φ_qᵀ` inherits the sparsity of the constraints.
+//! What a system is: coordinates with a mass matrix (see [`crate::mass`]
+//! for why it is constant and diagonal), holonomic constraint elements,
+//! potentials and non-conservative forces.
 
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
+use crate::mass::{DiagonalMass, MassMatrix};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
 pub use crate::sparse::Pattern;
 
 /// A constrained mechanical system, ready to simulate.
 pub struct Model {
-    mass: Vec<f64>,
-    inv_mass: Vec<f64>,
+    mass: DiagonalMass,
     constraints: Vec<Box<dyn ConstraintBlock>>,
     potentials: Vec<Box<dyn PotentialBlock>>,
     forces: Vec<Box<dyn ForceBlock>>,
@@ -116,10 +112,10 @@ impl ModelBuilder {
                 pattern.start.push(last + b.width() as u32);
             }
         }
-        check_sizes(&self.mass, pattern.start.len() - 1)?;
+        let mass = DiagonalMass::new(self.mass)?;
+        check_rows(pattern.start.len() - 1, n)?;
         Ok(Model {
-            inv_mass: self.mass.iter().map(|m| 1.0 / m).collect(),
-            mass: self.mass,
+            mass,
             constraints: self.constraints,
             potentials: self.potentials,
             forces: self.forces,
@@ -129,13 +125,9 @@ impl ModelBuilder {
     }
 }
 
-/// Checks every mass is positive and there are no more constraint rows
-/// `m` than coordinates (`m = n` is allowed: a fully driven, kinematic mechanism).
-pub(crate) fn check_sizes(mass: &[f64], m: usize) -> Result<()> {
-    for &x in mass {
-        crate::error::positive("mass", x)?;
-    }
-    let n = mass.len();
+/// Checks there are no more constraint rows `m` than coordinates `n`
+/// (`m = n` is allowed: a fully driven, kinematic mechanism).
+pub(crate) fn check_rows(m: usize, n: usize) -> Result<()> {
     if m > n {
         return Err(Problem::TooManyConstraints { m, n }.into());
     }
@@ -150,17 +142,15 @@ impl Model {
 
     /// Number of coordinates `n`.
     pub fn n(&self) -> usize {
-        self.mass.len()
+        self.mass.n()
     }
     /// Number of constraint rows `m`.
     pub fn m(&self) -> usize {
         self.pattern.start.len() - 1
     }
-    pub fn mass(&self) -> &[f64] {
+    /// The mass matrix `M`.
+    pub fn mass(&self) -> &DiagonalMass {
         &self.mass
-    }
-    pub fn inv_mass(&self) -> &[f64] {
-        &self.inv_mass
     }
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
@@ -208,6 +198,6 @@ impl Model {
 
     /// Kinetic energy `½ vᵀ M v`.
     pub fn kinetic(&self, v: &[f64]) -> f64 {
-        crate::energy::kinetic(&self.mass, v)
+        self.mass.kinetic(v)
     }
 }

@@ -18,8 +18,9 @@ use crate::energy;
 use crate::error::Result;
 use crate::force::{Force, Potential, energy_and_gradient};
 use crate::integrate::{Buffer, Rhs};
-use crate::linalg::{Breakdown, PIVOT_TOLERANCE};
-use crate::model::{Model, check_sizes};
+use crate::linalg::{Breakdown, check_pivot};
+use crate::mass::{DiagonalMass, MassMatrix};
+use crate::model::{Model, check_rows};
 use crate::scalar::Scalar;
 use crate::simulate::{Settings, Stepper, check_initial_state};
 use crate::system::{EvalError, System};
@@ -88,10 +89,10 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
     pub fn new(system: S, settings: Settings, q0: [f64; N], v0: [f64; N]) -> Result<Self> {
         settings.validate()?;
         check_initial_state(N, &q0, &v0)?;
-        let mass = system.mass();
-        check_sizes(&mass, M)?;
+        let mass = DiagonalMass::new(system.mass())?;
+        check_rows(M, N)?;
         let system = Whole(Arc::new(system));
-        let e0 = energy::kinetic(&mass, &v0) + system.energy(q0);
+        let e0 = mass.kinetic(&v0) + system.energy(q0);
         let controlled =
             SmallControlled { system, control: settings.control, e0, evaluations: 0, d: SmallDynamics::new(mass) };
         Self::start(controlled, settings, &q0, &v0)
@@ -139,8 +140,7 @@ pub struct SmallControlled<S, const N: usize, const M: usize> {
 
 /// One evaluation of the dynamics of a small system (as `Dynamics`, in arrays).
 struct SmallDynamics<const N: usize, const M: usize> {
-    mass: [f64; N],
-    inv_mass: [f64; N],
+    mass: DiagonalMass<[f64; N]>,
     phi: [f64; M],
     phi_dot: [f64; M],
     phi_t: [f64; M],
@@ -168,10 +168,9 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
         all
     };
 
-    fn new(mass: [f64; N]) -> Self {
+    fn new(mass: DiagonalMass<[f64; N]>) -> Self {
         Self {
             mass,
-            inv_mass: mass.map(|m| 1.0 / m),
             phi: [0.0; M],
             phi_dot: [0.0; M],
             phi_t: [0.0; M],
@@ -201,7 +200,9 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
         self.potential = potential;
         self.grad_potential = grad;
         self.force_power = (0..N).map(|i| force[i] * v[i]).sum();
-        let mut acc: [f64; N] = std::array::from_fn(|i| (force[i] - grad[i]) * self.inv_mass[i]);
+        let applied: [f64; N] = std::array::from_fn(|i| force[i] - grad[i]);
+        let mut acc = [0.0; N];
+        self.mass.solve(&applied, &mut acc);
         let l = local(system, q, v, acc, t);
         (self.phi, self.phi_dot, self.phi_t, self.jac) = (l.phi, l.phi_dot, l.phi_t, l.jac);
         self.factor()?;
@@ -215,15 +216,18 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     }
 
     /// Factors `S = Φ_q M⁻¹ Φ_qᵀ` as `L D Lᵀ`, with the pivot test of the general kernel.
+    ///
+    /// A second copy of the factorization on purpose: `linalg::Schur` reads
+    /// every entry through index arrays and eliminates left-looking with
+    /// `(L D)_jk`, so using it here would add indirection to the shortest
+    /// steps and change the rounding of `d_j` for `M ≥ 2` (final states no
+    /// longer bit-identical). What both must agree on, the pivot test, is shared.
     #[inline(always)]
     fn factor(&mut self) -> Result<(), Breakdown> {
         for j in 0..M {
             let s_jj = self.s(j, j);
             let d = s_jj - (0..j).map(|k| self.lower[j][k] * self.lower[j][k] * self.d[k]).sum::<f64>();
-            if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
-                let blown_up = !d.is_finite() || self.jac.iter().flatten().any(|x| !x.is_finite());
-                return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(j) });
-            }
+            check_pivot(d, s_jj, self.jac.as_flattened(), || j)?;
             self.d[j] = d;
             self.inv_d[j] = 1.0 / d;
             for i in j + 1..M {
@@ -234,10 +238,11 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
         Ok(())
     }
 
-    /// An entry of `S`.
+    /// An entry of `S`, weighted by the mass matrix as in the general kernel.
     #[inline(always)]
     fn s(&self, i: usize, j: usize) -> f64 {
-        (0..N).map(|c| self.jac[i][c] * self.jac[j][c] * self.inv_mass[c]).sum()
+        let weight = self.mass.inverse();
+        (0..N).map(|c| self.jac[i][c] * self.jac[j][c] * weight[c]).sum()
     }
 
     /// Solves `S x = b` in place with the current factorization.
@@ -261,16 +266,18 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     /// `out −= M⁻¹ Φ_qᵀ y`
     #[inline(always)]
     fn subtract_weighted_jt(&self, y: &[f64; M], out: &mut [f64]) {
+        let weight = self.mass.inverse();
         for r in 0..M {
             for c in 0..N {
-                out[c] -= self.inv_mass[c] * self.jac[r][c] * y[r];
+                out[c] -= weight[c] * self.jac[r][c] * y[r];
             }
         }
     }
 }
 
 impl<const N: usize, const M: usize> Evaluation for SmallDynamics<N, M> {
-    fn mass(&self) -> &[f64] {
+    type Mass = DiagonalMass<[f64; N]>;
+    fn mass(&self) -> &DiagonalMass<[f64; N]> {
         &self.mass
     }
     fn phi(&self) -> &[f64] {

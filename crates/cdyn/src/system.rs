@@ -6,6 +6,7 @@ use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::{Buffer, Rhs};
+use crate::mass::DiagonalMass;
 use crate::model::Model;
 
 /// A failed evaluation of the right-hand side.
@@ -162,7 +163,8 @@ struct Evaluated<'a> {
 }
 
 impl Evaluation for Evaluated<'_> {
-    fn mass(&self) -> &[f64] {
+    type Mass = DiagonalMass;
+    fn mass(&self) -> &DiagonalMass {
         self.model.mass()
     }
     fn phi(&self) -> &[f64] {

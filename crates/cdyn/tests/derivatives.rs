@@ -101,7 +101,7 @@ fn accelerations_satisfy_the_constraint_equations() {
     let mut jt = vec![0.0; model.n()];
     cdyn::dynamics::add_weighted_jt(model.pattern(), d.jac(), d.lambda(), &[1.0; 4], 1.0, &mut jt);
     for i in 0..model.n() {
-        let residual = model.mass()[i] * d.acc()[i] + jt[i] - d.force()[i];
+        let residual = model.mass().diagonal()[i] * d.acc()[i] + jt[i] - d.force()[i];
         assert!(residual.abs() < 1e-12, "coordinate {i}: residual {residual}");
     }
 }
