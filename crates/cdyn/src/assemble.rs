@@ -14,15 +14,19 @@ use crate::model::Model;
 /// What the assembly changed.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Assembly {
+    /// Newton iterations of the position projection.
     pub newton_iterations: usize,
-    /// Largest `|Φ|` before and after.
+    /// Largest `|Φ|` before.
     pub phi_before: f64,
+    /// Largest `|Φ|` after.
     pub phi_after: f64,
-    /// Largest `|Φ̇|` before and after.
+    /// Largest `|Φ̇|` before.
     pub phi_dot_before: f64,
+    /// Largest `|Φ̇|` after.
     pub phi_dot_after: f64,
-    /// Largest change of a position and of a velocity.
+    /// Largest change of a position.
     pub max_dq: f64,
+    /// Largest change of a velocity.
     pub max_dv: f64,
 }
 

@@ -18,10 +18,16 @@ pub enum Gain {
 /// Control of the holonomic constraints.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Geometric {
+    /// No geometric control (Eq. 8).
     #[default]
     None,
     /// Baumgarte's `Φ̈ + α Φ̇ + β Φ = 0` (Eqs. 13, 48).
-    Baumgarte { alpha: f64, beta: f64 },
+    Baumgarte {
+        /// Velocity gain `α`.
+        alpha: f64,
+        /// Position gain `β`.
+        beta: f64,
+    },
     /// CVSGF: `dq/dt = v − 2 Φ_qᵀ Z Φ` (Eqs. 28, 49).
     Gradient(Gain),
 }
@@ -58,18 +64,30 @@ pub(crate) fn baumgarte_gains(omega: f64, damping_ratio: f64) -> Result<(f64, f6
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum EnergyGain {
     /// `ρ_q`, `ρ_v` as given (Eq. 20).
-    Fixed { rho_q: f64, rho_v: f64 },
+    Fixed {
+        /// Gain `ρ_q` of the position correction along `Ψ_q`.
+        rho_q: f64,
+        /// Gain `ρ_v` of the velocity correction along `Ψ_v`.
+        rho_v: f64,
+    },
     /// `ρ_q = 0` and `ρ_v = α_e / (2|Ψ_v|²)` at every evaluation (Eqs. 27, 44).
-    Rate { alpha_e: f64 },
+    Rate {
+        /// Target linearized decay rate `α_e` of `Ψ`.
+        alpha_e: f64,
+    },
 }
 
 /// Control of the energy constraint `Ψ`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Energy {
+    /// No energy control.
     #[default]
     None,
     /// Baumgarte-type `Ψ̇ + η Ψ = 0` through a second multiplier (Eqs. 14–19).
-    Baumgarte { eta: f64 },
+    Baumgarte {
+        /// Decay rate `η` of `Ψ`.
+        eta: f64,
+    },
     /// Steepest descent on `Ψ²` (Eqs. 20, 22, 44).
     Gradient(EnergyGain),
 }
@@ -77,8 +95,11 @@ pub enum Energy {
 /// A complete stabilization method: one row of the table in `equations.md`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Control {
+    /// Control of the holonomic constraints.
     pub geometric: Geometric,
+    /// Control of the energy constraint.
     pub energy: Energy,
+    /// Where the control term is integrated.
     pub application: Application,
 }
 

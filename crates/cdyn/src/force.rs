@@ -11,12 +11,14 @@ use std::any::Any;
 
 /// Potential energy `V(x)` of `K` coordinates.
 pub trait Potential<const K: usize>: Send + Sync + 'static {
+    /// `V(x)`, for any scalar type (dual numbers give `∇V` and more).
     fn energy<D: Scalar>(&self, x: [D; K]) -> D;
 }
 
 /// A non-conservative generalized force on `K` coordinates, from their
 /// positions `x`, velocities `xd` and the time.
 pub trait Force<const K: usize>: Send + Sync + 'static {
+    /// The force on each coordinate, for any scalar type.
     fn force<D: Scalar>(&self, x: [D; K], xd: [D; K], t: D) -> [D; K];
 }
 

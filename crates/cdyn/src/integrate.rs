@@ -11,9 +11,13 @@
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(try_from = "String", into = "&'static str"))]
 pub enum Scheme {
+    /// Forward Euler, order 1.
     Euler,
+    /// Adams–Bashforth, two steps, order 2 (Euler start-up).
     AdamsBashforth2,
+    /// Adams–Bashforth, three steps, order 3 (RK-4 start-up, as in the paper).
     AdamsBashforth3,
+    /// The classical Runge–Kutta method, order 4.
     RungeKutta4,
 }
 
@@ -39,13 +43,22 @@ pub enum Formula {
     /// `x_{k+1} = x_k + h Σ_j w_j F_{k−j}`
     Multistep(&'static [f64]),
     /// An explicit Butcher tableau: `a` is strictly lower-triangular, row by row.
-    RungeKutta { a: &'static [&'static [f64]], b: &'static [f64], c: &'static [f64] },
+    RungeKutta {
+        /// Stage coefficients `a_ij`, one row per stage.
+        a: &'static [&'static [f64]],
+        /// Weights `b_i`.
+        b: &'static [f64],
+        /// Nodes `c_i`.
+        c: &'static [f64],
+    },
 }
 
 /// Everything that distinguishes one scheme from another.
 #[derive(Debug, Clone, Copy)]
 pub struct SchemeInfo {
+    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`.
     pub name: &'static str,
+    /// Order of accuracy.
     pub order: u32,
     /// Right-hand-side evaluations per step once started.
     pub evaluations: usize,
@@ -53,6 +66,7 @@ pub struct SchemeInfo {
     pub history: usize,
     /// The scheme used while the history fills up.
     pub startup: Option<Scheme>,
+    /// The formula: multistep weights or a Butcher tableau.
     pub formula: Formula,
 }
 
@@ -61,8 +75,10 @@ const RK4_B: &[f64] = &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
 const RK4_C: &[f64] = &[0.0, 0.5, 0.5, 1.0];
 
 impl Scheme {
+    /// Every scheme.
     pub const ALL: [Scheme; 4] = [Scheme::Euler, Scheme::AdamsBashforth2, Scheme::AdamsBashforth3, Scheme::RungeKutta4];
 
+    /// Order, cost, history, start-up and formula of this scheme.
     pub fn info(self) -> SchemeInfo {
         match self {
             Scheme::Euler => SchemeInfo {
@@ -126,6 +142,7 @@ impl From<Scheme> for &'static str {
 
 /// A state equation `ẋ = f(x, t) + U(x, t)`.
 pub trait Rhs {
+    /// Why an evaluation can fail.
     type Error;
     /// Length of the state `x`.
     fn state_len(&self) -> usize;
@@ -139,7 +156,9 @@ pub trait Rhs {
 /// array when the size is known at compile time (so that a small system's
 /// step keeps its numbers in registers).
 pub trait Buffer: Clone {
+    /// The numbers.
     fn as_slice(&self) -> &[f64];
+    /// The numbers, to write.
     fn as_mut_slice(&mut self) -> &mut [f64];
 }
 
@@ -170,6 +189,7 @@ pub struct Integrator<B = Vec<f64>> {
 }
 
 impl Integrator {
+    /// An integrator of `scheme` for states of length `len`, in vectors.
     pub fn new(scheme: Scheme, application: Application, len: usize) -> Self {
         Self::with_zero(scheme, application, vec![0.0; len])
     }

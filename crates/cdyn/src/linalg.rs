@@ -31,7 +31,9 @@ pub enum LinearSolver {
     /// Dense below [`SPARSE_FROM`] constraint rows, sparse from there on.
     #[default]
     Auto,
+    /// The full triangle of `S`: for few constraint rows.
     Dense,
+    /// The pattern of `S`, ordered for little fill: for many rows.
     Sparse,
 }
 

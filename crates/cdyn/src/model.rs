@@ -90,6 +90,7 @@ impl ModelBuilder {
         self.constraints.iter().map(|b| b.rows()).sum()
     }
 
+    /// The model, or the first error met while adding elements.
     pub fn build(self) -> Result<Model> {
         if let Some(e) = self.error {
             return Err(e);
@@ -152,6 +153,7 @@ impl Model {
     pub fn mass(&self) -> &DiagonalMass {
         &self.mass
     }
+    /// Which coordinates each constraint row of `Φ_q` reads.
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
     }

@@ -15,8 +15,11 @@ use crate::system::{ControlledSystem, EvalError, System};
 /// How to simulate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
+    /// The fixed-step scheme.
     pub scheme: Scheme,
+    /// The step size.
     pub h: f64,
+    /// The stabilization method.
     pub control: Control,
     /// The initial state must satisfy `|Φ|, |Φ̇| ≤` this, unless `None`.
     pub consistency_tolerance: Option<f64>,
@@ -27,6 +30,8 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// These choices, a consistency tolerance of 1e-9, no violation limit
+    /// and the solver chosen by size.
     pub fn new(scheme: Scheme, h: f64, control: Control) -> Self {
         Self {
             scheme,
@@ -38,6 +43,7 @@ impl Settings {
         }
     }
 
+    /// Checks `h`, the gains and the tolerances.
     pub fn validate(&self) -> Result<()> {
         positive("h", self.h)?;
         self.control.validate()?;
@@ -78,6 +84,7 @@ impl<'m> Simulation<'m> {
         Self::start(ControlledSystem::with_solver(model, settings.control, e0, settings.solver), settings, q0, v0)
     }
 
+    /// The model simulated.
     pub fn model(&self) -> &'m Model {
         self.system.model()
     }
@@ -112,6 +119,7 @@ impl<S: System> Stepper<S> {
         Ok(Self { system, integrator, settings, x, step: 0 })
     }
 
+    /// The settings it runs with.
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
@@ -123,9 +131,11 @@ impl<S: System> Stepper<S> {
     pub fn t(&self) -> f64 {
         self.step as f64 * self.settings.h
     }
+    /// Current positions.
     pub fn q(&self) -> &[f64] {
         &self.x.as_slice()[..self.system.n()]
     }
+    /// Current velocities.
     pub fn v(&self) -> &[f64] {
         let n = self.system.n();
         &self.x.as_slice()[n..2 * n]

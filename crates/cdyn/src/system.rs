@@ -13,9 +13,17 @@ use crate::model::Model;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum EvalError {
     /// `Φ_q M⁻¹ Φ_qᵀ` is singular at a finite state.
-    Singular { t: f64, row: usize },
+    Singular {
+        /// Time of the evaluation.
+        t: f64,
+        /// The dependent constraint row.
+        row: usize,
+    },
     /// The state handed in was not finite.
-    NonFinite { t: f64 },
+    NonFinite {
+        /// Time of the evaluation.
+        t: f64,
+    },
 }
 
 impl EvalError {

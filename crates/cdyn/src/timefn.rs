@@ -14,6 +14,7 @@ pub struct TimeFn {
 }
 
 impl TimeFn {
+    /// `f(t) = c`.
     pub fn constant(c: f64) -> Self {
         Self { polynomial: vec![c], sines: Vec::new() }
     }
@@ -23,6 +24,7 @@ impl TimeFn {
         Self { polynomial: vec![c0, c1], sines: Vec::new() }
     }
 
+    /// `f(t)`, for any scalar type (dual numbers give `ḟ`, `f̈`).
     pub fn eval<D: Scalar>(&self, t: D) -> D {
         // Horner for the polynomial.
         let mut p = D::from(0.0);
