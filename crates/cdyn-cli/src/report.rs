@@ -31,7 +31,7 @@ pub fn write_figure(dir: &Path, stem: &str, title: &str, quantity: Quantity, cas
     let series: Vec<plot::Series> = cases
         .iter()
         .filter_map(|c| {
-            let s = &c.series;
+            let s = c.series();
             let y = match quantity {
                 Quantity::Phi => &s.phi,
                 Quantity::Psi => &s.psi,
@@ -60,7 +60,7 @@ pub const RUN_FIGURES: Stems = ["phi", "psi", "err"];
 pub fn write_figures(dir: &Path, title: &str, cases: &[CaseResult], stems: Stems) -> Result<()> {
     write_figure(dir, stems[0], &format!("{title}: geometric constraint violation"), Quantity::Phi, cases)?;
     write_figure(dir, stems[1], &format!("{title}: energy constraint violation"), Quantity::Psi, cases)?;
-    if let Some(c) = cases.iter().find(|c| !c.series.error.is_empty()) {
+    if let Some(c) = cases.iter().find(|c| !c.series().error.is_empty()) {
         write_figure(dir, stems[2], &format!("{title}: error in {}", c.error_observable), Quantity::Err, cases)?;
     }
     Ok(())
@@ -77,12 +77,12 @@ pub fn table(cases: &[CaseResult]) -> String {
         out += &format!(
             "{:<24} {:>11.3e} {:>11.3e} {:>11} {:>11} {:>7} {:>9}{}\n",
             c.name,
-            c.max_abs_phi,
-            c.max_abs_psi,
-            opt(c.max_abs_err_x),
-            opt(c.err_x_final),
-            c.steps,
-            c.rhs_evals,
+            c.record.max_abs_phi,
+            c.record.max_abs_psi,
+            opt(c.record.max_abs_error),
+            opt(c.record.final_error),
+            c.record.steps,
+            c.record.evaluations,
             c.error.as_ref().map_or(String::new(), |e| format!("  FAILED: {e}")),
         );
     }

@@ -30,7 +30,8 @@ impl Case {
     }
 }
 
-/// What a case produced, as `summary.json` reports it.
+/// What a case produced, as `summary.json` reports it: the case, then the
+/// library's record of the run.
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
     pub name: String,
@@ -38,23 +39,14 @@ pub struct CaseResult {
     pub error_observable: String,
     pub scheme: &'static str,
     pub h: f64,
-    pub max_abs_phi: f64,
-    pub max_abs_psi: f64,
-    /// `null` when the model has no reference solution.
-    pub max_abs_err_x: Option<f64>,
-    pub err_x_final: Option<f64>,
-    pub max_abs_coupling: f64,
-    pub steps: u64,
-    pub t_final: f64,
-    pub rhs_evals: u64,
-    pub q_end: Vec<f64>,
-    pub v_end: Vec<f64>,
+    #[serde(flatten)]
+    pub record: Record,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
-    /// Sampled time histories, for the figures (empty for sweeps).
-    #[serde(skip)]
-    pub series: Series,
 }
+
+/// The series of a run that kept none (sweeps).
+static NO_SERIES: Series = Series { t: Vec::new(), phi: Vec::new(), psi: Vec::new(), error: Vec::new() };
 
 impl CaseResult {
     /// The summary of `case` from its record.
@@ -64,19 +56,14 @@ impl CaseResult {
             error_observable: case.example.observables[0].clone(),
             scheme: case.settings.scheme.info().name,
             h: case.settings.h,
-            max_abs_phi: record.max_abs_phi,
-            max_abs_psi: record.max_abs_psi,
-            max_abs_err_x: record.max_abs_error,
-            err_x_final: record.final_error,
-            max_abs_coupling: record.max_abs_coupling,
-            steps: record.steps,
-            t_final: record.t_final,
-            rhs_evals: record.evaluations,
-            q_end: record.q_end,
-            v_end: record.v_end,
-            error: record.error.map(|e| format!("case {}: {e}", case.name)),
-            series: record.series.unwrap_or_default(),
+            error: record.error.as_ref().map(|e| format!("case {}: {e}", case.name)),
+            record,
         }
+    }
+
+    /// Sampled time histories, for the figures (empty for sweeps).
+    pub fn series(&self) -> &Series {
+        self.record.series.as_ref().unwrap_or(&NO_SERIES)
     }
 }
 

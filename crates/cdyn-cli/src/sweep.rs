@@ -160,10 +160,10 @@ pub fn run(scenario: &Scenario, path: &Path, shard: Option<Shard>, threads: Opti
                 Point {
                     index: *index,
                     values: values.clone(),
-                    max_abs_phi: r.max_abs_phi,
-                    max_abs_psi: r.max_abs_psi,
-                    max_abs_err: r.max_abs_err_x,
-                    steps: r.steps,
+                    max_abs_phi: r.record.max_abs_phi,
+                    max_abs_psi: r.record.max_abs_psi,
+                    max_abs_err: r.record.max_abs_error,
+                    steps: r.record.steps,
                     error: r.error,
                 }
             })

@@ -93,32 +93,41 @@ pub struct Series {
     pub error: Vec<f64>,
 }
 
-/// What a recorded run produced.
+/// What a recorded run produced. With the `serde` feature it serializes
+/// under the names summaries have always used (the paper's error is in `X`:
+/// `max_abs_err_x`, `err_x_final`, `rhs_evals`); the series and the error
+/// are left to the caller.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Record {
     /// Largest `|Φ|` over the samples.
     pub max_abs_phi: f64,
     /// Largest `|Ψ|` over the samples.
     pub max_abs_psi: f64,
-    /// Largest coupling measure `max_i |Y_ci|` over the samples.
-    pub max_abs_coupling: f64,
     /// Largest error of the first observable against the reference; `None` without one.
+    #[cfg_attr(feature = "serde", serde(rename = "max_abs_err_x"))]
     pub max_abs_error: Option<f64>,
     /// That error at the last sample; `None` without a reference or a sample.
+    #[cfg_attr(feature = "serde", serde(rename = "err_x_final"))]
     pub final_error: Option<f64>,
+    /// Largest coupling measure `max_i |Y_ci|` over the samples.
+    pub max_abs_coupling: f64,
     /// Steps taken.
     pub steps: u64,
     /// Time reached.
     pub t_final: f64,
     /// Right-hand-side evaluations.
+    #[cfg_attr(feature = "serde", serde(rename = "rhs_evals"))]
     pub evaluations: u64,
     /// Positions at the end (after a failure: where the run stopped).
     pub q_end: Vec<f64>,
     /// Velocities at the end.
     pub v_end: Vec<f64>,
     /// The sampled series, when asked for with [`Recorder::keep_series`].
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub series: Option<Series>,
     /// Why the run stopped early; `None` when it reached the end.
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub error: Option<Error>,
 }
 
