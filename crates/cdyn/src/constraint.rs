@@ -31,6 +31,37 @@ pub(crate) struct ConstraintValues<'a> {
     pub jac: &'a mut [f64],
 }
 
+/// The outputs of constraint passes that a workspace keeps: `Φ`, `Φ̇`,
+/// `Φ_t`, `γ` and the Jacobian values (in [`Pattern`](crate::sparse::Pattern) order).
+pub(crate) struct ConstraintBuffers {
+    pub phi: Vec<f64>,
+    pub phi_dot: Vec<f64>,
+    pub phi_t: Vec<f64>,
+    pub gamma: Vec<f64>,
+    pub jac: Vec<f64>,
+}
+
+impl ConstraintBuffers {
+    /// Buffers for `m` rows and `nnz` Jacobian entries.
+    pub fn new(m: usize, nnz: usize) -> Self {
+        Self { phi: vec![0.0; m], phi_dot: vec![0.0; m], phi_t: vec![0.0; m], gamma: vec![0.0; m], jac: vec![0.0; nnz] }
+    }
+
+    /// Where a pass writes, for the unconstrained acceleration `free_acc`,
+    /// with `Φ_q a − γ` going to `rhs`.
+    pub fn pass<'a>(&'a mut self, free_acc: &'a [f64], rhs: &'a mut [f64]) -> ConstraintValues<'a> {
+        ConstraintValues {
+            free_acc,
+            rhs,
+            phi: &mut self.phi,
+            phi_dot: &mut self.phi_dot,
+            phi_t: &mut self.phi_t,
+            gamma: &mut self.gamma,
+            jac: &mut self.jac,
+        }
+    }
+}
+
 /// A run of constraint elements of one type (object-safe face).
 pub(crate) trait ConstraintBlock: Send + Sync {
     fn rows(&self) -> usize;

@@ -1,7 +1,7 @@
 //! What a sample reports: the violations `Φ`, `Φ̇`, `Ψ` and the coupling
 //! measure `Y_c` (Eq. 47), computed without factorizing anything.
 
-use crate::constraint::ConstraintValues;
+use crate::constraint::ConstraintBuffers;
 use crate::energy;
 use crate::model::Model;
 
@@ -46,11 +46,8 @@ impl Measures {
 
 /// Buffers for measuring; one per model.
 pub struct Probe {
-    phi: Vec<f64>,
-    phi_dot: Vec<f64>,
-    phi_t: Vec<f64>,
-    gamma: Vec<f64>,
-    jac: Vec<f64>,
+    /// Φ, Φ̇, Φ_t, γ and Φ_q of the last pass.
+    constraints: ConstraintBuffers,
     grad: Vec<f64>,
     /// The constraint pass also forms `Φ_q a − γ`; here for `a = 0`, unused.
     zeros: Vec<f64>,
@@ -62,11 +59,7 @@ impl Probe {
     pub fn new(model: &Model) -> Self {
         let m = model.m();
         Self {
-            phi: vec![0.0; m],
-            phi_dot: vec![0.0; m],
-            phi_t: vec![0.0; m],
-            gamma: vec![0.0; m],
-            jac: vec![0.0; model.pattern().nnz()],
+            constraints: ConstraintBuffers::new(m, model.pattern().nnz()),
             grad: vec![0.0; model.n()],
             zeros: vec![0.0; model.n()],
             rhs: vec![0.0; m],
@@ -75,22 +68,13 @@ impl Probe {
 
     /// Measures the violations at `(q, v, e, t)` for initial energy `e0`.
     pub fn measure(&mut self, model: &Model, q: &[f64], v: &[f64], e: f64, t: f64, e0: f64) -> Measures {
-        let values = ConstraintValues {
-            free_acc: &self.zeros,
-            rhs: &mut self.rhs,
-            phi: &mut self.phi,
-            phi_dot: &mut self.phi_dot,
-            phi_t: &mut self.phi_t,
-            gamma: &mut self.gamma,
-            jac: &mut self.jac,
-        };
-        model.constraints(q, v, t, values);
+        model.constraints(q, v, t, self.constraints.pass(&self.zeros, &mut self.rhs));
         self.grad.fill(0.0);
         let potential = model.potential(q, Some(&mut self.grad));
         let pattern = model.pattern();
         let psi = energy::psi(model.mass(), v, potential, e, e0);
-        let jac = &self.jac;
-        Measures::of(psi, &self.grad, &self.phi, &self.phi_dot, |r| {
+        let jac = &self.constraints.jac;
+        Measures::of(psi, &self.grad, &self.constraints.phi, &self.constraints.phi_dot, |r| {
             let range = pattern.row(r);
             (&jac[range.clone()], &pattern.cols[range])
         })

@@ -1,7 +1,7 @@
 //! What the system does, uncontrolled: `Φ`, `Φ_q`, `γ`, the multipliers
 //! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
 
-use crate::constraint::ConstraintValues;
+use crate::constraint::ConstraintBuffers;
 use crate::energy;
 use crate::linalg::Schur;
 pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
@@ -12,11 +12,8 @@ use crate::model::{Model, Pattern};
 /// model; `evaluate` never allocates. The results are read through the
 /// accessors below, so only [`evaluate`](Self::evaluate) writes them.
 pub struct Dynamics {
-    phi: Vec<f64>,
-    phi_dot: Vec<f64>,
-    phi_t: Vec<f64>,
-    gamma: Vec<f64>,
-    jac: Vec<f64>,
+    /// Φ, Φ̇, Φ_t, γ and Φ_q of the last pass.
+    constraints: ConstraintBuffers,
     force: Vec<f64>,
     grad_potential: Vec<f64>,
     potential: f64,
@@ -36,11 +33,7 @@ impl Dynamics {
     pub fn with_solver(model: &Model, solver: LinearSolver) -> Self {
         let (n, m) = (model.n(), model.m());
         Self {
-            phi: vec![0.0; m],
-            phi_dot: vec![0.0; m],
-            phi_t: vec![0.0; m],
-            gamma: vec![0.0; m],
-            jac: vec![0.0; model.pattern().nnz()],
+            constraints: ConstraintBuffers::new(m, model.pattern().nnz()),
             force: vec![0.0; n],
             grad_potential: vec![0.0; n],
             potential: 0.0,
@@ -63,22 +56,20 @@ impl Dynamics {
         // The unconstrained acceleration M⁻¹ G, which the constraint pass needs for `Φ_q M⁻¹ G − γ`.
         model.mass().solve(&self.force, &mut self.acc);
         // λ starts as the right-hand side of (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
-        let out = ConstraintValues {
-            free_acc: &self.acc,
-            rhs: &mut self.lambda,
-            phi: &mut self.phi,
-            phi_dot: &mut self.phi_dot,
-            phi_t: &mut self.phi_t,
-            gamma: &mut self.gamma,
-            jac: &mut self.jac,
-        };
-        model.constraints(q, v, t, out);
+        model.constraints(q, v, t, self.constraints.pass(&self.acc, &mut self.lambda));
         if model.m() == 0 {
             return Ok(());
         }
-        self.schur.factor_and_solve(&self.jac, &mut self.lambda)?;
+        self.schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        add_weighted_jt(model.pattern(), &self.jac, &self.lambda, model.mass().inverse(), -1.0, &mut self.acc);
+        add_weighted_jt(
+            model.pattern(),
+            &self.constraints.jac,
+            &self.lambda,
+            model.mass().inverse(),
+            -1.0,
+            &mut self.acc,
+        );
         Ok(())
     }
 
@@ -88,33 +79,33 @@ impl Dynamics {
     /// Uses the factorization of the last [`evaluate`](Self::evaluate).
     pub fn add_constraint_response(&self, model: &Model, b: &mut [f64], out: &mut [f64]) {
         self.schur.solve(b);
-        add_weighted_jt(model.pattern(), &self.jac, b, model.mass().inverse(), -1.0, out);
+        add_weighted_jt(model.pattern(), &self.constraints.jac, b, model.mass().inverse(), -1.0, out);
     }
 
     /// The energy input `Ė = F·v + λᵀ Φ_t` of the last evaluation (see [`crate::energy`]).
     pub fn energy_input(&self) -> f64 {
-        energy::power(self.force_power, &self.lambda, &self.phi_t)
+        energy::power(self.force_power, &self.lambda, &self.constraints.phi_t)
     }
 
     /// `Φ(q, t)`
     pub fn phi(&self) -> &[f64] {
-        &self.phi
+        &self.constraints.phi
     }
     /// `Φ̇ = Φ_q v + Φ_t`
     pub fn phi_dot(&self) -> &[f64] {
-        &self.phi_dot
+        &self.constraints.phi_dot
     }
     /// `Φ_t`, as `Φ̇ − Φ_q v` (zero up to round-off without drives).
     pub fn phi_t(&self) -> &[f64] {
-        &self.phi_t
+        &self.constraints.phi_t
     }
     /// `γ` of Eq. 5
     pub fn gamma(&self) -> &[f64] {
-        &self.gamma
+        &self.constraints.gamma
     }
     /// Values of `Φ_q` in the model's [`Pattern`] order.
     pub fn jac(&self) -> &[f64] {
-        &self.jac
+        &self.constraints.jac
     }
     /// Generalized applied force `G = −∇V + F`.
     pub fn force(&self) -> &[f64] {
