@@ -103,6 +103,15 @@ fn output_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
 }
 
+/// Writes a sweep's (or merged sweep's) `sweep.json` and heat maps into `out` and prints its table.
+fn write_sweep(result: &sweep::Sweep, out: &Path) -> Result<()> {
+    output_dir(out)?;
+    sweep::write(result, out)?;
+    print!("{}", sweep::table(result));
+    println!("wrote {}", out.join("sweep.json").display());
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Paper { out } => {
@@ -146,12 +155,7 @@ fn run(cli: Cli) -> Result<()> {
             if threads == Some(0) {
                 bail!("--threads 0: need at least one thread");
             }
-            let result = sweep::run(&parsed, &scenario, shard, threads)?;
-            output_dir(&out)?;
-            sweep::write(&result, &out)?;
-            print!("{}", sweep::table(&result));
-            println!("wrote {}", out.join("sweep.json").display());
-            Ok(())
+            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out)
         }
         Command::Merge { parts, out } => {
             let parts = parts
@@ -163,12 +167,7 @@ fn run(cli: Cli) -> Result<()> {
                     serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            let merged = sweep::merge(parts)?;
-            output_dir(&out)?;
-            sweep::write(&merged, &out)?;
-            print!("{}", sweep::table(&merged));
-            println!("wrote {}", out.join("sweep.json").display());
-            Ok(())
+            write_sweep(&sweep::merge(parts)?, &out)
         }
         Command::Compare { scenario, out } => {
             let parsed = scenario::load(&scenario)?;

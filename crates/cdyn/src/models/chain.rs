@@ -3,8 +3,8 @@
 use std::f64::consts::FRAC_PI_2;
 
 use super::parts::{dir, example, hanging, point_body};
-use super::{Example, Reference};
-use crate::error::{Error, Result, finite, non_negative, positive};
+use super::{Example, PendulumParams, Reference};
+use crate::error::{Error, Result};
 use crate::planar::{BodyId, Element, Mechanism};
 use crate::reference::PendulumExact;
 
@@ -52,12 +52,9 @@ impl ChainParams {
                 reason: "a chain has at most 1000000 links",
             });
         }
-        positive("mass", self.mass)?;
-        positive("length", self.length)?;
-        non_negative("gravity", self.gravity)?;
-        finite("theta0", self.theta0)?;
-        finite("omega0", self.omega0)?;
-        Ok(())
+        // Each link is the paper's pendulum, with its parameters' domains.
+        let (mass, length, gravity, theta0, omega0) = (self.mass, self.length, self.gravity, self.theta0, self.omega0);
+        PendulumParams { mass, length, gravity, theta0, omega0 }.validate()
     }
 }
 

@@ -34,7 +34,7 @@ impl Default for PendulumParams {
 }
 
 impl PendulumParams {
-    fn validate(&self) -> Result<()> {
+    pub(super) fn validate(&self) -> Result<()> {
         positive("mass", self.mass)?;
         positive("length", self.length)?;
         non_negative("gravity", self.gravity)?;
