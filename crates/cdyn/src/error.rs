@@ -71,12 +71,37 @@ pub enum Error {
     },
     /// Method keys that do not describe one method.
     #[error("{0}")]
-    Method(#[from] crate::methods::KeyProblem),
+    Method(#[from] KeyProblem),
     /// The pendulum's energy lies within a relative 1e-10 of the upright
     /// energy: the period diverges and the elliptic closed form of the
     /// reference solution degenerates.
     #[error("pendulum energy lies on the separatrix (just reaches the top); no elliptic closed form")]
     Separatrix,
+}
+
+/// A combination of method keys ([`MethodKeys`](crate::methods::MethodKeys))
+/// that does not describe one method.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum KeyProblem {
+    /// Two keys that each set the same gain.
+    #[error("give one of {0}, {1}, not both")]
+    Both(&'static str, &'static str),
+    /// A gain of a method that is not selected.
+    #[error("{key} is only used with {method}")]
+    Unused {
+        /// The key given.
+        key: &'static str,
+        /// The selection that uses it, e.g. `geometric = "cvsgf"`.
+        method: &'static str,
+    },
+    /// A selected method without its gains, or with an incomplete set.
+    #[error("{method} takes {takes}")]
+    Gains {
+        /// The selection, e.g. `geometric = "cvsgf"`.
+        method: &'static str,
+        /// What it needs, e.g. `one of zeta, alpha_g`.
+        takes: &'static str,
+    },
 }
 
 /// The part of a model an [`Error::InvalidModel`] is about.

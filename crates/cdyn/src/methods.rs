@@ -4,7 +4,7 @@
 //! `bench` and benchmarks. A simulation itself needs only a [`Control`].
 
 use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, baumgarte_gains};
-use crate::error::{Error, Result, non_negative};
+use crate::error::{Error, KeyProblem, Result, non_negative};
 use crate::integrate::Application;
 
 /// The geometric control a [`MethodKeys`] names.
@@ -69,30 +69,6 @@ pub struct MethodKeys {
     pub rho_v: Option<f64>,
     /// Baumgarte-type energy control: `Ψ̇ + ηΨ = 0` (Eq. 19).
     pub eta: Option<f64>,
-}
-
-/// A combination of method keys that does not describe one method.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum KeyProblem {
-    /// Two keys that each set the same gain.
-    #[error("give one of {0}, {1}, not both")]
-    Both(&'static str, &'static str),
-    /// A gain of a method that is not selected.
-    #[error("{key} is only used with {method}")]
-    Unused {
-        /// The key given.
-        key: &'static str,
-        /// The selection that uses it, e.g. `geometric = "cvsgf"`.
-        method: &'static str,
-    },
-    /// A selected method without its gains, or with an incomplete set.
-    #[error("{method} takes {takes}")]
-    Gains {
-        /// The selection, e.g. `geometric = "cvsgf"`.
-        method: &'static str,
-        /// What it needs, e.g. `one of zeta, alpha_g`.
-        takes: &'static str,
-    },
 }
 
 const CVSGF: &str = "geometric = \"cvsgf\"";
