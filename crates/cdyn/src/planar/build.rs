@@ -38,8 +38,9 @@ impl Mechanism {
         }
         let mut mass = Vec::new();
         let (mut q0, mut v0, mut names, mut offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut earlier = std::collections::HashSet::with_capacity(self.bodies.len());
         for (i, b) in self.bodies.iter().enumerate() {
-            b.check(i, &self.bodies[..i])?;
+            b.check(i, &mut earlier)?;
             offsets.push(mass.len());
             mass.extend([b.mass, b.mass]);
             q0.extend(b.position);
