@@ -163,8 +163,8 @@ fn double_pendulum_normal_modes_have_the_linearized_frequencies() {
             })
             .unwrap();
             let omega = w2.sqrt();
-            // About eight periods.
-            let t_end = 16.0 * PI / omega;
+            // About eight periods, ending on a whole step.
+            let t_end = cdyn::simulate::nearest_valid_t_end(16.0 * PI / omega, 1e-3);
             let (mut first, mut second) = (Vec::new(), Vec::new());
             let mut sim = rk4(&ex, 1e-3);
             sim.run::<Error>(t_end, 1, |s| {
