@@ -11,11 +11,13 @@ mod report;
 mod runner;
 mod scenario;
 mod sweep;
+mod terminal;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use terminal::print;
 
 #[global_allocator]
 static ALLOCATOR: alloc_count::Counting = alloc_count::Counting;
@@ -93,7 +95,7 @@ fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
+            terminal::eprint_line(&format!("error: {}", format!("{e:#}").replace('\n', " ")));
             ExitCode::FAILURE
         }
     }
@@ -107,8 +109,8 @@ fn output_dir(dir: &Path) -> Result<()> {
 fn write_sweep(result: &sweep::Sweep, out: &Path) -> Result<()> {
     output_dir(out)?;
     sweep::write(result, out)?;
-    print!("{}", sweep::table(result));
-    println!("wrote {}", out.join("sweep.json").display());
+    print(&sweep::table(result))?;
+    print(&format!("wrote {}\n", out.join("sweep.json").display()))?;
     Ok(())
 }
 
@@ -117,15 +119,17 @@ fn run(cli: Cli) -> Result<()> {
         Command::Paper { out } => {
             output_dir(&out)?;
             let results = paper::run(&out)?;
-            print!("{}", report::table(&results));
-            println!("wrote {}", out.display());
+            print(&report::table(&results))?;
+            print(&format!("wrote {}\n", out.display()))?;
             fail_on_error(&results, &out)
         }
         Command::Run { scenario, out } => {
-            let case = scenario::load(&scenario)?.case(&scenario)?;
+            let parsed = scenario::load(&scenario)?;
+            parsed.refuse_sweep(&scenario, "run")?;
+            let case = parsed.case(&scenario)?;
             case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
             if let Some(a) = &case.assembly {
-                println!("{}", report::assembly_line(a));
+                print(&format!("{}\n", report::assembly_line(a)))?;
             }
             output_dir(&out)?;
             let results = [runner::run_case(&case, &out)?];
@@ -135,8 +139,8 @@ fn run(cli: Cli) -> Result<()> {
             });
             report::write_summary(&out, &results, extra)?;
             report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
-            print!("{}", report::table(&results));
-            println!("wrote {}", out.display());
+            print(&report::table(&results))?;
+            print(&format!("wrote {}\n", out.display()))?;
             fail_on_error(&results, &out)
         }
         Command::Bench { out, light } => {
@@ -145,16 +149,14 @@ fn run(cli: Cli) -> Result<()> {
             let path = out.join("bench.json");
             std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
                 .with_context(|| format!("cannot write {}", path.display()))?;
-            print!("{}", bench::table(&report));
-            println!("wrote {}", path.display());
+            print(&bench::table(&report))?;
+            print(&format!("wrote {}\n", path.display()))?;
             Ok(())
         }
         Command::Sweep { scenario, out, shard, threads } => {
             let parsed = scenario::load(&scenario)?;
             let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
-            if threads == Some(0) {
-                bail!("--threads 0: need at least one thread");
-            }
+            let threads = sweep::worker_threads(threads)?;
             write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out)
         }
         Command::Merge { parts, out } => {
@@ -171,11 +173,12 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Compare { scenario, out } => {
             let parsed = scenario::load(&scenario)?;
+            parsed.refuse_sweep(&scenario, "compare")?;
             let cases = compare::cases(&parsed, &scenario)?;
             output_dir(&out)?;
             let results = compare::run(&cases, &scenario, &out)?;
-            print!("{}", report::table(&results));
-            println!("wrote {}", out.display());
+            print(&report::table(&results))?;
+            print(&format!("wrote {}\n", out.display()))?;
             fail_on_error(&results, &out)
         }
     }

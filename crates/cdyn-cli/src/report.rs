@@ -4,6 +4,7 @@
 use crate::plot::{self, Figure, Scale};
 use crate::runner::CaseResult;
 use anyhow::{Context, Result};
+use cdyn::json_float::JsonFloat;
 use serde_json::json;
 use std::path::Path;
 
@@ -89,16 +90,16 @@ pub fn table(cases: &[CaseResult]) -> String {
     out
 }
 
-/// The assembly report as JSON.
+/// The assembly report as JSON (infinities and NaN as strings, as everywhere).
 pub fn assembly_json(a: &cdyn::assemble::Assembly) -> serde_json::Value {
     json!({
         "newton_iterations": a.newton_iterations,
-        "max_abs_phi_before": a.phi_before,
-        "max_abs_phi_after": a.phi_after,
-        "max_abs_phi_dot_before": a.phi_dot_before,
-        "max_abs_phi_dot_after": a.phi_dot_after,
-        "max_abs_dq": a.max_dq,
-        "max_abs_dv": a.max_dv,
+        "max_abs_phi_before": JsonFloat(a.phi_before),
+        "max_abs_phi_after": JsonFloat(a.phi_after),
+        "max_abs_phi_dot_before": JsonFloat(a.phi_dot_before),
+        "max_abs_phi_dot_after": JsonFloat(a.phi_dot_after),
+        "max_abs_dq": JsonFloat(a.max_dq),
+        "max_abs_dv": JsonFloat(a.max_dv),
     })
 }
 

@@ -38,6 +38,7 @@ pub struct CaseResult {
     /// The observable whose error against the reference is reported.
     pub error_observable: String,
     pub scheme: &'static str,
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub h: f64,
     #[serde(flatten)]
     pub record: Record,

@@ -9,6 +9,7 @@ use cdyn::error::{Part, positive};
 use cdyn::methods::MethodKeys;
 use cdyn::models::{Example, Kind};
 use cdyn::planar::{Body, Element, Group, Mechanism};
+use cdyn::simulate::{nearest_valid_t_end, steps_to};
 use cdyn::{Scheme, Settings};
 use serde::Deserialize;
 use std::path::Path;
@@ -181,6 +182,18 @@ fn locate(within: &[&str], table: &toml::Table, path: &serde_path_to_error::Path
 }
 
 impl Scenario {
+    /// Refuses a `[sweep]` table for a `command` that runs the scenario as
+    /// written (`run`, `compare`): it would be ignored without a word.
+    pub fn refuse_sweep(&self, path: &Path, command: &str) -> Result<()> {
+        if self.sweep.is_some() {
+            bail!(
+                "{}: [sweep] is read by `cdyn sweep` only; `cdyn {command}` would ignore it: run `cdyn sweep`, or remove the table",
+                path.display()
+            );
+        }
+        Ok(())
+    }
+
     /// The case this scenario describes; `path` names it in errors.
     pub fn case(&self, path: &Path) -> Result<Case> {
         let file = &path.display().to_string();
@@ -192,6 +205,14 @@ impl Scenario {
         if t_end / h > 1e9 {
             bail!("{file}: [integrator] t_end / h = {:e} steps is more than 1e9", t_end / h);
         }
+        // The library's rule: t_end is a whole number of steps h.
+        steps_to(t_end, h).map_err(|e| match e {
+            cdyn::Error::InvalidParameter { name, reason, .. } => anyhow!(
+                "{file}: [integrator] h = {h}, t_end = {t_end}: {name} {reason}; the nearest valid t_end is {}",
+                nearest_valid_t_end(t_end, h)
+            ),
+            other => integrator(other),
+        })?;
         let mut settings = Settings::new(i.scheme, h, control);
         let init = &self.initial;
         if let Some(tol) = init.tolerance {

@@ -19,6 +19,7 @@ use std::path::Path;
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Axis {
     pub name: String,
+    #[serde(with = "cdyn::json_float")]
     pub values: Vec<f64>,
 }
 
@@ -26,9 +27,13 @@ pub struct Axis {
 pub struct Point {
     pub index: usize,
     /// One value per axis.
+    #[serde(with = "cdyn::json_float")]
     pub values: Vec<f64>,
+    #[serde(with = "cdyn::json_float")]
     pub max_abs_phi: f64,
+    #[serde(with = "cdyn::json_float")]
     pub max_abs_psi: f64,
+    #[serde(with = "cdyn::json_float")]
     pub max_abs_err: Option<f64>,
     pub steps: u64,
     pub error: Option<String>,
@@ -67,6 +72,30 @@ pub fn parse_shard(s: &str) -> Result<Shard> {
         bail!("--shard {s:?}: need 0 ≤ I < N");
     }
     Ok(Shard { index, count })
+}
+
+/// Most worker threads for `available` cores: beyond a few per core more
+/// threads only cost start-up time (100000 would take minutes to start).
+fn max_threads(available: usize) -> usize {
+    (4 * available).min(256)
+}
+
+/// The `--threads` to run with: `None` for one per core; a request above
+/// [`max_threads`] is capped with a notice on standard error.
+pub fn worker_threads(requested: Option<usize>) -> Result<Option<usize>> {
+    let Some(n) = requested else { return Ok(None) };
+    if n == 0 {
+        bail!("--threads 0: need at least one thread");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    let max = max_threads(cores);
+    if n > max {
+        crate::terminal::eprint_line(&format!(
+            "notice: --threads {n} is more than {max} (4 per core on {cores} cores, at most 256); using {max}"
+        ));
+        return Ok(Some(max));
+    }
+    Ok(Some(n))
 }
 
 /// The axes of the scenario's `[sweep]` table, in file order.

@@ -132,7 +132,9 @@ fn shipped_examples_run() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             let dir = tempfile::tempdir().unwrap();
-            let out = cdyn(&["run"], Some(&path), dir.path());
+            // A sweep example is for `cdyn sweep`: `run` refuses its [sweep] table.
+            let is_sweep = std::fs::read_to_string(&path).unwrap().lines().any(|l| l.trim() == "[sweep]");
+            let out = cdyn(&[if is_sweep { "sweep" } else { "run" }], Some(&path), dir.path());
             assert!(out.status.success(), "{}: {}", path.display(), String::from_utf8_lossy(&out.stderr));
         }
     }

@@ -12,6 +12,8 @@ pub mod energy;
 pub mod error;
 pub mod force;
 pub mod integrate;
+#[cfg(feature = "serde")]
+pub mod json_float;
 mod linalg;
 pub mod mass;
 pub mod methods;

@@ -95,33 +95,40 @@ pub struct Series {
 
 /// What a recorded run produced. With the `serde` feature it serializes
 /// under the names summaries have always used (the paper's error is in `X`:
-/// `max_abs_err_x`, `err_x_final`, `rhs_evals`); the series and the error
-/// are left to the caller.
+/// `max_abs_err_x`, `err_x_final`, `rhs_evals`), infinities and NaN as
+/// strings ([`crate::json_float`]); the series and the error are left to
+/// the caller.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Record {
     /// Largest `|Φ|` over the samples.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub max_abs_phi: f64,
     /// Largest `|Ψ|` over the samples.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub max_abs_psi: f64,
     /// Largest error of the first observable against the reference; `None` without one.
-    #[cfg_attr(feature = "serde", serde(rename = "max_abs_err_x"))]
+    #[cfg_attr(feature = "serde", serde(rename = "max_abs_err_x", serialize_with = "crate::json_float::serialize"))]
     pub max_abs_error: Option<f64>,
     /// That error at the last sample; `None` without a reference or a sample.
-    #[cfg_attr(feature = "serde", serde(rename = "err_x_final"))]
+    #[cfg_attr(feature = "serde", serde(rename = "err_x_final", serialize_with = "crate::json_float::serialize"))]
     pub final_error: Option<f64>,
     /// Largest coupling measure `max_i |Y_ci|` over the samples.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub max_abs_coupling: f64,
     /// Steps taken.
     pub steps: u64,
     /// Time reached.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub t_final: f64,
     /// Right-hand-side evaluations.
     #[cfg_attr(feature = "serde", serde(rename = "rhs_evals"))]
     pub evaluations: u64,
     /// Positions at the end (after a failure: where the run stopped).
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub q_end: Vec<f64>,
     /// Velocities at the end.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub v_end: Vec<f64>,
     /// The sampled series, when asked for with [`Recorder::keep_series`].
     #[cfg_attr(feature = "serde", serde(skip))]

@@ -181,8 +181,9 @@ impl<S: System> Stepper<S> {
         Ok(())
     }
 
-    /// Steps until `t_end` (the last step ends at or just past it), calling
-    /// `observe` at the start and after every `every`-th step and the last.
+    /// Steps until `t_end`, which must be a whole number of steps (see
+    /// [`steps_to`]), calling `observe` at the start and after every
+    /// `every`-th step and the last.
     pub fn run<E: From<Error>>(
         &mut self,
         t_end: f64,
@@ -202,7 +203,28 @@ impl<S: System> Stepper<S> {
     }
 }
 
-/// Number of steps of size `h` to reach `t_end`, tolerating round-off in `t_end / h`.
+/// Relative tolerance of "a whole number of steps": absorbs the round-off
+/// of decimal inputs (`20.0 / 0.01` is `1999.9999999999998`), far below any
+/// step a user means.
+const WHOLE_STEPS_TOLERANCE: f64 = 1e-9;
+
+/// Number of steps of size `h` that end exactly at `t_end`.
+///
+/// The rule: `t_end` must be a whole number of steps (to a relative 1e-9).
+/// The last step is never shortened or stretched — a shortened step would
+/// break the fixed step every scheme and the multistep history assume — and
+/// a run never overshoots `t_end`. `h > t_end` and any other `t_end` are an
+/// [`Error::InvalidParameter`] naming `h` or `t_end`; [`nearest_valid_t_end`]
+/// is the end time to suggest instead.
+///
+/// ```
+/// use cdyn::simulate::{nearest_valid_t_end, steps_to};
+/// assert_eq!(steps_to(20.0, 0.01)?, 2000);
+/// assert!(steps_to(0.105, 0.01).is_err());
+/// assert!(steps_to(0.1, 0.5).is_err());
+/// assert!((nearest_valid_t_end(0.1049, 0.01) - 0.1).abs() < 1e-12);
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
     positive("t_end", t_end)?;
     positive("h", h)?;
@@ -210,7 +232,23 @@ pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
     if ratio > 1e12 {
         return Err(Error::InvalidParameter { name: "t_end / h", value: ratio, reason: "more than 1e12 steps" });
     }
-    Ok((ratio - 1e-9 * ratio.max(1.0)).ceil().max(1.0) as u64)
+    let steps = ratio.round();
+    if steps >= 1.0 && (ratio - steps).abs() <= WHOLE_STEPS_TOLERANCE * ratio {
+        Ok(steps as u64)
+    } else if ratio < 1.0 {
+        Err(Error::InvalidParameter { name: "h", value: h, reason: "must not exceed t_end" })
+    } else {
+        Err(Error::InvalidParameter { name: "t_end", value: t_end, reason: "must be a whole number of steps h" })
+    }
+}
+
+/// The end time nearest to `t_end` that [`steps_to`] accepts for `h`: a
+/// whole number of steps, at least one. It is rounded to 12 significant
+/// digits so that it prints as a user would write it (`0.11`, not
+/// `0.10999999999999999`); that moves it far less than the tolerance.
+pub fn nearest_valid_t_end(t_end: f64, h: f64) -> f64 {
+    let t = (t_end / h).round().max(1.0) * h;
+    format!("{t:.11e}").parse().unwrap_or(t)
 }
 
 /// Whether every value is finite; without early exit inside a chunk, so
