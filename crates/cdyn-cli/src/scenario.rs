@@ -283,7 +283,7 @@ impl Scenario {
             bail!("{file}: [[bodies]], [[joints]], [[drives]] and [[forces]] need [model] kind = \"mechanism\"");
         }
         let pendulum = matches!(m.kind, Kind::Pendulum | Kind::PendulumTheta);
-        if m.parameters.is_some() && matches!(m.kind, Kind::Pendulum | Kind::PendulumTheta | Kind::Mechanism) {
+        if m.parameters.is_some() && (pendulum || m.kind == Kind::Mechanism) {
             bail!(
                 "{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none"
             );
@@ -331,9 +331,7 @@ impl Scenario {
             }
         }
     }
-}
 
-impl Scenario {
     /// The element lists in the order the mechanism takes them.
     fn element_lists(&self) -> [(Group, &[Element<String>]); 3] {
         [(Group::Joints, &self.joints), (Group::Drives, &self.drives), (Group::Forces, &self.forces)]
