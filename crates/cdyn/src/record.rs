@@ -250,12 +250,8 @@ impl<'a, K: Sink> Recorder<'a, K> {
             Observed::Coordinates => (q, None),
             Observed::Example { example, values, reference } => {
                 (example.observe)(q, v, values);
-                // As `Example::error`, into buffers allocated once.
-                let error = reference.as_mut().zip(example.reference.as_ref()).map(|((qr, vr, at_ref), exact)| {
-                    exact(t, qr, vr);
-                    (example.observe)(qr, vr, at_ref);
-                    values[0] - at_ref[0]
-                });
+                let error =
+                    reference.as_mut().and_then(|(qr, vr, at_ref)| example.error_of(values[0], t, qr, vr, at_ref));
                 (&values[..], error)
             }
         };

@@ -95,10 +95,19 @@ impl Example {
 
     /// Error of the first observable against the reference at time `t`.
     pub fn error(&self, q: &[f64], v: &[f64], t: f64) -> Option<f64> {
-        let reference = self.reference.as_ref()?;
         let n = self.model.n();
-        let (mut qr, mut vr) = (vec![0.0; n], vec![0.0; n]);
-        reference(t, &mut qr, &mut vr);
-        Some(self.observe(q, v)[0] - self.observe(&qr, &vr)[0])
+        let (mut qr, mut vr, mut at_ref) = (vec![0.0; n], vec![0.0; n], vec![0.0; self.observables.len()]);
+        self.error_of(self.observe(q, v)[0], t, &mut qr, &mut vr, &mut at_ref)
+    }
+
+    /// The error of `first`, the first observable of a state, against the
+    /// reference at time `t`, into caller-held buffers (the reference state
+    /// `qr`, `vr` and its observables `at_ref`), so that a recorder sampling
+    /// a long run allocates nothing.
+    pub fn error_of(&self, first: f64, t: f64, qr: &mut [f64], vr: &mut [f64], at_ref: &mut [f64]) -> Option<f64> {
+        let reference = self.reference.as_ref()?;
+        reference(t, qr, vr);
+        (self.observe)(qr, vr, at_ref);
+        Some(first - at_ref[0])
     }
 }
