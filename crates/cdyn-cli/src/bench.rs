@@ -133,6 +133,7 @@ fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
         geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
         energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
         application: Application::ForwardEuler,
+        ..Control::none()
     };
     let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;

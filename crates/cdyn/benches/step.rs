@@ -68,6 +68,7 @@ fn chains(c: &mut Criterion) {
         geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
         energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
         application: Application::ForwardEuler,
+        ..Control::none()
     };
     let mut group = c.benchmark_group("chain_cvsgf_energy_ab3");
     for n in sizes {

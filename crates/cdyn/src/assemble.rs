@@ -9,6 +9,7 @@
 
 use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Part, Problem, Result};
+use crate::projection::{Failure, Work, positions, velocities};
 use crate::model::Model;
 
 /// What the assembly changed.
@@ -36,48 +37,36 @@ fn max_abs(x: &[f64]) -> f64 {
 
 /// Projects `(q, v)` at time `t` onto the constraints, to `|Φ| ≤ tolerance`.
 pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: f64) -> Result<Assembly> {
-    const MAX_ITERATIONS: usize = 50;
+    const MAX_ITERATIONS: u32 = 50;
     let mut d = Dynamics::new(model);
     let (q_start, v_start) = (q.to_vec(), v.to_vec());
     let mut out = Assembly::default();
-    let mut correction = vec![0.0; model.n()];
-    let mut rhs = vec![0.0; model.m()];
-    let singular = |b: Breakdown, iteration: usize| match b {
-        Breakdown::Singular(row) => Problem::SingularAssembly { row, iteration }.at(Part::Assembly),
-        Breakdown::NonFinite => Problem::NonFinitePositions.at(Part::Assembly),
-    };
-    loop {
-        d.evaluate(model, q, v, t).map_err(|b| singular(b, out.newton_iterations))?;
-        let phi = max_abs(d.phi());
-        if out.newton_iterations == 0 {
-            out.phi_before = phi;
-            out.phi_dot_before = max_abs(d.phi_dot());
+    let mut work = Work::new(model);
+    d.evaluate(model, q, v, t).map_err(|b| singular(b, 0))?;
+    out.phi_before = max_abs(d.phi());
+    out.phi_dot_before = max_abs(d.phi_dot());
+    let iterations = positions(model, &mut d, q, v, t, tolerance, MAX_ITERATIONS, &mut work).map_err(|f| match f {
+        Failure::Breakdown(b, iteration) => singular(b, iteration),
+        Failure::Positions { residual, iterations, .. } => {
+            Problem::NoConvergence { phi: residual, iterations: iterations as usize }.at(Part::Assembly)
         }
-        if phi <= tolerance {
-            out.phi_after = phi;
-            break;
-        }
-        if out.newton_iterations == MAX_ITERATIONS || !phi.is_finite() {
-            return Err(Problem::NoConvergence { phi, iterations: out.newton_iterations }.at(Part::Assembly));
-        }
-        rhs.copy_from_slice(d.phi());
-        correction.fill(0.0);
-        d.add_constraint_response(model, &mut rhs, &mut correction);
-        for (q, c) in q.iter_mut().zip(&correction) {
-            *q += c;
-        }
-        out.newton_iterations += 1;
-    }
+        // Not met: assembly does not project the energy.
+        Failure::Energy { residual } => Problem::NoConvergence { phi: residual, iterations: 0 }.at(Part::Assembly),
+    })?;
+    out.newton_iterations = iterations as usize;
+    out.phi_after = max_abs(d.phi());
     // Φ_q v + Φ_t = Φ̇ at the assembled positions; remove it in one linear step.
-    rhs.copy_from_slice(d.phi_dot());
-    correction.fill(0.0);
-    d.add_constraint_response(model, &mut rhs, &mut correction);
-    for (v, c) in v.iter_mut().zip(&correction) {
-        *v += c;
-    }
-    d.evaluate(model, q, v, t).map_err(|b| singular(b, out.newton_iterations))?;
+    velocities(model, &d, v, &mut work);
+    d.evaluate(model, q, v, t).map_err(|b| singular(b, out.newton_iterations as u32))?;
     out.phi_dot_after = max_abs(d.phi_dot());
     out.max_dq = q.iter().zip(&q_start).fold(0.0, |a, (x, y)| a.max((x - y).abs()));
     out.max_dv = v.iter().zip(&v_start).fold(0.0, |a, (x, y)| a.max((x - y).abs()));
     Ok(out)
+}
+
+fn singular(b: Breakdown, iteration: u32) -> crate::Error {
+    match b {
+        Breakdown::Singular(row) => Problem::SingularAssembly { row, iteration: iteration as usize }.at(Part::Assembly),
+        Breakdown::NonFinite => Problem::NonFinitePositions.at(Part::Assembly),
+    }
 }

@@ -5,18 +5,50 @@
 use crate::error::{Result, non_negative, positive};
 use crate::integrate::Application;
 use crate::mass::MassMatrix;
+use crate::projection::Projection;
 
 /// A gain either fixed, or set at every evaluation from a target decay rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Gain {
     /// The gain itself (`ζ` for CVSGF).
     Fixed(f64),
     /// A target linearized decay rate (`α_g`, Eq. 40): `ζᵢ = α_g / (2|∇Φᵢ|²)`.
     Rate(f64),
+    /// A rate chosen when the simulation starts (see [`crate::gains`]): the
+    /// largest that keeps the most strongly coupled mode of the constraints
+    /// inside the scheme's stability interval.
+    Auto,
+}
+
+/// A target decay rate, given or chosen when the simulation starts from
+/// the scheme, the step and how the control is applied (see [`crate::gains`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Rate {
+    /// This rate (1/s).
+    Given(f64),
+    /// Chosen at the start of the simulation.
+    Auto,
+}
+
+impl Rate {
+    /// The rate; an unresolved `Auto` acts as no control.
+    #[inline(always)]
+    pub fn value(self) -> f64 {
+        match self {
+            Rate::Given(a) => a,
+            Rate::Auto => 0.0,
+        }
+    }
 }
 
 /// Control of the holonomic constraints.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Geometric {
     /// No geometric control (Eq. 8).
     #[default]
@@ -30,6 +62,31 @@ pub enum Geometric {
     },
     /// CVSGF: `dq/dt = v − 2 Φ_qᵀ Z Φ` (Eqs. 28, 49).
     Gradient(Gain),
+    /// CVSGF in the kinetic-energy metric with the coupled gain matrix
+    /// `Z = α_g (Φ_q M⁻¹ Φ_qᵀ)⁻¹`: `dq/dt = v − α_g M⁻¹ Φ_qᵀ (Φ_q M⁻¹ Φ_qᵀ)⁻¹ Φ`.
+    /// It is the gradient of `½ Φᵀ Z Φ` (with `Z` frozen) in the metric `M`,
+    /// so `Φ_q U_q = −α_g Φ` exactly: every constraint mode, coupled or
+    /// not, decays at the rate `α_g`. One solve with the factorization of `λ`.
+    /// With an Euler step and `h α_g = 1` it is one Gauss–Newton step of the
+    /// minimum-norm projection that assembly does.
+    Newton(Rate),
+}
+
+/// Velocity-level gradient feedback on `Φ̇ = Φ_q v + Φ_t`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Velocity {
+    /// None.
+    #[default]
+    None,
+    /// `dv/dt = … − α_v M⁻¹ Φ_qᵀ (Φ_q M⁻¹ Φ_qᵀ)⁻¹ Φ̇`: the gradient of
+    /// `½ Φ̇ᵀ Z_v Φ̇` with respect to `v` in the metric `M`, with
+    /// `Z_v = α_v (Φ_q M⁻¹ Φ_qᵀ)⁻¹`, so `Φ_q U_v = −α_v Φ̇` exactly. In the
+    /// right-hand side it is Baumgarte's damping term `α Φ̇` alone; applied
+    /// by an Euler step, next to CVSGF, it removes the equilibria off the
+    /// constraint manifold that position feedback alone leaves.
+    Gradient(Rate),
 }
 
 impl Gain {
@@ -39,7 +96,7 @@ impl Gain {
         match self {
             Gain::Fixed(z) => z,
             Gain::Rate(alpha_g) if g2 > 0.0 => alpha_g / (2.0 * g2),
-            Gain::Rate(_) => 0.0,
+            Gain::Rate(_) | Gain::Auto => 0.0,
         }
     }
 }
@@ -62,6 +119,8 @@ pub(crate) fn baumgarte_gains(omega: f64, damping_ratio: f64) -> Result<(f64, f6
 
 /// Gains of the gradient energy control.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum EnergyGain {
     /// `ρ_q`, `ρ_v` as given (Eq. 20).
     Fixed {
@@ -79,6 +138,8 @@ pub enum EnergyGain {
 
 /// Control of the energy constraint `Ψ`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Energy {
     /// No energy control.
     #[default]
@@ -90,17 +151,41 @@ pub enum Energy {
     },
     /// Steepest descent on `Ψ²` (Eqs. 20, 22, 44).
     Gradient(EnergyGain),
+    /// Gradient feedback that respects the constraints (README, "Energy
+    /// control that respects the constraints"): along `g_v = P v` and
+    /// `g_q = c P M⁻¹ ∇V`, with `P = I − M⁻¹Φ_qᵀ(Φ_q M⁻¹ Φ_qᵀ)⁻¹Φ_q`, scaled
+    /// so that `Ψ̇ = −α_e Ψ`. `Φ_q U_q = Φ_q U_v = 0` exactly, and the gain
+    /// stays bounded when the kinetic energy passes through zero because
+    /// the position part takes over there. `c = position_weight / α_e²`.
+    Projected {
+        /// Target decay rate `α_e` of `Ψ`.
+        alpha_e: Rate,
+        /// `c α_e²`, dimensionless: how early the position part takes over
+        /// near a turning point. 0 gives the paper's direction (projected).
+        position_weight: f64,
+    },
 }
 
-/// A complete stabilization method: one row of the table in `equations.md`.
+/// The default `position_weight` of [`Energy::Projected`]: `c = 16/α_e²`,
+/// the suite's choice (README).
+pub const POSITION_WEIGHT: f64 = 16.0;
+
+/// A complete stabilization method: one row of the table in `equations.md`,
+/// plus velocity-level feedback.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Control {
     /// Control of the holonomic constraints.
     pub geometric: Geometric,
+    /// Velocity-level feedback on `Φ̇`.
+    pub velocity: Velocity,
     /// Control of the energy constraint.
     pub energy: Energy,
     /// Where the control term is integrated.
     pub application: Application,
+    /// Exact projection onto the invariants after every step (the
+    /// `projection` method), if any.
+    pub projection: Option<Projection>,
 }
 
 /// What the control laws read of one evaluation of the dynamics.
@@ -120,6 +205,32 @@ pub(crate) trait Evaluation {
     /// For a change `b` of the constraint right-hand side, adds the change
     /// of acceleration `−M⁻¹ Φ_qᵀ S⁻¹ b` to `out`; `b` is overwritten.
     fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]);
+
+    /// `out = Φ_q x`.
+    fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
+        for (r, o) in out.iter_mut().enumerate() {
+            let (jac, cols) = self.row(r);
+            *o = jac.iter().zip(cols).map(|(j, &c)| j * x[c as usize]).sum();
+        }
+    }
+
+    /// `out = P x = x − M⁻¹Φ_qᵀ S⁻¹ Φ_q x`, the `M`-orthogonal projection
+    /// onto the null space of `Φ_q`; `rows` (length `m`) is scratch.
+    fn project(&self, x: &[f64], rows: &mut [f64], out: &mut [f64]) {
+        out.copy_from_slice(x);
+        self.jac_mul(x, rows);
+        self.add_constraint_response(rows, out);
+    }
+}
+
+/// Buffers the control laws work in: `m` and twice `n` values.
+pub(crate) struct Workspace<'a> {
+    /// Length `m`.
+    pub rows: &'a mut [f64],
+    /// Length `n`.
+    pub a: &'a mut [f64],
+    /// Length `n`.
+    pub b: &'a mut [f64],
 }
 
 /// Below this `|Ψ_v|²` (or `vᵀMv`) the energy control has no direction to
@@ -134,11 +245,14 @@ impl Control {
 
     /// Whether any control term can be non-zero.
     pub fn is_active(&self) -> bool {
-        self.geometric != Geometric::None || self.energy != Energy::None
+        self.geometric != Geometric::None || self.velocity != Velocity::None || self.energy != Energy::None
     }
 
-    /// Checks every gain is finite and not negative.
+    /// Checks every gain is finite and not negative, and the projection's settings.
     pub fn validate(&self) -> Result<()> {
+        if let Some(p) = &self.projection {
+            p.validate()?;
+        }
         match self.geometric {
             Geometric::None => {}
             Geometric::Baumgarte { alpha, beta } => {
@@ -146,7 +260,13 @@ impl Control {
                 non_negative("beta", beta)?;
             }
             Geometric::Gradient(Gain::Fixed(z)) => _ = non_negative("zeta", z)?,
-            Geometric::Gradient(Gain::Rate(a)) => _ = non_negative("alpha_g", a)?,
+            Geometric::Gradient(Gain::Rate(a)) | Geometric::Newton(Rate::Given(a)) => {
+                _ = non_negative("alpha_g", a)?
+            }
+            Geometric::Gradient(Gain::Auto) | Geometric::Newton(Rate::Auto) => {}
+        }
+        if let Velocity::Gradient(Rate::Given(a)) = self.velocity {
+            non_negative("alpha_v", a)?;
         }
         match self.energy {
             Energy::None => {}
@@ -156,13 +276,18 @@ impl Control {
                 non_negative("rho_v", rho_v)?;
             }
             Energy::Gradient(EnergyGain::Rate { alpha_e }) => _ = non_negative("alpha_e", alpha_e)?,
+            Energy::Projected { alpha_e, position_weight } => {
+                if let Rate::Given(a) = alpha_e {
+                    non_negative("alpha_e", a)?;
+                }
+                non_negative("position_weight", position_weight)?;
+            }
         }
         Ok(())
     }
 
     /// Writes the control term `U = (U_q, U_v)` at a state whose dynamics
-    /// `d` were just evaluated. `psi` and `e_dot` are `Ψ` and `Ė` there;
-    /// `scratch` has length `m`.
+    /// `d` were just evaluated. `psi` and `e_dot` are `Ψ` and `Ė` there.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn terms<E: Evaluation>(
@@ -173,8 +298,9 @@ impl Control {
         e_dot: f64,
         u_q: &mut [f64],
         u_v: &mut [f64],
-        scratch: &mut [f64],
+        work: Workspace<'_>,
     ) {
+        let scratch = work.rows;
         u_q.fill(0.0);
         u_v.fill(0.0);
         let mass = d.mass();
@@ -197,6 +323,22 @@ impl Control {
                     }
                 }
             }
+            Geometric::Newton(rate) => {
+                // U_q = −α_g M⁻¹ Φ_qᵀ S⁻¹ Φ
+                let alpha = rate.value();
+                for (b, p) in scratch.iter_mut().zip(d.phi()) {
+                    *b = alpha * p;
+                }
+                d.add_constraint_response(scratch, u_q);
+            }
+        }
+        if let Velocity::Gradient(rate) = self.velocity {
+            // U_v −= α_v M⁻¹ Φ_qᵀ S⁻¹ Φ̇
+            let alpha = rate.value();
+            for (b, p) in scratch.iter_mut().zip(d.phi_dot()) {
+                *b = alpha * p;
+            }
+            d.add_constraint_response(scratch, u_v);
         }
         match self.energy {
             Energy::None => {}
@@ -227,6 +369,47 @@ impl Control {
                     let mu = num / two_t;
                     // U_v −= μ M⁻¹ Ψ_vᵀ   (Eq. 19)
                     mass.add_inverse_psi_v(v, -mu, u_v);
+                }
+            }
+            Energy::Projected { alpha_e, position_weight } => {
+                let alpha = alpha_e.value();
+                if alpha == 0.0 || psi == 0.0 {
+                    return;
+                }
+                // g_v = P v, and |P v|²_M = Ψ_v g_v since P is M-orthogonal.
+                let g_v = work.a;
+                d.project(v, scratch, g_v);
+                let mut norm = mass.psi_v_dot(v, |i| g_v[i], |_| 0.0, 0.0);
+                // g_q = c P M⁻¹ ∇V, and ∇V·g_q = c |P M⁻¹ ∇V|²_M.
+                let c = position_weight / (alpha * alpha);
+                let g_q = work.b;
+                let use_positions = c > 0.0;
+                if use_positions {
+                    // M⁻¹∇V, projected in place: rows = Φ_q w, then w −= M⁻¹Φ_qᵀ S⁻¹ rows.
+                    mass.solve(d.grad_potential(), g_q);
+                    d.jac_mul(g_q, scratch);
+                    d.add_constraint_response(scratch, g_q);
+                    for g in g_q.iter_mut() {
+                        *g *= c;
+                    }
+                    norm += g_q.iter().zip(d.grad_potential()).map(|(g, p)| g * p).sum::<f64>();
+                }
+                // A correction is a first-order step along the gradient; where
+                // the gradient is too short to reach Ψ = 0 without the
+                // quadratic terms dominating (N < |Ψ|: a static equilibrium,
+                // or at rest at an extremum of V on the constraint surface)
+                // the gain is capped so that |U| stays bounded (README).
+                let scale = alpha * psi / norm.max(psi.abs());
+                if !(norm > REST) || !scale.is_finite() {
+                    return;
+                }
+                for (u, g) in u_v.iter_mut().zip(g_v.iter()) {
+                    *u -= scale * g;
+                }
+                if use_positions {
+                    for (u, g) in u_q.iter_mut().zip(g_q.iter()) {
+                        *u -= scale * g;
+                    }
                 }
             }
         }

@@ -69,9 +69,31 @@ pub enum Error {
         /// The configured limit.
         limit: f64,
     },
+    /// The exact projection (the `projection` method) did not converge.
+    #[error(
+        "projection did not converge at step {step}, t = {t}: {invariant} = {residual:.3e}{} after {iterations} Newton iterations (raise max_iterations or tolerance, or set on_failure = \"continue\")",
+        row.map_or(String::new(), |r| format!(" in constraint row {r}"))
+    )]
+    ProjectionFailed {
+        /// Steps taken, including the one whose result could not be projected.
+        step: u64,
+        /// Time of the state that could not be projected.
+        t: f64,
+        /// `|Φ|` or `|Ψ|`.
+        invariant: &'static str,
+        /// The worst violation left.
+        residual: f64,
+        /// The worst constraint row, for `|Φ|`.
+        row: Option<usize>,
+        /// Newton iterations taken.
+        iterations: u32,
+    },
     /// Method keys that do not describe one method.
     #[error("{0}")]
     Method(#[from] KeyProblem),
+    /// A combination of settings this kind of simulation does not offer.
+    #[error("{0}")]
+    Unsupported(&'static str),
     /// The pendulum's energy lies within a relative 1e-10 of the upright
     /// energy: the period diverges and the elliptic closed form of the
     /// reference solution degenerates.
@@ -93,6 +115,14 @@ pub enum KeyProblem {
         key: &'static str,
         /// The selection that uses it, e.g. `geometric = "cvsgf"`.
         method: &'static str,
+    },
+    /// A key that a preset sets itself.
+    #[error("{preset} sets {key} itself; remove {key}, or write the method out key by key")]
+    Preset {
+        /// The preset, e.g. `preset = "robust"`.
+        preset: &'static str,
+        /// The key given.
+        key: &'static str,
     },
     /// A selected method without its gains, or with an incomplete set.
     #[error("{method} takes {takes}")]

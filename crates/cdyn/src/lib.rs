@@ -11,6 +11,7 @@ pub mod dynamics;
 pub mod energy;
 pub mod error;
 pub mod force;
+pub mod gains;
 pub mod integrate;
 #[cfg(feature = "serde")]
 pub mod json_float;
@@ -20,6 +21,7 @@ pub mod methods;
 pub mod model;
 pub mod models;
 pub mod planar;
+pub mod projection;
 pub mod record;
 pub mod reference;
 pub mod scalar;
@@ -30,7 +32,7 @@ pub mod system;
 pub mod timefn;
 
 pub use constraint::Constraint;
-pub use control::{Control, Energy, EnergyGain, Gain, Geometric};
+pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
 pub use error::{Error, Result};
 pub use force::{Force, Potential};
 pub use integrate::{Application, Scheme};

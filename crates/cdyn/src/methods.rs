@@ -3,9 +3,78 @@
 //! named cases of the paper's comparison, for `cdyn paper`, `compare`,
 //! `bench` and benchmarks. A simulation itself needs only a [`Control`].
 
-use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, baumgarte_gains};
+use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity, baumgarte_gains};
 use crate::error::{Error, KeyProblem, Result, non_negative};
 use crate::integrate::Application;
+use crate::projection::{OnFailure, Projection};
+
+/// A whole method by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Preset {
+    /// [`robust`]: the combination the method suite shows best, with automatic gains.
+    Robust,
+    /// [`projection`]: exact projection onto the invariants after every step.
+    Projection,
+}
+
+/// A rate as scenario files write it: a number (1/s), or `"auto"`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RateKey {
+    /// This rate.
+    Value(f64),
+    /// Chosen when the simulation starts ([`crate::gains`]).
+    Auto,
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for RateKey {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = RateKey;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<RateKey, E> {
+                Ok(RateKey::Value(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<RateKey, E> {
+                Ok(RateKey::Value(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<RateKey, E> {
+                Ok(RateKey::Value(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<RateKey, E> {
+                match v {
+                    "auto" => Ok(RateKey::Auto),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for RateKey {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            RateKey::Value(v) => s.serialize_f64(*v),
+            RateKey::Auto => s.serialize_str("auto"),
+        }
+    }
+}
+
+impl RateKey {
+    fn rate(self, key: &'static str) -> Result<Rate> {
+        Ok(match self {
+            RateKey::Value(a) => Rate::Given(non_negative(key, a)?),
+            RateKey::Auto => Rate::Auto,
+        })
+    }
+}
 
 /// The geometric control a [`MethodKeys`] names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -17,8 +86,23 @@ pub enum GeometricKind {
     None,
     /// Baumgarte's method: `alpha` and `beta`, or `omega` (and `damping_ratio`).
     Baumgarte,
-    /// CVSGF: `zeta` or `alpha_g`.
+    /// CVSGF: `zeta` or `alpha_g` (a number or `"auto"`).
     Cvsgf,
+    /// CVSGF with the coupled gain in the kinetic-energy metric
+    /// ([`Geometric::Newton`]): `alpha_g`, automatic when not given.
+    Newton,
+}
+
+/// The velocity-level feedback a [`MethodKeys`] names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum VelocityKind {
+    /// None.
+    #[default]
+    None,
+    /// Gradient feedback on `Φ̇` ([`Velocity::Gradient`]): `alpha_v`, automatic when not given.
+    Gradient,
 }
 
 /// The energy control a [`MethodKeys`] names.
@@ -33,6 +117,9 @@ pub enum EnergyKind {
     Gradient,
     /// Baumgarte-type: `eta`.
     Baumgarte,
+    /// Gradient feedback that respects the constraints ([`Energy::Projected`]):
+    /// `alpha_e` (automatic when not given) and `position_weight`.
+    Projected,
 }
 
 /// A stabilization method as scenario files write it: one flat table whose
@@ -43,16 +130,24 @@ pub enum EnergyKind {
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct MethodKeys {
-    /// `none`, `baumgarte` or `cvsgf`.
+    /// A whole method by name: `robust` or `projection`; then only the
+    /// projection's settings may be given besides.
+    pub preset: Option<Preset>,
+    /// `none`, `baumgarte`, `cvsgf` or `newton`.
     pub geometric: GeometricKind,
-    /// `none`, `gradient` or `baumgarte`.
+    /// `none` or `gradient`.
+    pub velocity: VelocityKind,
+    /// `none`, `gradient`, `baumgarte` or `projected`.
     pub energy: EnergyKind,
-    /// `rhs`, `forward_euler` or `backward_euler`.
-    pub apply: Application,
+    /// `rhs` (the default), `forward_euler` or `backward_euler`.
+    pub apply: Option<Application>,
     /// CVSGF: fixed gain `ζ`.
     pub zeta: Option<f64>,
-    /// CVSGF: target rate `α_g`, `ζᵢ = α_g / (2|∇Φᵢ|²)` every step (Eq. 40).
-    pub alpha_g: Option<f64>,
+    /// CVSGF: target rate `α_g`, `ζᵢ = α_g / (2|∇Φᵢ|²)` every step (Eq. 40);
+    /// Newton: the exact rate. `"auto"` chooses it ([`crate::gains`]).
+    pub alpha_g: Option<RateKey>,
+    /// Velocity feedback: its rate `α_v`, or `"auto"`.
+    pub alpha_v: Option<RateKey>,
     /// Baumgarte: `α`.
     pub alpha: Option<f64>,
     /// Baumgarte: `β`.
@@ -61,17 +156,29 @@ pub struct MethodKeys {
     pub omega: Option<f64>,
     /// Baumgarte: damping ratio (`α = 2·ratio·ω`), default 1.
     pub damping_ratio: Option<f64>,
-    /// Gradient energy control: target rate `α_e` (Eq. 27).
-    pub alpha_e: Option<f64>,
+    /// Gradient energy control: target rate `α_e` (Eq. 27); projected: its
+    /// rate, or `"auto"`.
+    pub alpha_e: Option<RateKey>,
+    /// Projected energy control: `c α_e²` (default [`POSITION_WEIGHT`]).
+    pub position_weight: Option<f64>,
     /// Gradient energy control: fixed `ρ_q` (default 0, with `rho_v`).
     pub rho_q: Option<f64>,
     /// Gradient energy control: fixed `ρ_v`.
     pub rho_v: Option<f64>,
     /// Baumgarte-type energy control: `Ψ̇ + ηΨ = 0` (Eq. 19).
     pub eta: Option<f64>,
+    /// Projection: tolerance on `|Φ|`, `|Φ̇|`, `|Ψ|` (default 1e-10).
+    pub tolerance: Option<f64>,
+    /// Projection: Newton iterations allowed per step (default 10).
+    pub max_iterations: Option<u32>,
+    /// Projection: `stop` (default) or `continue` when it does not converge.
+    pub on_failure: Option<OnFailure>,
 }
 
 const CVSGF: &str = "geometric = \"cvsgf\"";
+const VELOCITY: &str = "velocity = \"gradient\"";
+const PROJECTED: &str = "energy = \"projected\"";
+const PROJECTION: &str = "preset = \"projection\"";
 const BAUMGARTE: &str = "geometric = \"baumgarte\"";
 const GRADIENT: &str = "energy = \"gradient\"";
 const ENERGY_BAUMGARTE: &str = "energy = \"baumgarte\"";
@@ -82,7 +189,8 @@ impl MethodKeys {
         Ok(match (self.zeta, self.alpha_g) {
             (Some(_), Some(_)) => return Err(KeyProblem::Both("zeta", "alpha_g").into()),
             (Some(z), None) => Some(Gain::Fixed(non_negative("zeta", z)?)),
-            (None, Some(a)) => Some(Gain::Rate(non_negative("alpha_g", a)?)),
+            (None, Some(RateKey::Value(a))) => Some(Gain::Rate(non_negative("alpha_g", a)?)),
+            (None, Some(RateKey::Auto)) => Some(Gain::Auto),
             (None, None) => None,
         })
     }
@@ -90,7 +198,7 @@ impl MethodKeys {
     /// The gradient energy gains given, if any: `alpha_e`, or `rho_v` (and `rho_q`).
     fn energy_gain(&self) -> Result<Option<EnergyGain>> {
         Ok(match (self.alpha_e, self.rho_q, self.rho_v) {
-            (Some(a), None, None) => Some(EnergyGain::Rate { alpha_e: non_negative("alpha_e", a)? }),
+            (Some(RateKey::Value(a)), None, None) => Some(EnergyGain::Rate { alpha_e: non_negative("alpha_e", a)? }),
             (None, q, Some(v)) => Some(EnergyGain::Fixed {
                 rho_q: non_negative("rho_q", q.unwrap_or(0.0))?,
                 rho_v: non_negative("rho_v", v)?,
@@ -127,19 +235,35 @@ impl MethodKeys {
 
     /// The control law, refusing gains that the selected methods do not use.
     pub fn control(&self) -> Result<Control> {
+        if let Some(preset) = self.preset {
+            return self.preset_control(preset);
+        }
+        for (key, given) in [
+            ("tolerance", self.tolerance.is_some()),
+            ("max_iterations", self.max_iterations.is_some()),
+            ("on_failure", self.on_failure.is_some()),
+        ] {
+            if given {
+                return Err(KeyProblem::Unused { key, method: PROJECTION }.into());
+            }
+        }
         let unused = |key: &'static str, value: Option<f64>, used: bool, method: &'static str| {
             if value.is_some() && !used { Err(Error::from(KeyProblem::Unused { key, method })) } else { Ok(()) }
         };
         let (g, e) = (self.geometric, self.energy);
-        for (key, value) in [("zeta", self.zeta), ("alpha_g", self.alpha_g)] {
-            unused(key, value, g == GeometricKind::Cvsgf, CVSGF)?;
-        }
+        unused("zeta", self.zeta, g == GeometricKind::Cvsgf, CVSGF)?;
+        let used = matches!(g, GeometricKind::Cvsgf | GeometricKind::Newton);
+        unused("alpha_g", self.alpha_g.map(|_| 0.0), used, "geometric = \"cvsgf\" or \"newton\"")?;
+        unused("alpha_v", self.alpha_v.map(|_| 0.0), self.velocity == VelocityKind::Gradient, VELOCITY)?;
+        unused("position_weight", self.position_weight, e == EnergyKind::Projected, PROJECTED)?;
         for (key, value) in
             [("alpha", self.alpha), ("beta", self.beta), ("omega", self.omega), ("damping_ratio", self.damping_ratio)]
         {
             unused(key, value, g == GeometricKind::Baumgarte, BAUMGARTE)?;
         }
-        for (key, value) in [("alpha_e", self.alpha_e), ("rho_q", self.rho_q), ("rho_v", self.rho_v)] {
+        let used = matches!(e, EnergyKind::Gradient | EnergyKind::Projected);
+        unused("alpha_e", self.alpha_e.map(|_| 0.0), used, "energy = \"gradient\" or \"projected\"")?;
+        for (key, value) in [("rho_q", self.rho_q), ("rho_v", self.rho_v)] {
             unused(key, value, e == EnergyKind::Gradient, GRADIENT)?;
         }
         unused("eta", self.eta, e == EnergyKind::Baumgarte, ENERGY_BAUMGARTE)?;
@@ -153,6 +277,11 @@ impl MethodKeys {
                 let (alpha, beta) = self.baumgarte_gains()?.ok_or_else(|| missing(BAUMGARTE, TAKES_BAUMGARTE))?;
                 Geometric::Baumgarte { alpha, beta }
             }
+            GeometricKind::Newton => Geometric::Newton(self.alpha_g.map_or(Ok(Rate::Auto), |r| r.rate("alpha_g"))?),
+        };
+        let velocity = match self.velocity {
+            VelocityKind::None => Velocity::None,
+            VelocityKind::Gradient => Velocity::Gradient(self.alpha_v.map_or(Ok(Rate::Auto), |r| r.rate("alpha_v"))?),
         };
         let energy = match e {
             EnergyKind::None => Energy::None,
@@ -161,10 +290,66 @@ impl MethodKeys {
                 Energy::Baumgarte { eta: non_negative("eta", eta)? }
             }
             EnergyKind::Gradient => {
+                if self.alpha_e == Some(RateKey::Auto) {
+                    return Err(KeyProblem::Gains { method: GRADIENT, takes: TAKES_ENERGY }.into());
+                }
                 Energy::Gradient(self.energy_gain()?.ok_or_else(|| missing(GRADIENT, TAKES_ENERGY))?)
             }
+            EnergyKind::Projected => Energy::Projected {
+                alpha_e: self.alpha_e.map_or(Ok(Rate::Auto), |r| r.rate("alpha_e"))?,
+                position_weight: non_negative("position_weight", self.position_weight.unwrap_or(POSITION_WEIGHT))?,
+            },
         };
-        Ok(Control { geometric, energy, application: self.apply })
+        Ok(Control { geometric, velocity, energy, application: self.apply.unwrap_or_default(), projection: None })
+    }
+
+    /// The control of a preset, refusing every key the preset sets itself.
+    fn preset_control(&self, preset: Preset) -> Result<Control> {
+        let name = match preset {
+            Preset::Robust => "preset = \"robust\"",
+            Preset::Projection => PROJECTION,
+        };
+        let mut keys = vec![
+            ("geometric", self.geometric != GeometricKind::None),
+            ("velocity", self.velocity != VelocityKind::None),
+            ("energy", self.energy != EnergyKind::None),
+            ("apply", self.apply.is_some()),
+            ("zeta", self.zeta.is_some()),
+            ("alpha_g", self.alpha_g.is_some()),
+            ("alpha_v", self.alpha_v.is_some()),
+            ("alpha", self.alpha.is_some()),
+            ("beta", self.beta.is_some()),
+            ("omega", self.omega.is_some()),
+            ("damping_ratio", self.damping_ratio.is_some()),
+            ("alpha_e", self.alpha_e.is_some()),
+            ("position_weight", self.position_weight.is_some()),
+            ("rho_q", self.rho_q.is_some()),
+            ("rho_v", self.rho_v.is_some()),
+            ("eta", self.eta.is_some()),
+        ];
+        if preset == Preset::Robust {
+            keys.extend([
+                ("tolerance", self.tolerance.is_some()),
+                ("max_iterations", self.max_iterations.is_some()),
+                ("on_failure", self.on_failure.is_some()),
+            ]);
+        }
+        if let Some((key, _)) = keys.into_iter().find(|(_, set)| *set) {
+            return Err(KeyProblem::Preset { preset: name, key }.into());
+        }
+        Ok(match preset {
+            Preset::Robust => robust(),
+            Preset::Projection => {
+                let d = Projection::default();
+                let p = Projection {
+                    tolerance: self.tolerance.unwrap_or(d.tolerance),
+                    max_iterations: self.max_iterations.unwrap_or(d.max_iterations),
+                    on_failure: self.on_failure.unwrap_or(d.on_failure),
+                };
+                p.validate()?;
+                Control { projection: Some(p), ..Control::none() }
+            }
+        })
     }
 }
 
@@ -205,6 +390,7 @@ impl MethodGains {
             geometric: Geometric::Gradient(self.cvsgf),
             energy: Energy::Gradient(self.energy),
             application: Application::ForwardEuler,
+            ..Control::none()
         }
     }
 }
@@ -217,7 +403,7 @@ pub fn redundant_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
     let baumgarte = Geometric::Baumgarte { alpha: g.baumgarte_alpha, beta: g.baumgarte_beta };
     let cvsgf = Geometric::Gradient(g.cvsgf);
     let energy = Energy::Gradient(g.energy);
-    let c = |geometric, energy, application| Control { geometric, energy, application };
+    let c = |geometric, energy, application| Control { geometric, energy, application, ..Control::none() };
     vec![
         ("none", Control::none()),
         ("baumgarte", c(baumgarte, Energy::None, Application::InRhs)),
@@ -236,4 +422,33 @@ pub fn independent_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
         ("theta", Control::none()),
         ("theta_energy", Control { energy: Energy::Gradient(g.energy), ..Control::none() }),
     ]
+}
+
+/// The `robust` preset: the combination the method suite shows best
+/// (README, "Choosing a method"), every rate automatic, applied by a
+/// forward Euler step: CVSGF with the coupled gain, velocity feedback on
+/// `Φ̇`, and energy control that respects the constraints.
+pub fn robust() -> Control {
+    Control {
+        geometric: Geometric::Newton(Rate::Auto),
+        velocity: Velocity::Gradient(Rate::Auto),
+        energy: Energy::Projected { alpha_e: Rate::Auto, position_weight: POSITION_WEIGHT },
+        application: Application::ForwardEuler,
+        projection: None,
+    }
+}
+
+/// The `projection` method with its default settings.
+pub fn projection() -> Control {
+    Control { projection: Some(Projection::default()), ..Control::none() }
+}
+
+/// The cases of `cdyn compare` and `cdyn suite`: the paper's comparison
+/// ([`redundant_cases`], or [`independent_cases`] without constraints),
+/// then `robust` and `projection`.
+pub fn compare_cases(g: &MethodGains, constrained: bool) -> Vec<(&'static str, Control)> {
+    let mut cases = if constrained { redundant_cases(g) } else { independent_cases(g) };
+    cases.push(("robust", robust()));
+    cases.push(("projection", projection()));
+    cases
 }

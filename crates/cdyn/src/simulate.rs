@@ -8,8 +8,10 @@ use crate::control::Control;
 use crate::diagnostics::Measures;
 use crate::dynamics::LinearSolver;
 use crate::error::{Error, Part, Problem, Result, positive};
+use crate::gains::{Tuning, resolve};
 use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
+use crate::projection::{Failure, OnFailure};
 use crate::system::{ControlledSystem, EvalError, System};
 
 /// How to simulate.
@@ -67,8 +69,12 @@ pub struct Stepper<S: System> {
     system: S,
     integrator: Integrator<S::State>,
     settings: Settings,
+    tuning: Tuning,
     x: S::State,
     step: u64,
+    /// Newton iterations of the projection so far, and steps it failed.
+    projection_iterations: u64,
+    projection_failures: u64,
 }
 
 /// A running simulation of a [`Model`].
@@ -115,11 +121,34 @@ impl<S: System> Stepper<S> {
                 return Err(Error::InconsistentInitialState { phi: m.phi.abs(), phi_dot: m.phi_dot, tolerance });
             }
         }
+        // Automatic gains, and the rate × h every control term runs at.
+        let (mu, max_row_norm2) = if settings.control.is_active() {
+            system.coupling(x.as_slice(), 0.0).map_err(|e| eval_error(e, 0, 0.0))?
+        } else {
+            (0.0, 0.0)
+        };
+        let (control, tuning) = resolve(settings.control, settings.scheme, settings.h, mu, max_row_norm2);
+        system.set_control(control);
+        let settings = Settings { control, ..settings };
         let integrator = Integrator::with_zero(settings.scheme, settings.control.application, system.zero_state());
-        Ok(Self { system, integrator, settings, x, step: 0 })
+        Ok(Self { system, integrator, settings, tuning, x, step: 0, projection_iterations: 0, projection_failures: 0 })
     }
 
-    /// The settings it runs with.
+    /// What the automatic gains were chosen from, and the largest rate × h
+    /// of the control terms ([`crate::gains`]).
+    pub fn tuning(&self) -> &Tuning {
+        &self.tuning
+    }
+    /// Newton iterations of the projection so far (the `projection` method).
+    pub fn projection_iterations(&self) -> u64 {
+        self.projection_iterations
+    }
+    /// Steps whose projection did not converge (with `on_failure = continue`).
+    pub fn projection_failures(&self) -> u64 {
+        self.projection_failures
+    }
+
+    /// The settings it runs with, its control with the automatic gains chosen.
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
@@ -163,13 +192,28 @@ impl<S: System> Stepper<S> {
     pub fn step(&mut self) -> Result<()> {
         let t = self.t();
         let step = self.step;
-        self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, self.settings.h).map_err(|e| match e {
-            EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
-            EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t + self.settings.h },
-        })?;
+        let h = self.settings.h;
+        self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
         self.step += 1;
         if !all_finite(self.x.as_slice()) {
             return Err(Error::Diverged { step: self.step, t: self.t() });
+        }
+        if let Some(p) = self.settings.control.projection {
+            let t = self.t();
+            match self.system.project(self.x.as_mut_slice(), t, &p) {
+                Ok(iterations) => self.projection_iterations += u64::from(iterations),
+                Err(f) => {
+                    let (invariant, residual, row, iterations) = match f {
+                        Failure::Breakdown(b, _) => return Err(eval_error(EvalError::at(b, t), self.step, t)),
+                        Failure::Positions { row, residual, iterations } => ("|Φ|", residual, Some(row), iterations),
+                        Failure::Energy { residual } => ("|Ψ|", residual, None, p.max_iterations),
+                    };
+                    if p.on_failure == OnFailure::Stop {
+                        return Err(Error::ProjectionFailed { step: self.step, t, invariant, residual, row, iterations });
+                    }
+                    self.projection_failures += 1;
+                }
+            }
         }
         // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.
         if self.settings.violation_limit.is_finite() {
@@ -249,6 +293,15 @@ pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
 pub fn nearest_valid_t_end(t_end: f64, h: f64) -> f64 {
     let t = (t_end / h).round().max(1.0) * h;
     format!("{t:.11e}").parse().unwrap_or(t)
+}
+
+/// The error of a failed evaluation during step `step` (steps taken before
+/// it), at time `t_next` for a state that stopped being finite.
+fn eval_error(e: EvalError, step: u64, t_next: f64) -> Error {
+    match e {
+        EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
+        EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t_next },
+    }
 }
 
 /// Whether every value is finite; without early exit inside a chunk, so

@@ -12,10 +12,11 @@
 //! model, and the tests hold both to the same trajectories.
 
 use crate::constraint::{Constraint, local};
-use crate::control::{Control, Evaluation};
+use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::Measures;
 use crate::energy;
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::projection::{Failure, Projection};
 use crate::force::{Force, Potential, energy_and_gradient};
 use crate::integrate::{Buffer, Rhs};
 use crate::linalg::{Breakdown, check_pivot};
@@ -88,6 +89,9 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
     /// and, unless disabled, that the initial state satisfies the constraints.
     pub fn new(system: S, settings: Settings, q0: [f64; N], v0: [f64; N]) -> Result<Self> {
         settings.validate()?;
+        if settings.control.projection.is_some() {
+            return Err(Error::Unsupported("the projection method runs on a general Model (small::to_model), not on a SmallSystem"));
+        }
         check_initial_state(N, &q0, &v0)?;
         let mass = DiagonalMass::new(system.mass())?;
         check_rows(M, N)?;
@@ -329,7 +333,8 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
             let (u_q, rest) = u.split_at_mut(N);
             let (u_v, u_e) = rest.split_at_mut(N);
             u_e[0] = 0.0;
-            self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, &mut [0.0; M]);
+            let work = Workspace { rows: &mut [0.0; M], a: &mut [0.0; N], b: &mut [0.0; N] };
+            self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, work);
         }
         Ok(())
     }
@@ -359,5 +364,18 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         let psi = energy::psi(&self.d.mass, &v, potential, e, self.e0);
         let columns = &SmallDynamics::<N, M>::COLUMNS;
         Measures::of(psi, &grad, &l.phi, &l.phi_dot, |r| (l.jac[r].as_slice(), columns.as_slice()))
+    }
+    fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError> {
+        let (q, v, _) = split(x);
+        self.d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
+        let rows = self.d.jac.iter().map(|row| row.iter().map(|j| j * j).sum::<f64>());
+        Ok((crate::gains::coupling(&self.d, N), rows.fold(0.0, f64::max)))
+    }
+    fn set_control(&mut self, control: Control) {
+        self.control = control;
+    }
+    /// Not reached: [`SmallSimulation::new`] refuses a projection.
+    fn project(&mut self, _: &mut [f64], _: f64, _: &Projection) -> Result<u32, Failure> {
+        Err(Failure::Energy { residual: f64::NAN })
     }
 }

@@ -1,13 +1,14 @@
 //! The controlled state equation `ẋ = f(x, t) + U(x, t)` of a model, with
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
-use crate::control::{Control, Evaluation};
+use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::{Buffer, Rhs};
 use crate::mass::DiagonalMass;
 use crate::model::Model;
+use crate::projection::{self, Failure, Projection};
 
 /// A failed evaluation of the right-hand side.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,6 +53,15 @@ pub trait System: Rhs<Error = EvalError> {
     fn last_violation(&self) -> f64;
     /// Violations at the state `x`, time `t`.
     fn measure(&mut self, x: &[f64], t: f64) -> Measures;
+    /// At the state `x`, time `t`: the largest mode `μ_max` of the paper's
+    /// CVSGF operator and the largest `|∇Φᵢ|²`, for automatic gains
+    /// ([`crate::gains`]). Not counted as an evaluation.
+    fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError>;
+    /// Replaces the control law (once its automatic gains are chosen).
+    fn set_control(&mut self, control: Control);
+    /// Projects the state `x` at time `t` onto the invariants (the
+    /// `projection` method); returns the Newton iterations taken.
+    fn project(&mut self, x: &mut [f64], t: f64, settings: &Projection) -> Result<u32, Failure>;
 }
 
 /// Splits a state into `(q, v, e)`.
@@ -67,8 +77,12 @@ pub struct ControlledSystem<'m> {
     dynamics: Dynamics,
     /// `E₀ = T₀ + V₀`
     e0: f64,
-    scratch: Vec<f64>,
+    /// Work space of the control laws: `m`, `n` and `n` values.
+    rows: Vec<f64>,
+    work_a: Vec<f64>,
+    work_b: Vec<f64>,
     probe: Probe,
+    projection: projection::Work,
     /// Right-hand-side evaluations so far.
     evaluations: u64,
 }
@@ -86,8 +100,11 @@ impl<'m> ControlledSystem<'m> {
             control,
             dynamics: Dynamics::with_solver(model, solver),
             e0,
-            scratch: vec![0.0; model.m()],
+            rows: vec![0.0; model.m()],
+            work_a: vec![0.0; model.n()],
+            work_b: vec![0.0; model.n()],
             probe: Probe::new(model),
+            projection: projection::Work::new(model),
             evaluations: 0,
         }
     }
@@ -135,7 +152,8 @@ impl Rhs for ControlledSystem<'_> {
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
             let d = Evaluated { model: self.model, dynamics: &self.dynamics };
-            self.control.terms(&d, v, psi, e_dot, u_q, u_v, &mut self.scratch);
+            let work = Workspace { rows: &mut self.rows, a: &mut self.work_a, b: &mut self.work_b };
+            self.control.terms(&d, v, psi, e_dot, u_q, u_v, work);
         }
         Ok(())
     }
@@ -161,6 +179,23 @@ impl System for ControlledSystem<'_> {
     fn measure(&mut self, x: &[f64], t: f64) -> Measures {
         let (q, v, e) = split_state(x, self.model.n());
         self.probe.measure(self.model, q, v, e, t, self.e0)
+    }
+    fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError> {
+        let (q, v, _) = split_state(x, self.model.n());
+        self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
+        let d = Evaluated { model: self.model, dynamics: &self.dynamics };
+        let rows = (0..self.model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
+        Ok((crate::gains::coupling(&d, self.model.n()), rows.fold(0.0, f64::max)))
+    }
+    fn set_control(&mut self, control: Control) {
+        self.control = control;
+    }
+    fn project(&mut self, x: &mut [f64], t: f64, settings: &Projection) -> Result<u32, Failure> {
+        let n = self.model.n();
+        let (q, rest) = x.split_at_mut(n);
+        let (v, e) = rest.split_at_mut(n);
+        let target = self.e0 + e[0];
+        projection::invariants(self.model, &mut self.dynamics, q, v, t, target, settings, &mut self.projection)
     }
 }
 

@@ -84,7 +84,7 @@ fn controls() -> Vec<Control> {
             [Energy::None, Energy::Gradient(EnergyGain::Rate { alpha_e: 40.0 }), Energy::Baumgarte { eta: 40.0 }]
         {
             for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-                out.push(Control { geometric, energy, application });
+                out.push(Control { geometric, energy, application, ..Control::none() });
             }
         }
     }
@@ -136,6 +136,7 @@ fn steps_do_not_allocate() {
             geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
             energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
             application: Application::ForwardEuler,
+            ..Control::none()
         };
         let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, control(1e-5)), 5, 200);
         assert_eq!(n, 0, "andrews, {scheme:?}: {n} allocations in 200 steps");

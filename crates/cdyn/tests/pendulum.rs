@@ -2,7 +2,7 @@
 //! every control by hand, control terms vanishing on the exact solution,
 //! decay rates of perturbations, and the work per step.
 
-use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
 use cdyn::dynamics::Dynamics;
 use cdyn::integrate::{Application, Integrator, Rhs, Scheme};
 use cdyn::models::{PendulumParams, cartesian_pendulum};
@@ -57,12 +57,11 @@ fn closed_form_control(c: &Control, s @ [x, y, vx, vy]: [f64; 4], e0: f64) -> [f
     let v2 = vx * vx + vy * vy;
     let mut u = [0.0; 4];
     let a = closed_form_acc(s);
-    let mut a_geo = a;
     match c.geometric {
         Geometric::None => {}
         Geometric::Baumgarte { alpha, beta } => {
             let lambda_b = (v2 - G * y + alpha * phi_dot + beta * phi) / r2;
-            a_geo = [-x * lambda_b, -G - y * lambda_b];
+            let a_geo = [-x * lambda_b, -G - y * lambda_b];
             u[2] = a_geo[0] - a[0];
             u[3] = a_geo[1] - a[1];
         }
@@ -70,11 +69,20 @@ fn closed_form_control(c: &Control, s @ [x, y, vx, vy]: [f64; 4], e0: f64) -> [f
             u[0] = -2.0 * zeta * phi * x;
             u[1] = -2.0 * zeta * phi * y;
         }
-        Geometric::Gradient(Gain::Rate(alpha_g)) => {
+        // One row: the coupled (Newton) gain is the rate gain.
+        Geometric::Gradient(Gain::Rate(alpha_g)) | Geometric::Newton(Rate::Given(alpha_g)) => {
             u[0] = -alpha_g * phi * x / r2;
             u[1] = -alpha_g * phi * y / r2;
         }
+        other => panic!("no hand computation for {other:?}"),
     }
+    if let Velocity::Gradient(Rate::Given(alpha_v)) = c.velocity {
+        // U_v −= α_v Φ_qᵀ Φ̇ / |Φ_q|²
+        u[2] -= alpha_v * phi_dot * x / r2;
+        u[3] -= alpha_v * phi_dot * y / r2;
+    }
+    // The Baumgarte-type energy control reads the acceleration with every geometric term so far.
+    let a_geo = [a[0] + u[2], a[1] + u[3]];
     let p = psi(s, e0);
     match c.energy {
         Energy::None => {}
@@ -92,6 +100,19 @@ fn closed_form_control(c: &Control, s @ [x, y, vx, vy]: [f64; 4], e0: f64) -> [f
             u[2] -= mu * vx;
             u[3] -= mu * vy;
         }
+        Energy::Projected { alpha_e: Rate::Given(alpha_e), position_weight } => {
+            // g_v = P v = v − (x, y)(x vx + y vy)/r², g_q = c P (0, G), c = w/α_e².
+            let g_v = [vx - x * phi_dot / r2, vy - y * phi_dot / r2];
+            let c = position_weight / (alpha_e * alpha_e);
+            let g_q = [c * (-x * G * y / r2), c * (G - y * G * y / r2)];
+            let n = vx * g_v[0] + vy * g_v[1] + G * g_q[1];
+            let k = alpha_e * p / n.max(p.abs());
+            u[0] -= k * g_q[0];
+            u[1] -= k * g_q[1];
+            u[2] -= k * g_v[0];
+            u[3] -= k * g_v[1];
+        }
+        other => panic!("no hand computation for {other:?}"),
     }
     u
 }
@@ -102,18 +123,22 @@ fn all_controls() -> Vec<Control> {
         Geometric::Baumgarte { alpha: 3.0, beta: 7.0 },
         Geometric::Gradient(Gain::Fixed(5.0)),
         Geometric::Gradient(Gain::Rate(11.0)),
+        Geometric::Newton(Rate::Given(11.0)),
     ];
     let energy = [
         Energy::None,
         Energy::Gradient(EnergyGain::Rate { alpha_e: 13.0 }),
         Energy::Gradient(EnergyGain::Fixed { rho_q: 0.7, rho_v: 2.0 }),
         Energy::Baumgarte { eta: 9.0 },
+        Energy::Projected { alpha_e: Rate::Given(13.0), position_weight: 2.0 },
     ];
     let mut out = Vec::new();
     for g in geometric {
-        for e in energy {
-            for a in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-                out.push(Control { geometric: g, energy: e, application: a });
+        for velocity in [Velocity::None, Velocity::Gradient(Rate::Given(6.0))] {
+            for e in energy {
+                for a in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
+                    out.push(Control { geometric: g, velocity, energy: e, application: a, projection: None });
+                }
             }
         }
     }
@@ -267,6 +292,7 @@ fn backward_euler_cvsgf_with_unit_gain_step_is_a_gauss_newton_projection() {
             geometric: Geometric::Gradient(Gain::Rate(1.0 / h)),
             energy: Energy::None,
             application: Application::BackwardEuler,
+            ..Control::none()
         };
         let mut sys = ControlledSystem::new(&model, c, 2.0);
         let mut integ = Integrator::new(Scheme::Euler, c.application, sys.state_len());
@@ -300,7 +326,7 @@ fn right_hand_side_evaluations_per_step_are_as_designed() {
         (Scheme::RungeKutta4, Application::ForwardEuler, 400),
     ];
     for (scheme, application, expected) in cases {
-        let c = Control { geometric: cvsgf, energy: Energy::None, application };
+        let c = Control { geometric: cvsgf, energy: Energy::None, application, ..Control::none() };
         let mut sim = Simulation::new(&ex.model, Settings::new(scheme, 0.01, c), &ex.q0, &ex.v0).unwrap();
         sim.run::<Error>(1.0, 1000, |_| Ok(())).unwrap();
         assert_eq!(sim.steps(), 100);
@@ -403,6 +429,7 @@ fn paper_gains_have_a_spurious_equilibrium_that_long_runs_reach() {
         geometric: Geometric::Gradient(Gain::Fixed(zeta)),
         energy: Energy::Gradient(EnergyGain::Rate { alpha_e }),
         application: Application::ForwardEuler,
+        ..Control::none()
     };
     let (system, q0, v0) = small_pendulum(PendulumParams::default()).unwrap();
     let mut sim = SmallSimulation::new(system, Settings::new(Scheme::AdamsBashforth3, 0.01, control), q0, v0).unwrap();

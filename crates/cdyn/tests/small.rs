@@ -47,7 +47,7 @@ fn controls() -> Vec<Control> {
             Energy::Baumgarte { eta: 40.0 },
         ] {
             for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-                out.push(Control { geometric, energy, application });
+                out.push(Control { geometric, energy, application, ..Control::none() });
             }
         }
     }

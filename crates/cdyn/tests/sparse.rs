@@ -76,6 +76,7 @@ fn a_long_chain_stays_on_its_constraints_with_the_sparse_path() {
         geometric: Geometric::Gradient(Gain::Rate(400.0)),
         energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 400.0 }),
         application: cdyn::Application::ForwardEuler,
+        ..Control::none()
     };
     let mut settings = Settings::new(Scheme::AdamsBashforth3, 1e-3, control);
     settings.solver = LinearSolver::Sparse;

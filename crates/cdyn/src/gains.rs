@@ -1,0 +1,198 @@
+//! Automatic gains: rates chosen from the scheme, the step size, how the
+//! control is applied and how strongly the constraints are coupled.
+//!
+//! A feedback term with rate `α` adds, to the linearization of the
+//! violation it controls, an eigenvalue `−α μ` for every mode `μ` of its
+//! operator. The step is stable when `h α μ` lies inside the stability
+//! interval of whatever integrates the term: the scheme's real interval
+//! when the term is in the right-hand side (AB-3: 6/11, RK-4: 2.785), and
+//! `(0, 2)` for a separate Euler step, which removes the mode in one step at
+//! `h α μ = 1`. The rate chosen is `target / (h μ_max)` with the target
+//! half the interval in the right-hand side and 1 for an Euler step.
+//!
+//! * The coupled forms ([`Geometric::Newton`], [`Velocity::Gradient`],
+//!   [`Energy::Projected`]) have `μ = 1` for every mode: their gain matrix
+//!   is `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` (or the scalar `1/N`), so their rate is exact.
+//! * The paper's CVSGF with `ζᵢ = α_g / (2|∇Φᵢ|²)` has the operator
+//!   `Φ_q Φ_qᵀ D⁻¹`, `D = diag |∇Φᵢ|²`, whose modes lie in `(0, μ_max]` with
+//!   `1 ≤ μ_max ≤ m`: coupled rows (the four-bar's loop, a chain) push the
+//!   fastest mode above `α_g`. `μ_max` is estimated by power iteration on
+//!   `D^{-1/2} Φ_q Φ_qᵀ D^{-1/2}` at the initial state.
+
+use crate::control::{Control, Energy, EnergyGain, Evaluation, Gain, Geometric, Rate, Velocity};
+use crate::integrate::{Application, Formula, Scheme};
+
+/// What the automatic gains were chosen from, and the resulting rate × h.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Tuning {
+    /// Largest mode `μ_max` of the paper's CVSGF operator at the initial
+    /// state (1 for uncoupled constraints; 0 without constraints).
+    pub coupling: f64,
+    /// The largest linearized rate × h of any active control term
+    /// (including the coupling); `0` without control.
+    pub rate_h: f64,
+    /// The `h α μ` the automatic gains aim at.
+    pub target: f64,
+}
+
+/// The negative real stability interval `[−x, 0]` of a scheme: the largest
+/// `x = h λ` for which `ẏ = −λ y` does not grow.
+pub fn real_stability_interval(scheme: Scheme) -> f64 {
+    match scheme.info().formula {
+        // Forward Euler: |1 − x| ≤ 1.
+        Formula::Multistep(w) if w.len() == 1 => 2.0,
+        // AB-2: x ≤ 1; AB-3: x ≤ 6/11.
+        Formula::Multistep(w) if w.len() == 2 => 1.0,
+        Formula::Multistep(_) => 6.0 / 11.0,
+        // RK-4: the real root of 1 − x + x²/2 − x³/6 + x⁴/24 = 1.
+        Formula::RungeKutta { .. } => 2.785_293_563_405_282,
+    }
+}
+
+/// The `h α μ_max` automatic gains aim at.
+pub fn target(scheme: Scheme, application: Application) -> f64 {
+    match application {
+        Application::InRhs => 0.5 * real_stability_interval(scheme),
+        Application::ForwardEuler | Application::BackwardEuler => 1.0,
+    }
+}
+
+/// `μ_max` of `D^{-1/2} Φ_q Φ_qᵀ D^{-1/2}` by power iteration (the
+/// operator is symmetric positive semi-definite, so the Rayleigh quotient
+/// converges from below). Allocates: called once per simulation.
+pub(crate) fn coupling<E: Evaluation>(d: &E, n: usize) -> f64 {
+    let m = d.phi().len();
+    if m == 0 {
+        return 0.0;
+    }
+    let inv_sqrt: Vec<f64> = (0..m)
+        .map(|r| {
+            let g2: f64 = d.row(r).0.iter().map(|j| j * j).sum();
+            if g2 > 0.0 { 1.0 / g2.sqrt() } else { 0.0 }
+        })
+        .collect();
+    // A start with no symmetry, so that it is not orthogonal to the top mode.
+    let mut x: Vec<f64> = (0..m).map(|r| 1.0 + 0.5 * ((r as f64) * 0.618_033_988_75).fract()).collect();
+    let mut y = vec![0.0; n];
+    let mut mu = 0.0;
+    for _ in 0..60 {
+        let norm = x.iter().map(|a| a * a).sum::<f64>().sqrt();
+        if norm == 0.0 || !norm.is_finite() {
+            return 1.0;
+        }
+        x.iter_mut().for_each(|a| *a /= norm);
+        // y = Φ_qᵀ D^{-1/2} x, then x' = D^{-1/2} Φ_q y; μ ≈ x·x' = |y|².
+        y.fill(0.0);
+        for r in 0..m {
+            let (jac, cols) = d.row(r);
+            for (j, &c) in jac.iter().zip(cols) {
+                y[c as usize] += j * inv_sqrt[r] * x[r];
+            }
+        }
+        let next = y.iter().map(|a| a * a).sum::<f64>();
+        let converged = (next - mu).abs() <= 1e-6 * next;
+        mu = next;
+        for r in 0..m {
+            let (jac, cols) = d.row(r);
+            x[r] = inv_sqrt[r] * jac.iter().zip(cols).map(|(j, &c)| j * y[c as usize]).sum::<f64>();
+        }
+        if converged {
+            break;
+        }
+    }
+    mu.max(1.0)
+}
+
+/// `control` with every automatic gain replaced by the chosen rate, and
+/// what they were chosen from. `coupling` is `μ_max` at the initial state;
+/// `max_row_norm2` the largest `|∇Φᵢ|²` there (for a fixed `ζ`).
+pub fn resolve(control: Control, scheme: Scheme, h: f64, coupling: f64, max_row_norm2: f64) -> (Control, Tuning) {
+    let target = target(scheme, control.application);
+    let mut c = control;
+    let exact = |r: Rate| Rate::Given(match r {
+        Rate::Given(a) => a,
+        Rate::Auto => target / h,
+    });
+    let mu = coupling.max(1.0);
+    let mut rate: f64 = 0.0;
+    c.geometric = match control.geometric {
+        Geometric::Gradient(gain) => {
+            let gain = match gain {
+                Gain::Auto => Gain::Rate(target / (h * mu)),
+                g => g,
+            };
+            rate = rate.max(match gain {
+                Gain::Rate(a) => a * mu,
+                Gain::Fixed(z) => 2.0 * z * max_row_norm2 * mu,
+                Gain::Auto => 0.0,
+            });
+            Geometric::Gradient(gain)
+        }
+        Geometric::Newton(r) => {
+            let r = exact(r);
+            rate = rate.max(r.value());
+            Geometric::Newton(r)
+        }
+        Geometric::Baumgarte { alpha, beta } => {
+            // The faster root of s² + α s + β.
+            let disc = alpha * alpha - 4.0 * beta;
+            rate = rate.max(if disc >= 0.0 { 0.5 * (alpha + disc.sqrt()) } else { beta.sqrt() });
+            control.geometric
+        }
+        Geometric::None => Geometric::None,
+    };
+    if let Velocity::Gradient(r) = control.velocity {
+        let r = exact(r);
+        rate = rate.max(r.value());
+        c.velocity = Velocity::Gradient(r);
+    }
+    c.energy = match control.energy {
+        Energy::Projected { alpha_e, position_weight } => {
+            let alpha_e = exact(alpha_e);
+            rate = rate.max(alpha_e.value());
+            Energy::Projected { alpha_e, position_weight }
+        }
+        Energy::Gradient(EnergyGain::Rate { alpha_e }) => {
+            rate = rate.max(alpha_e);
+            control.energy
+        }
+        Energy::Baumgarte { eta } => {
+            rate = rate.max(eta);
+            control.energy
+        }
+        e => e,
+    };
+    (c, Tuning { coupling, rate_h: rate * h, target })
+}
+
+/// Whether `control` has an automatic gain left to choose.
+pub fn has_auto(control: &Control) -> bool {
+    matches!(control.geometric, Geometric::Gradient(Gain::Auto) | Geometric::Newton(Rate::Auto))
+        || control.velocity == Velocity::Gradient(Rate::Auto)
+        || matches!(control.energy, Energy::Projected { alpha_e: Rate::Auto, .. })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_real_stability_intervals_end_where_a_root_reaches_minus_one() {
+        for scheme in Scheme::ALL {
+            let x = real_stability_interval(scheme);
+            let at_minus_one = match scheme.info().formula {
+                // R(−x) = −1 for the Runge–Kutta amplification factor.
+                Formula::RungeKutta { .. } => 1.0 - x + x * x / 2.0 - x.powi(3) / 6.0 + x.powi(4) / 24.0 + 1.0,
+                // ζᵏ − ζᵏ⁻¹ + x Σⱼ wⱼ ζᵏ⁻¹⁻ʲ at ζ = −1.
+                Formula::Multistep(w) => {
+                    let k = w.len() as i32;
+                    let z = -1.0_f64;
+                    z.powi(k) - z.powi(k - 1)
+                        + x * w.iter().enumerate().map(|(j, w)| w * z.powi(k - 1 - j as i32)).sum::<f64>()
+                }
+            };
+            assert!(at_minus_one.abs() < 1e-12, "{scheme:?}: {at_minus_one}");
+        }
+    }
+}

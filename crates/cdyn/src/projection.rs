@@ -1,0 +1,218 @@
+//! Exact projection onto the invariants, the yardstick of the stabilization
+//! methods: after every step, the positions onto `Φ = 0` by Newton's method
+//! (the minimum-norm correction in the kinetic-energy metric, the same code
+//! that assembles initial conditions), the velocities onto
+//! `Φ_q v + Φ_t = 0` (one linear step), and the energy onto `Ψ = 0` along
+//! the constraint-respecting energy direction: `v` along `P v` (a
+//! quadratic in the step length, solved exactly), or, where the tangential
+//! kinetic energy is too small to absorb the error (a turning point), the
+//! positions along `P M⁻¹ ∇V` by a Newton step, after which the positions
+//! are projected again.
+//!
+//! A multistep scheme keeps its history: each step's first evaluation is
+//! taken at the projected state `x_k`, so the history holds `f` at the
+//! projected states of the last steps; nothing is re-evaluated (as
+//! manifold-projection callbacks of ODE libraries do).
+
+use crate::dynamics::{Breakdown, Dynamics};
+use crate::error::{Result, positive};
+use crate::mass::MassMatrix;
+use crate::model::Model;
+
+/// What to do when the projection does not converge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum OnFailure {
+    /// Stop the run with [`Error::ProjectionFailed`](crate::Error::ProjectionFailed).
+    #[default]
+    Stop,
+    /// Keep the best state reached, count the failure and go on.
+    Continue,
+}
+
+/// Settings of the exact projection (the `projection` method).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Projection {
+    /// `|Φ|`, `|Φ̇|` and `|Ψ|` are brought below this.
+    pub tolerance: f64,
+    /// Newton iterations allowed per step, for the positions and for the energy.
+    pub max_iterations: u32,
+    /// Stop or continue when the iterations do not converge.
+    pub on_failure: OnFailure,
+}
+
+impl Default for Projection {
+    /// Tolerance 1e-10, at most 10 iterations, stop on failure.
+    fn default() -> Self {
+        Self { tolerance: 1e-10, max_iterations: 10, on_failure: OnFailure::Stop }
+    }
+}
+
+impl Projection {
+    /// Checks the tolerance is positive and the iteration cap not zero.
+    pub fn validate(&self) -> Result<()> {
+        positive("tolerance", self.tolerance)?;
+        if self.max_iterations == 0 {
+            return Err(crate::Error::InvalidParameter {
+                name: "max_iterations",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Why a projection did not converge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Failure {
+    /// `Φ_q M⁻¹ Φ_qᵀ` could not be factored.
+    Breakdown(Breakdown, u32),
+    /// The positions are still off `Φ = 0`: the worst row and its `|Φ|`.
+    Positions {
+        /// The worst constraint row.
+        row: usize,
+        /// Its `|Φ|`.
+        residual: f64,
+        /// Newton iterations taken.
+        iterations: u32,
+    },
+    /// The energy is still off `Ψ = 0`.
+    Energy {
+        /// `|Ψ|`.
+        residual: f64,
+    },
+}
+
+/// Buffers of a projection: allocated once per model.
+pub(crate) struct Work {
+    rows: Vec<f64>,
+    correction: Vec<f64>,
+    direction: Vec<f64>,
+}
+
+impl Work {
+    pub(crate) fn new(model: &Model) -> Self {
+        Self { rows: vec![0.0; model.m()], correction: vec![0.0; model.n()], direction: vec![0.0; model.n()] }
+    }
+}
+
+fn worst(x: &[f64]) -> (usize, f64) {
+    x.iter().enumerate().fold((0, 0.0), |(r, a), (i, x)| if x.abs() > a { (i, x.abs()) } else { (r, a) })
+}
+
+/// Newton's method for `Φ(q, t) = 0` with the minimum-norm correction
+/// `Δq = −M⁻¹Φ_qᵀ(Φ_q M⁻¹Φ_qᵀ)⁻¹Φ`. Returns the iterations taken; `d` is
+/// left evaluated at the final `q` (with the `v` given). Stops early
+/// when `|Φ|` is not finite.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn positions(
+    model: &Model,
+    d: &mut Dynamics,
+    q: &mut [f64],
+    v: &[f64],
+    t: f64,
+    tolerance: f64,
+    max_iterations: u32,
+    work: &mut Work,
+) -> std::result::Result<u32, Failure> {
+    let mut iterations = 0;
+    loop {
+        d.evaluate(model, q, v, t).map_err(|b| Failure::Breakdown(b, iterations))?;
+        let (row, residual) = worst(d.phi());
+        if residual <= tolerance {
+            return Ok(iterations);
+        }
+        if iterations == max_iterations || !residual.is_finite() {
+            return Err(Failure::Positions { row, residual, iterations });
+        }
+        work.rows.copy_from_slice(d.phi());
+        work.correction.fill(0.0);
+        d.add_constraint_response(model, &mut work.rows, &mut work.correction);
+        for (q, c) in q.iter_mut().zip(&work.correction) {
+            *q += c;
+        }
+        iterations += 1;
+    }
+}
+
+/// `v −= M⁻¹Φ_qᵀ(Φ_q M⁻¹Φ_qᵀ)⁻¹Φ̇`: exact in one step, since `Φ̇` is linear in
+/// `v`. `d` must be evaluated at this `(q, v)`.
+pub(crate) fn velocities(model: &Model, d: &Dynamics, v: &mut [f64], work: &mut Work) {
+    work.rows.copy_from_slice(d.phi_dot());
+    work.correction.fill(0.0);
+    d.add_constraint_response(model, &mut work.rows, &mut work.correction);
+    for (v, c) in v.iter_mut().zip(&work.correction) {
+        *v += c;
+    }
+}
+
+/// `out = P x`, the `M`-orthogonal projection onto the null space of `Φ_q`.
+fn project(model: &Model, d: &Dynamics, x: &[f64], rows: &mut [f64], out: &mut [f64]) {
+    crate::dynamics::jac_mul(model.pattern(), d.jac(), x, rows);
+    out.copy_from_slice(x);
+    d.add_constraint_response(model, rows, out);
+}
+
+/// Projects `(q, v)` onto `Φ = 0`, `Φ̇ = 0` and `Ψ = T + V − E₀ − e = 0`
+/// (`e0_plus_e = E₀ + e`). Returns the Newton iterations taken.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn invariants(
+    model: &Model,
+    d: &mut Dynamics,
+    q: &mut [f64],
+    v: &mut [f64],
+    t: f64,
+    e0_plus_e: f64,
+    settings: &Projection,
+    work: &mut Work,
+) -> std::result::Result<u32, Failure> {
+    let tol = settings.tolerance;
+    let mut iterations = 0;
+    let mut energy_steps = 0;
+    loop {
+        let remaining = settings.max_iterations.saturating_sub(iterations);
+        iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
+        velocities(model, d, v, work);
+        let psi = model.kinetic(v) + d.potential() - e0_plus_e;
+        if psi.abs() <= tol {
+            return Ok(iterations);
+        }
+        if energy_steps == settings.max_iterations {
+            return Err(Failure::Energy { residual: psi.abs() });
+        }
+        energy_steps += 1;
+        // Along g = P v: Ψ(s) = Ψ − a s + ½ a s², a = |P v|²_M = vᵀ M P v.
+        let mass = model.mass();
+        project(model, d, v, &mut work.rows, &mut work.direction);
+        let a = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
+        let disc = 1.0 - 2.0 * psi / a;
+        if a > 0.0 && disc >= 0.25 {
+            // The root nearer zero, written without cancellation.
+            let s = (2.0 * psi / a) / (1.0 + disc.sqrt());
+            for (v, g) in v.iter_mut().zip(&work.direction) {
+                *v -= s * g;
+            }
+            // The velocity step keeps Φ and Φ̇; only round-off is left.
+            let psi = model.kinetic(v) + d.potential() - e0_plus_e;
+            if psi.abs() <= tol {
+                return Ok(iterations);
+            }
+            continue;
+        }
+        // A turning point: move the positions along w = P M⁻¹ ∇V (Newton
+        // step on V), then project them again on the next pass.
+        mass.solve(d.grad_potential(), &mut work.direction);
+        project(model, d, &work.direction, &mut work.rows, &mut work.correction);
+        let slope: f64 = d.grad_potential().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
+        if !(slope > 0.0) {
+            return Err(Failure::Energy { residual: psi.abs() });
+        }
+        let s = psi / slope;
+        for (q, w) in q.iter_mut().zip(&work.correction) {
+            *q -= s * w;
+        }
+    }
+}
