@@ -45,7 +45,7 @@ pub fn real_stability_interval(scheme: Scheme) -> f64 {
         // AB-2: x ≤ 1; AB-3: x ≤ 6/11.
         Formula::Multistep(w) if w.len() == 2 => 1.0,
         Formula::Multistep(_) => 6.0 / 11.0,
-        // RK-4: the real root of 1 − x + x²/2 − x³/6 + x⁴/24 = 1.
+        // RK-4: the real root x > 0 of 1 − x + x²/2 − x³/6 + x⁴/24 = 1.
         Formula::RungeKutta { .. } => 2.785_293_563_405_282,
     }
 }
@@ -178,12 +178,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_real_stability_intervals_end_where_a_root_reaches_minus_one() {
+    fn the_real_stability_intervals_end_where_the_amplification_reaches_the_unit_circle() {
         for scheme in Scheme::ALL {
             let x = real_stability_interval(scheme);
-            let at_minus_one = match scheme.info().formula {
-                // R(−x) = −1 for the Runge–Kutta amplification factor.
-                Formula::RungeKutta { .. } => 1.0 - x + x * x / 2.0 - x.powi(3) / 6.0 + x.powi(4) / 24.0 + 1.0,
+            let at_boundary = match scheme.info().formula {
+                // R(−x) = 1 for the Runge–Kutta amplification factor (positive on the real axis).
+                Formula::RungeKutta { .. } => 1.0 - x + x * x / 2.0 - x.powi(3) / 6.0 + x.powi(4) / 24.0 - 1.0,
                 // ζᵏ − ζᵏ⁻¹ + x Σⱼ wⱼ ζᵏ⁻¹⁻ʲ at ζ = −1.
                 Formula::Multistep(w) => {
                     let k = w.len() as i32;
@@ -192,7 +192,7 @@ mod tests {
                         + x * w.iter().enumerate().map(|(j, w)| w * z.powi(k - 1 - j as i32)).sum::<f64>()
                 }
             };
-            assert!(at_minus_one.abs() < 1e-12, "{scheme:?}: {at_minus_one}");
+            assert!(at_boundary.abs() < 1e-12, "{scheme:?}: {at_boundary}");
         }
     }
 }
