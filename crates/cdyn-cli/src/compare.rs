@@ -1,11 +1,12 @@
 //! `cdyn compare`: one model under every stabilization method of the
-//! paper's test, with the scenario's gains or target rates.
+//! paper's test, with the scenario's gains or target rates, then the
+//! `robust` preset and exact `projection`.
 
 use crate::report;
 use crate::runner::{Case, CaseResult, run_case};
 use crate::scenario::Scenario;
 use anyhow::Result;
-use cdyn::methods::{independent_cases, redundant_cases};
+use cdyn::methods::compare_cases;
 use serde_json::json;
 use std::path::Path;
 
@@ -13,9 +14,14 @@ use std::path::Path;
 pub fn cases(scenario: &Scenario, path: &Path) -> Result<Vec<Case>> {
     let file = path.display().to_string();
     let base = scenario.case(path)?;
-    let gains = scenario.method.gains(base.settings.h).map_err(|e| anyhow::anyhow!("{file}: [method] {e}"))?;
+    let gains = scenario
+        .method
+        .clone()
+        .unwrap_or_default()
+        .gains(base.settings.h)
+        .map_err(|e| anyhow::anyhow!("{file}: [method] {e}"))?;
     // A model without constraints has nothing for geometric control to do.
-    let methods = if base.example.model.m() == 0 { independent_cases(&gains) } else { redundant_cases(&gains) };
+    let methods = compare_cases(&gains, base.example.model.m() > 0);
     methods
         .into_iter()
         .map(|(name, control)| {

@@ -42,8 +42,22 @@ pub struct CaseResult {
     pub h: f64,
     #[serde(flatten)]
     pub record: Record,
+    /// The method as it ran: its automatic gains chosen (`None` if it could not start).
+    pub control: Option<cdyn::Control>,
+    /// What the automatic gains were chosen from, and the largest rate × h.
+    pub tuning: Option<cdyn::gains::Tuning>,
+    /// Mean Newton iterations per step of the `projection` method.
+    pub projection_iterations_per_step: Option<f64>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
+}
+
+/// What a run reports of its method besides the record.
+#[derive(Default)]
+struct Method {
+    control: Option<cdyn::Control>,
+    tuning: Option<cdyn::gains::Tuning>,
+    projection_iterations_per_step: Option<f64>,
 }
 
 /// The series of a run that kept none (sweeps).
@@ -51,7 +65,7 @@ static NO_SERIES: Series = Series { t: Vec::new(), phi: Vec::new(), psi: Vec::ne
 
 impl CaseResult {
     /// The summary of `case` from its record.
-    fn new(case: &Case, record: Record) -> Self {
+    fn new(case: &Case, (record, method): (Record, Method)) -> Self {
         CaseResult {
             name: case.name.clone(),
             error_observable: case.example.observables[0].clone(),
@@ -59,6 +73,9 @@ impl CaseResult {
             h: case.settings.h,
             error: record.error.as_ref().map(|e| format!("case {}: {e}", case.name)),
             record,
+            control: method.control,
+            tuning: method.tuning,
+            projection_iterations_per_step: method.projection_iterations_per_step,
         }
     }
 
@@ -126,10 +143,23 @@ pub fn run_case_quietly(case: &Case) -> CaseResult {
 
 /// Runs `case` into `recorder`; an error of the simulation, also one
 /// starting it, is kept in the record, an error of the sink returned.
-fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<Record, K::Error> {
+fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
-        Ok(mut sim) => recorder.run(&mut sim, case.t_end, case.every),
-        Err(e) => Ok(recorder.abandon(e)),
+        Ok(mut sim) => {
+            let record = recorder.run(&mut sim, case.t_end, case.every)?;
+            let method = Method {
+                control: Some(sim.settings().control),
+                tuning: Some(*sim.tuning()),
+                projection_iterations_per_step: sim
+                    .settings()
+                    .control
+                    .projection
+                    .is_some()
+                    .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
+            };
+            Ok((record, method))
+        }
+        Err(e) => Ok((recorder.abandon(e), Method::default())),
     }
 }

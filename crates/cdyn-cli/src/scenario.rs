@@ -6,7 +6,7 @@ use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
 use cdyn::assemble::assemble;
 use cdyn::error::{Part, positive};
-use cdyn::methods::MethodKeys;
+use cdyn::methods::{MethodKeys, Preset};
 use cdyn::models::{Example, Kind};
 use cdyn::planar::{Body, Element, Group, Mechanism};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
@@ -20,8 +20,8 @@ pub struct Scenario {
     pub model: ModelSpec,
     #[serde(default)]
     pub initial: InitialSpec,
-    #[serde(default)]
-    pub method: MethodKeys,
+    /// `[method]`; without it, the `robust` preset.
+    pub method: Option<MethodKeys>,
     pub integrator: IntegratorSpec,
     #[serde(default)]
     pub output: OutputSpec,
@@ -194,10 +194,15 @@ impl Scenario {
         Ok(())
     }
 
+    /// The method as written, or the `robust` preset when there is no `[method]`.
+    pub fn method(&self) -> MethodKeys {
+        self.method.clone().unwrap_or(MethodKeys { preset: Some(Preset::Robust), ..MethodKeys::default() })
+    }
+
     /// The case this scenario describes; `path` names it in errors.
     pub fn case(&self, path: &Path) -> Result<Case> {
         let file = &path.display().to_string();
-        let control = self.method.control().map_err(|e| anyhow!("{file}: [method] {e}"))?;
+        let control = self.method().control().map_err(|e| anyhow!("{file}: [method] {e}"))?;
         let i = &self.integrator;
         let integrator = |e| anyhow!("{file}: [integrator] {e}");
         let h = positive("h", i.h).map_err(integrator)?;

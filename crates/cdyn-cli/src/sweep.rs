@@ -153,9 +153,9 @@ fn set(scenario: &mut Scenario, name: &str, value: f64) -> Result<()> {
         scenario.integrator.h = value;
         return Ok(());
     }
-    let mut table = toml::Table::try_from(&scenario.method)?;
+    let mut table = toml::Table::try_from(scenario.method())?;
     table.insert(name.to_string(), toml::Value::Float(value));
-    scenario.method = table.try_into().map_err(|e: toml::de::Error| anyhow!("{}", e.message().trim()))?;
+    scenario.method = Some(table.try_into().map_err(|e: toml::de::Error| anyhow!("{}", e.message().trim()))?);
     Ok(())
 }
 

@@ -260,9 +260,7 @@ impl Control {
                 non_negative("beta", beta)?;
             }
             Geometric::Gradient(Gain::Fixed(z)) => _ = non_negative("zeta", z)?,
-            Geometric::Gradient(Gain::Rate(a)) | Geometric::Newton(Rate::Given(a)) => {
-                _ = non_negative("alpha_g", a)?
-            }
+            Geometric::Gradient(Gain::Rate(a)) | Geometric::Newton(Rate::Given(a)) => _ = non_negative("alpha_g", a)?,
             Geometric::Gradient(Gain::Auto) | Geometric::Newton(Rate::Auto) => {}
         }
         if let Velocity::Gradient(Rate::Given(a)) = self.velocity {

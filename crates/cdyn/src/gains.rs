@@ -110,10 +110,12 @@ pub(crate) fn coupling<E: Evaluation>(d: &E, n: usize) -> f64 {
 pub fn resolve(control: Control, scheme: Scheme, h: f64, coupling: f64, max_row_norm2: f64) -> (Control, Tuning) {
     let target = target(scheme, control.application);
     let mut c = control;
-    let exact = |r: Rate| Rate::Given(match r {
-        Rate::Given(a) => a,
-        Rate::Auto => target / h,
-    });
+    let exact = |r: Rate| {
+        Rate::Given(match r {
+            Rate::Given(a) => a,
+            Rate::Auto => target / h,
+        })
+    };
     let mu = coupling.max(1.0);
     let mut rate: f64 = 0.0;
     c.geometric = match control.geometric {

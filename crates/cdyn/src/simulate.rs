@@ -209,7 +209,14 @@ impl<S: System> Stepper<S> {
                         Failure::Energy { residual } => ("|Ψ|", residual, None, p.max_iterations),
                     };
                     if p.on_failure == OnFailure::Stop {
-                        return Err(Error::ProjectionFailed { step: self.step, t, invariant, residual, row, iterations });
+                        return Err(Error::ProjectionFailed {
+                            step: self.step,
+                            t,
+                            invariant,
+                            residual,
+                            row,
+                            iterations,
+                        });
                     }
                     self.projection_failures += 1;
                 }

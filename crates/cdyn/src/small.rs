@@ -16,12 +16,12 @@ use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::Measures;
 use crate::energy;
 use crate::error::{Error, Result};
-use crate::projection::{Failure, Projection};
 use crate::force::{Force, Potential, energy_and_gradient};
 use crate::integrate::{Buffer, Rhs};
 use crate::linalg::{Breakdown, check_pivot};
 use crate::mass::{DiagonalMass, MassMatrix};
 use crate::model::{Model, check_rows};
+use crate::projection::{Failure, Projection};
 use crate::scalar::Scalar;
 use crate::simulate::{Settings, Stepper, check_initial_state};
 use crate::system::{EvalError, System};
@@ -90,7 +90,9 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
     pub fn new(system: S, settings: Settings, q0: [f64; N], v0: [f64; N]) -> Result<Self> {
         settings.validate()?;
         if settings.control.projection.is_some() {
-            return Err(Error::Unsupported("the projection method runs on a general Model (small::to_model), not on a SmallSystem"));
+            return Err(Error::Unsupported(
+                "the projection method runs on a general Model (small::to_model), not on a SmallSystem",
+            ));
         }
         check_initial_state(N, &q0, &v0)?;
         let mass = DiagonalMass::new(system.mass())?;
