@@ -35,7 +35,8 @@ pub enum OnFailure {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Projection {
-    /// `|Φ|`, `|Φ̇|` and `|Ψ|` are brought below this.
+    /// `|Φ|` and `|Φ̇|` are brought below this, and `|Ψ|` below this times
+    /// `max(1, T + |V|)` (`Ψ` is a difference of energies).
     pub tolerance: f64,
     /// Newton iterations allowed per step, for the positions and for the energy.
     pub max_iterations: u32,
@@ -157,7 +158,8 @@ fn project(model: &Model, d: &Dynamics, x: &[f64], rows: &mut [f64], out: &mut [
 }
 
 /// Projects `(q, v)` onto `Φ = 0`, `Φ̇ = 0` and `Ψ = T + V − E₀ − e = 0`
-/// (`e0_plus_e = E₀ + e`). Returns the Newton iterations taken.
+/// (`e0_plus_e = E₀ + e`), `|Ψ|` to the tolerance times the mechanical
+/// energy's magnitude where that exceeds 1. Returns the Newton iterations taken.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn invariants(
     model: &Model,
@@ -176,8 +178,14 @@ pub(crate) fn invariants(
         let remaining = settings.max_iterations.saturating_sub(iterations);
         iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
         velocities(model, d, v, work);
-        let psi = model.kinetic(v) + d.potential() - e0_plus_e;
-        if psi.abs() <= tol {
+        let (kinetic, potential) = (model.kinetic(v), d.potential());
+        let psi = kinetic + potential - e0_plus_e;
+        // Ψ is a difference of energies: its round-off grows with them.
+        let psi_tol = tol * (kinetic + potential.abs()).max(1.0);
+        // With as many constraint rows as coordinates no motion is free (a
+        // fully driven mechanism): T and V are fixed by the constraints, and
+        // Ψ measures only the quadrature of Ė, which no projection can change.
+        if psi.abs() <= psi_tol || model.m() == model.n() {
             return Ok(iterations);
         }
         if energy_steps == settings.max_iterations {
@@ -197,7 +205,7 @@ pub(crate) fn invariants(
             }
             // The velocity step keeps Φ and Φ̇; only round-off is left.
             let psi = model.kinetic(v) + d.potential() - e0_plus_e;
-            if psi.abs() <= tol {
+            if psi.abs() <= psi_tol {
                 return Ok(iterations);
             }
             continue;
