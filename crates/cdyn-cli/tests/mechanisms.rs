@@ -44,7 +44,17 @@ fn compare_runs_every_method_and_reports_final_states() {
     let names: Vec<&str> = s["cases"].as_array().unwrap().iter().map(|c| c["name"].as_str().unwrap()).collect();
     assert_eq!(
         names,
-        ["none", "baumgarte", "cvsgf", "energy", "baumgarte_energy", "cvsgf_energy", "cvsgf_energy_backward"]
+        [
+            "none",
+            "baumgarte",
+            "cvsgf",
+            "energy",
+            "baumgarte_energy",
+            "cvsgf_energy",
+            "cvsgf_energy_backward",
+            "robust",
+            "projection"
+        ]
     );
     for c in s["cases"].as_array().unwrap() {
         assert_eq!(floats(&c["q_end"]).len(), 9);
@@ -53,7 +63,7 @@ fn compare_runs_every_method_and_reports_final_states() {
         assert!(dir.path().join(format!("{}.csv", c["name"].as_str().unwrap())).exists());
     }
     // The gains used are recorded, and the assembly.
-    assert_eq!(s["methods"].as_array().unwrap().len(), 7);
+    assert_eq!(s["methods"].as_array().unwrap().len(), 9);
     assert!(s["assembly"]["max_abs_phi_after"].as_f64().unwrap() < 1e-10);
     for fig in ["phi.png", "psi.svg"] {
         assert!(dir.path().join(fig).exists());
