@@ -371,7 +371,16 @@ impl Control {
             }
             Energy::Projected { alpha_e, position_weight } => {
                 let alpha = alpha_e.value();
-                if alpha == 0.0 || psi == 0.0 {
+                if alpha == 0.0 {
+                    return;
+                }
+                // The rate at which the terms above change Ψ (the geometric
+                // corrections move q through V and v through T): cancelled
+                // too, so that the whole control gives Ψ̇ = −α_e Ψ.
+                let others = d.grad_potential().iter().zip(u_q.iter()).map(|(g, u)| g * u).sum::<f64>()
+                    + mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
+                let target = alpha * psi + others;
+                if target == 0.0 {
                     return;
                 }
                 // g_v = P v, and |P v|²_M = Ψ_v g_v since P is M-orthogonal.
@@ -393,11 +402,11 @@ impl Control {
                     norm += g_q.iter().zip(d.grad_potential()).map(|(g, p)| g * p).sum::<f64>();
                 }
                 // A correction is a first-order step along the gradient; where
-                // the gradient is too short to reach Ψ = 0 without the
-                // quadratic terms dominating (N < |Ψ|: a static equilibrium,
-                // or at rest at an extremum of V on the constraint surface)
-                // the gain is capped so that |U| stays bounded (README).
-                let scale = alpha * psi / norm.max(psi.abs());
+                // the gradient is too short to reach the target without the
+                // quadratic terms dominating (N < |target|/α_e: a static
+                // equilibrium, or at rest at an extremum of V on the constraint
+                // surface) the gain is capped so that |U| stays bounded (README).
+                let scale = target / norm.max(target.abs() / alpha);
                 if !(norm > REST) || !scale.is_finite() {
                     return;
                 }

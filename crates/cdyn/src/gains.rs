@@ -54,7 +54,7 @@ pub fn real_stability_interval(scheme: Scheme) -> f64 {
 pub fn target(scheme: Scheme, application: Application) -> f64 {
     match application {
         Application::InRhs => 0.5 * real_stability_interval(scheme),
-        Application::ForwardEuler | Application::BackwardEuler => 1.0,
+        Application::ForwardEuler | Application::BackwardEuler | Application::PostStep => 1.0,
     }
 }
 

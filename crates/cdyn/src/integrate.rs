@@ -35,6 +35,14 @@ pub enum Application {
     ForwardEuler,
     /// The scheme integrates `f`; `U(x̂_{k+1})` is added with one backward Euler step (Eq. 59).
     BackwardEuler,
+    /// As [`BackwardEuler`](Self::BackwardEuler), `x_{k+1} = x̂_{k+1} + h U(x̂_{k+1})`,
+    /// but at the cost of forward Euler: the evaluation at `x̂_{k+1}` that
+    /// gives `U` also starts the next step, so the scheme's history holds
+    /// `f(x̂_{k+1})` instead of `f(x_{k+1})`. They differ by `O(h |U|)`, the
+    /// size of the violation just removed (the drift of one step), so the
+    /// scheme's order is kept. With `h α = 1` the control is one Gauss–Newton
+    /// step onto the invariants at the stepped state, measured after the step.
+    PostStep,
 }
 
 /// How a scheme combines evaluations.
@@ -186,6 +194,9 @@ pub struct Integrator<B = Vec<f64>> {
     stage_x: B,
     u: B,
     scratch: B,
+    /// The newest history entry is `f` at the state before the last
+    /// post-step correction ([`Application::PostStep`]), to be used as is.
+    evaluated: bool,
 }
 
 impl Integrator {
@@ -218,6 +229,7 @@ impl<B: Buffer> Integrator<B> {
             stage_x: zero.clone(),
             u: zero.clone(),
             scratch: zero,
+            evaluated: false,
         }
     }
 
@@ -241,7 +253,9 @@ impl<B: Buffer> Integrator<B> {
         let split = control && self.application != Application::InRhs;
         // F(x_k): f + U in the right-hand side, f alone when split; U(x_k) kept for forward Euler.
         self.newest = (self.newest + self.history.len() - 1) % self.history.len();
-        self.evaluate_first(rhs, x, t, control)?;
+        if !std::mem::take(&mut self.evaluated) {
+            self.evaluate_first(rhs, x, t, control)?;
+        }
         self.filled = (self.filled + 1).min(self.history.len());
         let mut control_pending = true;
         match active.formula {
@@ -280,8 +294,17 @@ impl<B: Buffer> Integrator<B> {
             }
         }
         if split && control_pending {
-            if self.application == Application::BackwardEuler {
-                rhs.eval(x, t + h, self.scratch.as_mut_slice(), Some(self.u.as_mut_slice()))?;
+            match self.application {
+                Application::BackwardEuler => {
+                    rhs.eval(x, t + h, self.scratch.as_mut_slice(), Some(self.u.as_mut_slice()))?;
+                }
+                Application::PostStep => {
+                    // f(x̂_{k+1}) goes where the next step reads its newest evaluation.
+                    let next = (self.newest + self.history.len() - 1) % self.history.len();
+                    rhs.eval(x, t + h, self.history[next].as_mut_slice(), Some(self.u.as_mut_slice()))?;
+                    self.evaluated = true;
+                }
+                _ => {}
             }
             for (xi, ui) in x.iter_mut().zip(self.u.as_slice()) {
                 *xi += h * ui;
@@ -294,7 +317,7 @@ impl<B: Buffer> Integrator<B> {
     fn evaluate_first<R: Rhs>(&mut self, rhs: &mut R, x: &[f64], t: f64, control: bool) -> Result<(), R::Error> {
         let (f, u) = (self.history[self.newest].as_mut_slice(), self.u.as_mut_slice());
         match (control, self.application) {
-            (false, _) | (true, Application::BackwardEuler) => rhs.eval(x, t, f, None),
+            (false, _) | (true, Application::BackwardEuler | Application::PostStep) => rhs.eval(x, t, f, None),
             (true, Application::ForwardEuler) => rhs.eval(x, t, f, Some(u)),
             (true, Application::InRhs) => {
                 rhs.eval(x, t, f, Some(u))?;

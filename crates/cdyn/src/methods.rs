@@ -433,7 +433,7 @@ pub fn robust() -> Control {
         geometric: Geometric::Newton(Rate::Auto),
         velocity: Velocity::Gradient(Rate::Auto),
         energy: Energy::Projected { alpha_e: Rate::Auto, position_weight: POSITION_WEIGHT },
-        application: Application::ForwardEuler,
+        application: Application::PostStep,
         projection: None,
     }
 }

@@ -106,7 +106,9 @@ fn closed_form_control(c: &Control, s @ [x, y, vx, vy]: [f64; 4], e0: f64) -> [f
             let c = position_weight / (alpha_e * alpha_e);
             let g_q = [c * (-x * G * y / r2), c * (G - y * G * y / r2)];
             let n = vx * g_v[0] + vy * g_v[1] + G * g_q[1];
-            let k = alpha_e * p / n.max(p.abs());
+            // The other terms' rate of change of Ψ is cancelled too.
+            let target = alpha_e * p + G * u[1] + vx * u[2] + vy * u[3];
+            let k = target / n.max(target.abs() / alpha_e);
             u[0] -= k * g_q[0];
             u[1] -= k * g_q[1];
             u[2] -= k * g_v[0];
