@@ -138,7 +138,9 @@ fn all_controls() -> Vec<Control> {
     for g in geometric {
         for velocity in [Velocity::None, Velocity::Gradient(Rate::Given(6.0))] {
             for e in energy {
-                for a in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
+                for a in
+                    [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler, Application::PostStep]
+                {
                     out.push(Control { geometric: g, velocity, energy: e, application: a, projection: None });
                 }
             }
@@ -166,13 +168,26 @@ fn one_euler_step_of_every_control_matches_the_hand_computation() {
         let expected = match c.application {
             Application::InRhs => plus(x0, plus(f(x0), closed_form_control(&c, x0, e0), 1.0), h),
             Application::ForwardEuler => plus(plus(x0, f(x0), h), closed_form_control(&c, x0, e0), h),
-            Application::BackwardEuler => {
+            // The first post-step correction is the backward Euler one.
+            Application::BackwardEuler | Application::PostStep => {
                 let xh = plus(x0, f(x0), h);
                 plus(xh, closed_form_control(&c, xh, e0), h)
             }
         };
         for i in 0..4 {
             assert!((x[i] - expected[i]).abs() < 1e-14, "{c:?}: component {i}: {} vs {}", x[i], expected[i]);
+        }
+        if c.application == Application::PostStep && c.is_active() {
+            // The second step integrates f at the stepped state x̂₁ of the
+            // first, not at the corrected x₁: that evaluation gave U too.
+            let x1: [f64; 4] = std::array::from_fn(|i| x[i]);
+            let xh1 = plus(x0, f(x0), h);
+            integ.step(&mut sys, &mut x, h, h).unwrap();
+            let xh2 = plus(x1, f(xh1), h);
+            let expected = plus(xh2, closed_form_control(&c, xh2, e0), h);
+            for i in 0..4 {
+                assert!((x[i] - expected[i]).abs() < 1e-14, "{c:?} step 2: component {i}: {} vs {}", x[i], expected[i]);
+            }
         }
     }
 }
@@ -326,6 +341,9 @@ fn right_hand_side_evaluations_per_step_are_as_designed() {
         (Scheme::Euler, Application::InRhs, 100),
         (Scheme::RungeKutta4, Application::InRhs, 400),
         (Scheme::RungeKutta4, Application::ForwardEuler, 400),
+        // Post-step control reuses its evaluation for the next step: one more in all.
+        (Scheme::AdamsBashforth3, Application::PostStep, 2 * 4 + 98 + 1),
+        (Scheme::RungeKutta4, Application::PostStep, 400 + 1),
     ];
     for (scheme, application, expected) in cases {
         let c = Control { geometric: cvsgf, energy: Energy::None, application, ..Control::none() };
