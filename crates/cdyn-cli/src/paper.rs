@@ -31,6 +31,7 @@ pub fn cases() -> Result<Vec<Case>> {
                 t_end: T_END,
                 every: 1,
                 assembly: None,
+                row_entries: Vec::new(),
             });
         }
     }

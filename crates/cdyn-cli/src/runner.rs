@@ -21,6 +21,9 @@ pub struct Case {
     pub every: u64,
     /// What projecting the initial state onto the constraints changed, if it was done.
     pub assembly: Option<cdyn::assemble::Assembly>,
+    /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
+    /// where the model comes from entries; errors name it instead of the row.
+    pub row_entries: Vec<String>,
 }
 
 impl Case {
@@ -71,7 +74,10 @@ impl CaseResult {
             error_observable: case.example.observables[0].clone(),
             scheme: case.settings.scheme.info().name,
             h: case.settings.h,
-            error: record.error.as_ref().map(|e| format!("case {}: {e}", case.name)),
+            error: record.error.as_ref().map(|e| {
+                let entry = e.row().and_then(|r| case.row_entries.get(r)).map_or(String::new(), |e| format!(" ({e})"));
+                format!("case {}: {e}{entry}", case.name)
+            }),
             record,
             control: method.control,
             tuning: method.tuning,

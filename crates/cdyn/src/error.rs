@@ -328,6 +328,15 @@ pub enum Problem {
 }
 
 impl Error {
+    /// The constraint row a simulation error is about, if any.
+    pub fn row(&self) -> Option<usize> {
+        match self {
+            Error::SingularConstraints { row, .. } => Some(*row),
+            Error::ProjectionFailed { row, .. } => *row,
+            _ => None,
+        }
+    }
+
     /// The same error, said of `part`: a refused parameter becomes an
     /// [`Error::InvalidModel`] at `part`; an invalid model error of the whole
     /// model is moved to `part`; other errors are kept.
