@@ -6,17 +6,25 @@
 //!   compile time) and as a general `Model` — and of the hand-written
 //!   closed form (`cdyn::baseline`), interleaved trials, best of each; the
 //!   ratio to the hand-written step is cdyn's abstraction overhead.
-//! - The N-link Cartesian chain (point masses on rods, total length 1 m,
-//!   released at rest 0.5 rad from vertical; CVSGF + energy with
+//! - The N-link Cartesian chain (unit point masses on rods of 1 m, g = 1,
+//!   released at rest 0.3 rad from vertical; CVSGF + energy with
 //!   hα_g = hα_e = 0.4, AB-3, h = 1e-3): microseconds per step, max |Φ|
 //!   over the run, and the fitted exponent of cost against N.
+//! - The methods side by side, each on Example 1 (general `Model`, h = 0.01)
+//!   and on the chain (h = 1e-3), AB-3: `cvsgf_energy` (the control timed
+//!   above), the `robust` preset (automatic gains resolved when each
+//!   simulation starts, outside the clock) and `projection` (with its mean
+//!   Newton iterations per step). Trials alternate the methods, rotating
+//!   their order; each figure is the median over the trials, and each
+//!   ratio the median of the ratios within a trial, so that a slow spell
+//!   of the machine, which hits the methods of one trial alike, cancels.
 //! - Allocations per step, counted by the binary's global allocator.
 
 use crate::alloc_count::allocations;
 use anyhow::Result;
 use cdyn::baseline::HandWritten;
-use cdyn::methods::MethodGains;
-use cdyn::models::{ChainParams, PendulumParams, cartesian_pendulum, chain, small_pendulum};
+use cdyn::methods::{self, MethodGains};
+use cdyn::models::{ChainParams, Example, PendulumParams, cartesian_pendulum, chain, small_pendulum};
 use cdyn::small::SmallSimulation;
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
 use serde::Serialize;
@@ -54,6 +62,40 @@ pub struct ChainRun {
     pub solver: &'static str,
 }
 
+/// One method's cost on one model, over the interleaved trials of a [`MethodComparison`].
+#[derive(Debug, Serialize)]
+pub struct MethodCost {
+    /// `cvsgf_energy`, `robust` or `projection`.
+    pub method: &'static str,
+    /// Median over the trials.
+    pub us_per_step: f64,
+    /// Median over the trials of this method's time over `cvsgf_energy`'s in the same trial.
+    pub ratio_to_cvsgf_energy: f64,
+    /// Newton iterations of the projection per step (`projection` only).
+    pub projection_iterations_per_step: Option<f64>,
+    /// Largest `|Φ|` seen, sampled (outside the clock) every [`PHI_EVERY`] steps and at the end.
+    pub max_abs_phi: f64,
+    /// The most allocations per step of any run.
+    pub allocations_per_step: f64,
+}
+
+/// The methods timed against each other on one model.
+#[derive(Debug, Serialize)]
+pub struct MethodComparison {
+    /// `example1` (the Cartesian pendulum as a general model) or `chain`.
+    pub model: &'static str,
+    /// Bodies: 1 for Example 1, `N` for the chain.
+    pub n: usize,
+    /// Step size, AB-3.
+    pub h: f64,
+    /// Every run starts afresh (set-up untimed) and lasts this many steps.
+    pub steps_per_run: u64,
+    pub runs_per_trial: u64,
+    pub trials: usize,
+    /// In the order of [`METHODS`].
+    pub methods: Vec<MethodCost>,
+}
+
 #[derive(Debug, Serialize)]
 pub struct Report {
     pub light: bool,
@@ -61,6 +103,9 @@ pub struct Report {
     pub chain: Vec<ChainRun>,
     /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
     pub chain_cost_exponent: Option<f64>,
+    /// `cvsgf_energy`, `robust` and `projection` on Example 1, then on the chain by N.
+    pub methods: Vec<MethodComparison>,
+    /// Over every run above, the methods' included.
     pub max_allocations_per_step: f64,
 }
 
@@ -128,14 +173,8 @@ fn example1(light: bool) -> Result<Example1> {
 
 fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
     let h = 1e-3;
-    let ex = chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 })?;
-    let control = Control {
-        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-        application: Application::ForwardEuler,
-        ..Control::none()
-    };
-    let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
+    let ex = chain_example(n)?;
+    let settings = Settings::new(Scheme::AdamsBashforth3, h, chain_control(h));
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
     let steps = cdyn::simulate::steps_to(t_end, h)?;
     let mut phi = vec![0.0; ex.model.m()];
@@ -163,6 +202,134 @@ fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
     })
 }
 
+/// The methods compared, by name; the first is the one ratios are taken to.
+pub const METHODS: [&str; 3] = ["cvsgf_energy", "robust", "projection"];
+
+/// Steps between samples of `|Φ|` in a [`MethodComparison`]: the clock is
+/// read this often, which costs well under 1 % even of Example 1's step.
+pub const PHI_EVERY: u64 = 100;
+
+/// The middle value (the mean of the two middle ones for an even count).
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    let k = x.len();
+    if k % 2 == 1 { x[k / 2] } else { 0.5 * (x[k / 2 - 1] + x[k / 2]) }
+}
+
+/// What one fresh run of a method measured.
+struct MethodRun {
+    seconds: f64,
+    allocations: u64,
+    max_abs_phi: f64,
+    projection_iterations: u64,
+}
+
+/// One fresh run of `steps` steps of `ex` (set-up, including the automatic
+/// gains, untimed), `|Φ|` sampled outside the clock.
+fn method_run(ex: &Example, settings: Settings, steps: u64, phi: &mut [f64]) -> Result<MethodRun> {
+    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
+    let (mut seconds, mut allocs, mut worst) = (0.0, 0, 0.0_f64);
+    while sim.steps() < steps {
+        let before = allocations();
+        let clock = Instant::now();
+        for _ in 0..PHI_EVERY.min(steps - sim.steps()) {
+            sim.step()?;
+        }
+        seconds += clock.elapsed().as_secs_f64();
+        allocs += allocations() - before;
+        ex.model.constraint_values(sim.q(), sim.t(), phi);
+        worst = phi.iter().fold(worst, |a, p| a.max(p.abs()));
+    }
+    Ok(MethodRun {
+        seconds,
+        allocations: allocs,
+        max_abs_phi: worst,
+        projection_iterations: sim.projection_iterations(),
+    })
+}
+
+/// [`METHODS`] on one model, interleaved: `trials` rounds, each running
+/// every method `runs` times, the order rotated from one round to the next.
+#[allow(clippy::too_many_arguments)]
+fn compare_methods(
+    model: &'static str,
+    n: usize,
+    ex: &Example,
+    h: f64,
+    cvsgf_energy: Control,
+    steps: u64,
+    runs: u64,
+    trials: usize,
+) -> Result<MethodComparison> {
+    let controls = [cvsgf_energy, methods::robust(), methods::projection()];
+    let k = controls.len();
+    let mut phi = vec![0.0; ex.model.m()];
+    let (mut seconds, mut ratios) = (vec![vec![0.0; trials]; k], vec![vec![0.0; trials]; k]);
+    let (mut allocs, mut worst, mut iterations) = (vec![0_u64; k], vec![0.0_f64; k], vec![0_u64; k]);
+    for trial in 0..trials {
+        for i in 0..k {
+            let c = (i + trial) % k;
+            let settings = Settings::new(Scheme::AdamsBashforth3, h, controls[c]);
+            for _ in 0..runs {
+                let r = method_run(ex, settings, steps, &mut phi)?;
+                seconds[c][trial] += r.seconds;
+                allocs[c] = allocs[c].max(r.allocations);
+                worst[c] = worst[c].max(r.max_abs_phi);
+                iterations[c] += r.projection_iterations;
+            }
+        }
+        for c in 0..k {
+            ratios[c][trial] = seconds[c][trial] / seconds[0][trial];
+        }
+    }
+    let total_steps = (runs * steps) as f64;
+    let methods = (0..k)
+        .map(|c| MethodCost {
+            method: METHODS[c],
+            us_per_step: median(seconds[c].clone()) / total_steps * 1e6,
+            ratio_to_cvsgf_energy: median(ratios[c].clone()),
+            projection_iterations_per_step: controls[c]
+                .projection
+                .map(|_| iterations[c] as f64 / (total_steps * trials as f64)),
+            max_abs_phi: worst[c],
+            allocations_per_step: allocs[c] as f64 / steps as f64,
+        })
+        .collect();
+    Ok(MethodComparison { model, n, h, steps_per_run: steps, runs_per_trial: runs, trials, methods })
+}
+
+/// The chain of the figures above: `n` links, released at rest.
+fn chain_example(n: usize) -> Result<Example> {
+    Ok(chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 })?)
+}
+
+/// The chain's control: CVSGF + energy with hα_g = hα_e = 0.4, by forward Euler.
+fn chain_control(h: f64) -> Control {
+    Control {
+        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
+        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
+        application: Application::ForwardEuler,
+        ..Control::none()
+    }
+}
+
+/// [`compare_methods`] on Example 1 and on the chain.
+fn method_comparisons(light: bool) -> Result<Vec<MethodComparison>> {
+    let (steps, runs, trials) = if light { (1_000, 1, 3) } else { (10_000, 20, 7) };
+    let ex = cartesian_pendulum(PendulumParams::default())?;
+    let paper = MethodGains::paper().cvsgf_energy();
+    let mut out = vec![compare_methods("example1", 1, &ex, 0.01, paper, steps, runs, trials)?];
+    // Steps per run so that each run lasts tens of milliseconds at least.
+    let sizes: &[(usize, u64)] =
+        if light { &[(10, 10), (100, 10), (1000, 10)] } else { &[(10, 10_000), (100, 5_000), (1000, 1_000)] };
+    let trials = if light { 3 } else { 7 };
+    let h = 1e-3;
+    for &(n, steps) in sizes {
+        out.push(compare_methods("chain", n, &chain_example(n)?, h, chain_control(h), steps, 1, trials)?);
+    }
+    Ok(out)
+}
+
 /// Slope of `ln y` against `ln x`.
 fn fitted_exponent(points: &[(f64, f64)]) -> Option<f64> {
     if points.len() < 2 {
@@ -182,9 +349,13 @@ pub fn run(light: bool) -> Result<Report> {
         if light { (&[10, 100, 1000], 0.05) } else { (&[10, 100, 1000, 10_000], 10.0) };
     let chain = sizes.iter().map(|&n| chain_run(n, t_end)).collect::<Result<Vec<_>>>()?;
     let fit: Vec<(f64, f64)> = chain.iter().filter(|c| c.n >= 100).map(|c| (c.n as f64, c.us_per_step)).collect();
-    let max_allocations_per_step =
-        chain.iter().map(|c| c.allocations_per_step).fold(example1.allocations_per_step, f64::max);
-    Ok(Report { light, example1, chain_cost_exponent: fitted_exponent(&fit), chain, max_allocations_per_step })
+    let methods = method_comparisons(light)?;
+    let max_allocations_per_step = chain
+        .iter()
+        .map(|c| c.allocations_per_step)
+        .chain(methods.iter().flat_map(|m| m.methods.iter().map(|c| c.allocations_per_step)))
+        .fold(example1.allocations_per_step, f64::max);
+    Ok(Report { light, example1, chain_cost_exponent: fitted_exponent(&fit), chain, methods, max_allocations_per_step })
 }
 
 /// The table printed on the terminal.
@@ -208,6 +379,33 @@ pub fn table(r: &Report) -> String {
     }
     if let Some(p) = r.chain_cost_exponent {
         out += &format!("  cost exponent (N ≥ 100): {p:.3}\n");
+    }
+    if let Some(m) = r.methods.first() {
+        out += &format!(
+            "Methods, AB-3 (median of {} interleaved trials; ratio to cvsgf_energy within a trial, median):\n",
+            m.trials
+        );
+    }
+    out += &format!(
+        "  {:>8} {:>6} {:>7} {:>8} {:>13} {:>12} {:>7} {:>10} {:>10}\n",
+        "model", "N", "h", "steps", "method", "µs/step", "ratio", "iter/step", "max|Φ|"
+    );
+    for m in &r.methods {
+        for c in &m.methods {
+            let iterations = c.projection_iterations_per_step.map_or("-".into(), |i| format!("{i:.3}"));
+            out += &format!(
+                "  {:>8} {:>6} {:>7} {:>8} {:>13} {:>12.3} {:>6.2}× {:>10} {:>10.2e}\n",
+                m.model,
+                m.n,
+                m.h,
+                m.steps_per_run * m.runs_per_trial,
+                c.method,
+                c.us_per_step,
+                c.ratio_to_cvsgf_energy,
+                iterations,
+                c.max_abs_phi
+            );
+        }
     }
     out += &format!("allocations per step (max): {}\n", r.max_allocations_per_step);
     out

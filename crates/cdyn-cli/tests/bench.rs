@@ -26,3 +26,42 @@ fn light_bench_writes_a_complete_report() {
     assert!(r["chain_cost_exponent"].as_f64().is_some());
     assert!(String::from_utf8_lossy(&out.stdout).contains("overhead"));
 }
+
+/// The methods' comparison: every model and method, ratios to
+/// `cvsgf_energy` taken within a trial (so its own is exactly 1), the
+/// projection's iterations counted and its violations within its tolerance.
+#[test]
+fn light_bench_compares_robust_and_projection_with_cvsgf_energy() {
+    let dir = tempfile::tempdir().unwrap();
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_cdyn")).args(["bench", "--light", "--out"]).arg(dir.path()).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("bench.json")).unwrap()).unwrap();
+    let comparisons = r["methods"].as_array().unwrap();
+    let models: Vec<_> = comparisons.iter().map(|m| (m["model"].as_str().unwrap(), m["n"].as_u64().unwrap())).collect();
+    assert_eq!(models, [("example1", 1), ("chain", 10), ("chain", 100), ("chain", 1000)]);
+    for m in comparisons {
+        let methods = m["methods"].as_array().unwrap();
+        let names: Vec<_> = methods.iter().map(|c| c["method"].as_str().unwrap()).collect();
+        assert_eq!(names, ["cvsgf_energy", "robust", "projection"], "{m}");
+        assert_eq!(methods[0]["ratio_to_cvsgf_energy"].as_f64(), Some(1.0), "{m}");
+        for c in methods {
+            assert!(c["us_per_step"].as_f64().unwrap() > 0.0, "{c}");
+            assert!(c["ratio_to_cvsgf_energy"].as_f64().unwrap() > 0.0, "{c}");
+            assert_eq!(c["allocations_per_step"].as_f64(), Some(0.0), "{c}");
+            let iterations = c["projection_iterations_per_step"].as_f64();
+            if c["method"] == "projection" {
+                assert!(iterations.unwrap() >= 0.0, "{c}");
+                // The default tolerance of the projection, met after every step.
+                assert!(c["max_abs_phi"].as_f64().unwrap() <= 1e-10, "{c}");
+            } else {
+                assert_eq!(iterations, None, "{c}");
+            }
+        }
+        if m["model"] == "chain" {
+            assert!(methods.iter().all(|c| c["max_abs_phi"].as_f64().unwrap() < 1e-8), "{m}");
+        }
+    }
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("robust") && table.contains("projection") && table.contains("iter/step"), "{table}");
+}

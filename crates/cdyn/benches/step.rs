@@ -1,12 +1,14 @@
 //! Cost of one step: Example 1 (cdyn as a small system and as a general
-//! model, against the hand-written baseline) and
-//! the N-link chain. `cargo bench -p cdyn` measures; `cargo test --benches`
+//! model, against the hand-written baseline; then the general model under
+//! the `robust` preset and the `projection` method) and the N-link chain
+//! under `cvsgf_energy`, `robust` and `projection`, one group each.
+//! `cargo bench -p cdyn` measures; `cargo test --benches`
 //! (CI) runs each benchmark once as a smoke test. Set `CDYN_BENCH_FULL=1`
 //! to add the 10 000-body chain. `cdyn bench` reports the same quantities
 //! as JSON.
 
 use cdyn::baseline::HandWritten;
-use cdyn::methods::MethodGains;
+use cdyn::methods::{self, MethodGains};
 use cdyn::models::{ChainParams, PendulumParams, cartesian_pendulum, chain, small_pendulum};
 use cdyn::small::SmallSimulation;
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
@@ -58,29 +60,21 @@ fn example1(c: &mut Criterion) {
     group.finish();
 }
 
-fn chains(c: &mut Criterion) {
-    let mut sizes = vec![10, 100, 1000];
-    if std::env::var_os("CDYN_BENCH_FULL").is_some() {
-        sizes.push(10_000);
-    }
-    let h = 1e-3;
-    let control = Control {
-        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-        application: Application::ForwardEuler,
-        ..Control::none()
-    };
-    let mut group = c.benchmark_group("chain_cvsgf_energy_ab3");
-    for n in sizes {
-        let ex = chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 }).unwrap();
-        let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
-        let start = || Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
-        let mut sim = start();
-        group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+/// Example 1 as a general model under the methods that only it can run
+/// (`projection`) or that resolve automatic gains (`robust`), next to the
+/// `cdyn_general_model` figure of [`example1`].
+fn example1_methods(c: &mut Criterion) {
+    let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
+    let mut group = c.benchmark_group("example1_methods_ab3");
+    for (name, control) in [("robust", methods::robust()), ("projection", methods::projection())] {
+        let settings = Settings::new(Scheme::AdamsBashforth3, 0.01, control);
+        // Restarts as in `example1`, for the same reason.
+        let fresh = || Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+        let mut sim = fresh();
+        group.bench_function(name, |b| {
             b.iter(|| {
-                // Restart after 10 s of motion, the interval the chain is known to behave over.
                 if sim.steps() == 10_000 {
-                    sim = start();
+                    sim = fresh();
                 }
                 sim.step().unwrap()
             })
@@ -89,5 +83,45 @@ fn chains(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, example1, chains);
+/// One group per method over the chain sizes, `chain_<method>_ab3/<N>`.
+fn chains(c: &mut Criterion) {
+    let mut sizes = vec![10, 100, 1000];
+    if std::env::var_os("CDYN_BENCH_FULL").is_some() {
+        sizes.push(10_000);
+    }
+    let h = 1e-3;
+    let cvsgf_energy = Control {
+        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
+        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
+        application: Application::ForwardEuler,
+        ..Control::none()
+    };
+    let examples: Vec<_> = sizes
+        .iter()
+        .map(|&n| chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 }).unwrap())
+        .collect();
+    for (name, control) in
+        [("cvsgf_energy", cvsgf_energy), ("robust", methods::robust()), ("projection", methods::projection())]
+    {
+        let mut group = c.benchmark_group(format!("chain_{name}_ab3"));
+        for (&n, ex) in sizes.iter().zip(&examples) {
+            let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
+            // Automatic gains (robust) are resolved here, outside the timing.
+            let start = || Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+            let mut sim = start();
+            group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+                b.iter(|| {
+                    // Restart after 10 s of motion, the interval the chain is known to behave over.
+                    if sim.steps() == 10_000 {
+                        sim = start();
+                    }
+                    sim.step().unwrap()
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, example1, example1_methods, chains);
 criterion_main!(benches);
