@@ -204,7 +204,20 @@ pub(crate) trait Evaluation {
     fn row(&self, r: usize) -> (&[f64], &[u32]);
     /// For a change `b` of the constraint right-hand side, adds the change
     /// of acceleration `−M⁻¹ Φ_qᵀ S⁻¹ b` to `out`; `b` is overwritten.
-    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]);
+    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
+        self.solve_many(&mut [b]);
+        self.add_weighted_jt(b, -1.0, out);
+    }
+
+    /// Solves `S x = b` in place for every `b`, in one pass over the
+    /// factorization of the last evaluation (`S = Φ_q M⁻¹ Φ_qᵀ`).
+    fn solve_many(&self, b: &mut [&mut [f64]]);
+
+    /// `out += scale · M⁻¹ Φ_qᵀ y`.
+    fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]);
+
+    /// `Φ_t`.
+    fn phi_t(&self) -> &[f64];
 
     /// `out = Φ_q x`.
     fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
@@ -213,24 +226,14 @@ pub(crate) trait Evaluation {
             *o = jac.iter().zip(cols).map(|(j, &c)| j * x[c as usize]).sum();
         }
     }
-
-    /// `out = P x = x − M⁻¹Φ_qᵀ S⁻¹ Φ_q x`, the `M`-orthogonal projection
-    /// onto the null space of `Φ_q`; `rows` (length `m`) is scratch.
-    fn project(&self, x: &[f64], rows: &mut [f64], out: &mut [f64]) {
-        out.copy_from_slice(x);
-        self.jac_mul(x, rows);
-        self.add_constraint_response(rows, out);
-    }
 }
 
-/// Buffers the control laws work in: `m` and twice `n` values.
+/// Buffers the control laws work in.
 pub(crate) struct Workspace<'a> {
-    /// Length `m`.
-    pub rows: &'a mut [f64],
+    /// Five vectors of length `m`.
+    pub rows: [&'a mut [f64]; 5],
     /// Length `n`.
-    pub a: &'a mut [f64],
-    /// Length `n`.
-    pub b: &'a mut [f64],
+    pub w: &'a mut [f64],
 }
 
 /// Below this `|Ψ_v|²` (or `vᵀMv`) the energy control has no direction to
@@ -298,7 +301,8 @@ impl Control {
         u_v: &mut [f64],
         work: Workspace<'_>,
     ) {
-        let scratch = work.rows;
+        let [scratch, r_v, y_v, y_w, phi_q_w] = work.rows;
+        let projected = matches!(self.energy, Energy::Projected { .. });
         u_q.fill(0.0);
         u_v.fill(0.0);
         let mass = d.mass();
@@ -321,6 +325,8 @@ impl Control {
                     }
                 }
             }
+            // With the projected energy control, below: their solves share one pass.
+            Geometric::Newton(_) if projected => {}
             Geometric::Newton(rate) => {
                 // U_q = −α_g M⁻¹ Φ_qᵀ S⁻¹ Φ
                 let alpha = rate.value();
@@ -330,8 +336,8 @@ impl Control {
                 d.add_constraint_response(scratch, u_q);
             }
         }
-        if let Velocity::Gradient(rate) = self.velocity {
-            // U_v −= α_v M⁻¹ Φ_qᵀ S⁻¹ Φ̇
+        if let (Velocity::Gradient(rate), false) = (self.velocity, projected) {
+            // U_v −= α_v M⁻¹ Φ_qᵀ S⁻¹ Φ̇, before the Baumgarte-type energy control reads U_v.
             let alpha = rate.value();
             for (b, p) in scratch.iter_mut().zip(d.phi_dot()) {
                 *b = alpha * p;
@@ -370,55 +376,139 @@ impl Control {
                 }
             }
             Energy::Projected { alpha_e, position_weight } => {
-                let alpha = alpha_e.value();
-                if alpha == 0.0 {
-                    return;
-                }
-                // The rate at which the terms above change Ψ (the geometric
-                // corrections move q through V and v through T): cancelled
-                // too, so that the whole control gives Ψ̇ = −α_e Ψ.
-                let others = d.grad_potential().iter().zip(u_q.iter()).map(|(g, u)| g * u).sum::<f64>()
-                    + mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
-                let target = alpha * psi + others;
-                if target == 0.0 {
-                    return;
-                }
-                // g_v = P v, and |P v|²_M = Ψ_v g_v since P is M-orthogonal.
-                let g_v = work.a;
-                d.project(v, scratch, g_v);
-                let mut norm = mass.psi_v_dot(v, |i| g_v[i], |_| 0.0, 0.0);
-                // g_q = c P M⁻¹ ∇V, and ∇V·g_q = c |P M⁻¹ ∇V|²_M.
-                let c = position_weight / (alpha * alpha);
-                let g_q = work.b;
-                let use_positions = c > 0.0;
-                if use_positions {
-                    // M⁻¹∇V, projected in place: rows = Φ_q w, then w −= M⁻¹Φ_qᵀ S⁻¹ rows.
-                    mass.solve(d.grad_potential(), g_q);
-                    d.jac_mul(g_q, scratch);
-                    d.add_constraint_response(scratch, g_q);
-                    for g in g_q.iter_mut() {
-                        *g *= c;
-                    }
-                    norm += g_q.iter().zip(d.grad_potential()).map(|(g, p)| g * p).sum::<f64>();
-                }
-                // A correction is a first-order step along the gradient; where
-                // the gradient is too short to reach the target without the
-                // quadratic terms dominating (N < |target|/α_e: a static
-                // equilibrium, or at rest at an extremum of V on the constraint
-                // surface) the gain is capped so that |U| stays bounded (README).
-                let scale = target / norm.max(target.abs() / alpha);
-                if !(norm > REST) || !scale.is_finite() {
-                    return;
-                }
-                for (u, g) in u_v.iter_mut().zip(g_v.iter()) {
-                    *u -= scale * g;
-                }
-                if use_positions {
-                    for (u, g) in u_q.iter_mut().zip(g_q.iter()) {
-                        *u -= scale * g;
-                    }
+                let rows = [scratch, r_v, y_v, y_w, phi_q_w];
+                self.coupled_terms(d, v, psi, alpha_e.value(), position_weight, u_q, u_v, rows, work.w);
+            }
+        }
+    }
+
+    /// [`Energy::Projected`] with the other terms whose gain matrix is
+    /// `S⁻¹` — [`Geometric::Newton`], [`Velocity::Gradient`] — added to `U`. Their
+    /// right-hand sides are solved together in one pass over `L`, and each
+    /// output takes one product with `M⁻¹Φ_qᵀ`, by linearity:
+    ///
+    /// * `U_q = −M⁻¹Φ_qᵀ(α_g z_Φ − κc y_w) − κc w`, `w = M⁻¹∇V`, and
+    /// * `U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v`,
+    ///
+    /// with `z_x = S⁻¹x`, `y_v = S⁻¹Φ_q v`, `y_w = S⁻¹Φ_q w`: these are the
+    /// laws of the README, `P v = v − M⁻¹Φ_qᵀ y_v`, `|Pv|²_M = vᵀMv − (Φ_q v)·y_v`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn coupled_terms<E: Evaluation>(
+        &self,
+        d: &E,
+        v: &[f64],
+        psi: f64,
+        alpha_e: f64,
+        position_weight: f64,
+        u_q: &mut [f64],
+        u_v: &mut [f64],
+        [r_q, r_v, y_v, y_w, phi_q_w]: [&mut [f64]; 5],
+        w: &mut [f64],
+    ) {
+        let alpha_g = match self.geometric {
+            Geometric::Newton(rate) => Some(rate.value()),
+            _ => None,
+        };
+        let alpha_v = match self.velocity {
+            Velocity::Gradient(rate) => Some(rate.value()),
+            Velocity::None => None,
+        };
+        let energy = (alpha_e > 0.0).then(|| (alpha_e, position_weight / (alpha_e * alpha_e)));
+        let mass = d.mass();
+        let (phi_dot, phi_t) = (d.phi_dot(), d.phi_t());
+        let mut rhs: [&mut [f64]; 4] = [r_q, r_v, y_v, y_w];
+        // The right-hand sides in use, packed to the front in a fixed order.
+        let positions = energy.is_some_and(|(_, c)| c > 0.0);
+        let mut used = [false; 4];
+        if let Some(a) = alpha_g {
+            rhs[0].iter_mut().zip(d.phi()).for_each(|(b, p)| *b = a * p);
+            used[0] = true;
+        }
+        if let Some(a) = alpha_v {
+            rhs[1].iter_mut().zip(phi_dot).for_each(|(b, p)| *b = a * p);
+            used[1] = true;
+        }
+        if energy.is_some() {
+            // Φ_q v = Φ̇ − Φ_t, known without a product.
+            rhs[2].iter_mut().zip(phi_dot).zip(phi_t).for_each(|((b, pd), pt)| *b = pd - pt);
+            used[2] = true;
+        }
+        if positions {
+            mass.solve(d.grad_potential(), w);
+            d.jac_mul(w, phi_q_w);
+            rhs[3].copy_from_slice(phi_q_w);
+            used[3] = true;
+        }
+        {
+            let mut active: [&mut [f64]; 4] = Default::default();
+            let mut k = 0;
+            for (b, u) in rhs.iter_mut().zip(used) {
+                if u {
+                    active[k] = &mut **b;
+                    k += 1;
                 }
             }
+            d.solve_many(&mut active[..k]);
+        }
+        let [z_q, z_v, y_v, y_w] = rhs;
+        let (mut kappa, mut kappa_c) = (0.0, 0.0);
+        if let Some((alpha, c)) = energy {
+            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
+            let phi_q_v = |r: usize| phi_dot[r] - phi_t[r];
+            let v_y = (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>();
+            // The rate at which the other terms change Ψ (moving q through V,
+            // v through T) is cancelled too: the whole control gives Ψ̇ = −α_e Ψ.
+            let mut others = dot(d.grad_potential(), u_q) + mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
+            if alpha_g.is_some() {
+                // ∇V·(−M⁻¹Φ_qᵀ z_Φ) = −(Φ_q w)·z_Φ, with w = M⁻¹∇V.
+                if !positions {
+                    mass.solve(d.grad_potential(), w);
+                    d.jac_mul(w, phi_q_w);
+                }
+                others -= dot(phi_q_w, z_q);
+            }
+            if alpha_v.is_some() {
+                // vᵀM(−M⁻¹Φ_qᵀ z_Φ̇) = −(Φ_q v)·z_Φ̇.
+                others -= (0..z_v.len()).map(|r| phi_q_v(r) * z_v[r]).sum::<f64>();
+            }
+            let target = alpha * psi + others;
+            // N = c|P M⁻¹∇V|²_M + |P v|²_M.
+            let mut norm = 2.0 * mass.kinetic(v) - v_y;
+            if positions {
+                norm += c * (dot(d.grad_potential(), w) - dot(phi_q_w, y_w));
+            }
+            // A correction is a first-order step along the gradient; where the
+            // gradient is too short to reach the target without the quadratic
+            // terms dominating (N < |target|/α_e: a static equilibrium, or at
+            // rest at an extremum of V on the constraint surface) the gain is
+            // capped so that |U| stays bounded (README).
+            let scale = target / norm.max(target.abs() / alpha);
+            if norm > REST && scale.is_finite() {
+                (kappa, kappa_c) = (scale, scale * c);
+            }
+        }
+        // U_q = −M⁻¹Φ_qᵀ(α_g z_Φ − κc y_w) − κc w
+        if alpha_g.is_some() || kappa_c != 0.0 {
+            if alpha_g.is_none() {
+                z_q.fill(0.0);
+            }
+            if kappa_c != 0.0 {
+                z_q.iter_mut().zip(y_w.iter()).for_each(|(z, y)| *z -= kappa_c * y);
+                u_q.iter_mut().zip(w.iter()).for_each(|(u, w)| *u -= kappa_c * w);
+            }
+            d.add_weighted_jt(z_q, -1.0, u_q);
+        }
+        // U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v
+        if alpha_v.is_some() || kappa != 0.0 {
+            if alpha_v.is_none() {
+                z_v.fill(0.0);
+            }
+            if kappa != 0.0 {
+                z_v.iter_mut().zip(y_v.iter()).for_each(|(z, y)| *z -= kappa * y);
+                mass.add_inverse_psi_v(v, -kappa, u_v);
+            }
+            d.add_weighted_jt(z_v, -1.0, u_v);
         }
     }
 }

@@ -215,7 +215,7 @@ pub(crate) fn invariants(
         mass.solve(d.grad_potential(), &mut work.direction);
         project(model, d, &work.direction, &mut work.rows, &mut work.correction);
         let slope: f64 = d.grad_potential().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
-        if !(slope > 0.0) {
+        if slope.is_nan() || slope <= 0.0 {
             return Err(Failure::Energy { residual: psi.abs() });
         }
         let s = psi / slope;

@@ -307,6 +307,22 @@ impl<const N: usize, const M: usize> Evaluation for SmallDynamics<N, M> {
         self.solve(b);
         self.subtract_weighted_jt(b, out);
     }
+    fn solve_many(&self, bs: &mut [&mut [f64]]) {
+        for b in bs.iter_mut() {
+            self.solve((&mut **b).try_into().expect("one value per constraint row"));
+        }
+    }
+    fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]) {
+        let weight = self.mass.inverse();
+        for r in 0..M {
+            for c in 0..N {
+                out[c] += scale * (weight[c] * self.jac[r][c] * y[r]);
+            }
+        }
+    }
+    fn phi_t(&self) -> &[f64] {
+        &self.phi_t
+    }
 }
 
 impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControlled<S, N, M> {
@@ -335,7 +351,9 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
             let (u_q, rest) = u.split_at_mut(N);
             let (u_v, u_e) = rest.split_at_mut(N);
             u_e[0] = 0.0;
-            let work = Workspace { rows: &mut [0.0; M], a: &mut [0.0; N], b: &mut [0.0; N] };
+            let mut rows = [[0.0; M]; 5];
+            let [r0, r1, r2, r3, r4] = &mut rows;
+            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut [0.0; N] };
             self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, work);
         }
         Ok(())

@@ -77,10 +77,9 @@ pub struct ControlledSystem<'m> {
     dynamics: Dynamics,
     /// `E₀ = T₀ + V₀`
     e0: f64,
-    /// Work space of the control laws: `m`, `n` and `n` values.
-    rows: Vec<f64>,
-    work_a: Vec<f64>,
-    work_b: Vec<f64>,
+    /// Work space of the control laws: five vectors of `m` values, one of `n`.
+    rows: [Vec<f64>; 5],
+    work: Vec<f64>,
     probe: Probe,
     projection: projection::Work,
     /// Right-hand-side evaluations so far.
@@ -100,9 +99,8 @@ impl<'m> ControlledSystem<'m> {
             control,
             dynamics: Dynamics::with_solver(model, solver),
             e0,
-            rows: vec![0.0; model.m()],
-            work_a: vec![0.0; model.n()],
-            work_b: vec![0.0; model.n()],
+            rows: std::array::from_fn(|_| vec![0.0; model.m()]),
+            work: vec![0.0; model.n()],
             probe: Probe::new(model),
             projection: projection::Work::new(model),
             evaluations: 0,
@@ -152,7 +150,8 @@ impl Rhs for ControlledSystem<'_> {
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
             let d = Evaluated { model: self.model, dynamics: &self.dynamics };
-            let work = Workspace { rows: &mut self.rows, a: &mut self.work_a, b: &mut self.work_b };
+            let [r0, r1, r2, r3, r4] = &mut self.rows;
+            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work };
             self.control.terms(&d, v, psi, e_dot, u_q, u_v, work);
         }
         Ok(())
@@ -226,7 +225,16 @@ impl Evaluation for Evaluated<'_> {
         let (pattern, range) = (self.model.pattern(), self.model.pattern().row(r));
         (&self.dynamics.jac()[range.clone()], &pattern.cols[range])
     }
-    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
-        self.dynamics.add_constraint_response(self.model, b, out);
+    fn solve_many(&self, b: &mut [&mut [f64]]) {
+        self.dynamics.solve_many(b);
+    }
+    fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]) {
+        self.dynamics.add_weighted_jt(self.model, y, scale, out);
+    }
+    fn phi_t(&self) -> &[f64] {
+        self.dynamics.phi_t()
+    }
+    fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
+        self.dynamics.jac_mul(self.model, x, out);
     }
 }
