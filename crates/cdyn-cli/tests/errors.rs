@@ -86,6 +86,37 @@ fn bad_scenarios_get_one_line_naming_the_problem() {
 }
 
 #[test]
+fn bad_keys_of_the_robust_methods_get_one_line_naming_the_key() {
+    let method = |keys: &str| GOOD.replace("geometric = \"cvsgf\"\nzeta = 20.0", keys);
+    let velocity =
+        |alpha_v: &str| method(&format!("geometric = \"cvsgf\"\nzeta = 20.0\nvelocity = \"gradient\"\n{alpha_v}"));
+    let cases: Vec<(String, &[&str])> = vec![
+        (method("preset = \"fast\""), &["bad.toml", "preset", "fast"]),
+        (method("preset = \"robust\"\nalpha_g = 3.0"), &["bad.toml", "robust", "alpha_g"]),
+        (method("preset = \"projection\"\ngeometric = \"cvsgf\""), &["bad.toml", "projection", "geometric"]),
+        (velocity("alpha_v = -1.0"), &["bad.toml", "alpha_v", "-1"]),
+        (velocity("alpha_v = inf"), &["bad.toml", "alpha_v", "inf"]),
+        (velocity("alpha_v = \"fast\""), &["bad.toml", "alpha_v", "fast"]),
+        (method("geometric = \"cvsgf\"\nalpha_g = \"fast\""), &["bad.toml", "alpha_g", "fast", "auto"]),
+        (method("geometric = \"newton\"\nalpha_g = -2.0"), &["bad.toml", "alpha_g", "-2"]),
+        (method("energy = \"projected\"\nposition_weight = -1.0"), &["bad.toml", "position_weight", "-1"]),
+        (method("geometric = \"cvsgf\"\nzeta = 20.0\nalpha_v = 3.0"), &["bad.toml", "alpha_v", "velocity"]),
+        (method("preset = \"projection\"\ntolerance = 0.0"), &["bad.toml", "tolerance", "0"]),
+        (method("preset = \"projection\"\ntolerance = nan"), &["bad.toml", "tolerance", "NaN"]),
+        (method("preset = \"projection\"\nmax_iterations = 0"), &["bad.toml", "max_iterations", "0"]),
+        (method("preset = \"projection\"\nmax_iterations = -1"), &["bad.toml", "max_iterations", "-1"]),
+        (method("preset = \"projection\"\non_failure = \"ignore\""), &["bad.toml", "on_failure", "ignore"]),
+        (method("geometric = \"cvsgf\"\nzeta = 20.0\ntolerance = 1e-9"), &["bad.toml", "tolerance", "projection"]),
+    ];
+    for (text, needles) in cases {
+        let (line, _) = error_of(&text);
+        for n in needles {
+            assert!(line.contains(n), "error {line:?} should mention {n:?} for:\n{text}");
+        }
+    }
+}
+
+#[test]
 fn missing_file_and_bad_command_fail_cleanly() {
     let dir = tempfile::tempdir().unwrap();
     let out = cdyn(&["run"], Some(&dir.path().join("nope.toml")), dir.path());

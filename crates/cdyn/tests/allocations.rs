@@ -1,13 +1,16 @@
 //! No allocation inside a step: a counting global allocator watches 200
 //! steps after warm-up, for every scheme, control law and application, on
 //! Example 1 (as a general model and as a small system) and on a mechanism
-//! with every kind of element.
+//! with every kind of element; the robust preset after its automatic gains
+//! are chosen, and the projection method (general models only).
 
-use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity};
 use cdyn::dynamics::LinearSolver;
 use cdyn::integrate::Application;
+use cdyn::methods;
 use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
 use cdyn::planar::{Coordinate, Element, Mechanism};
+use cdyn::projection::{OnFailure, Projection};
 use cdyn::simulate::Stepper;
 use cdyn::small::SmallSimulation;
 use cdyn::system::System as Controlled;
@@ -91,6 +94,37 @@ fn controls() -> Vec<Control> {
     out
 }
 
+/// The laws of the robust stabilization alone and combined, with given and
+/// automatic rates (chosen when the simulation starts), every application,
+/// and the robust preset itself.
+fn robust_controls() -> Vec<Control> {
+    let rate = Rate::Given(40.0);
+    let projected = |alpha_e, position_weight| Energy::Projected { alpha_e, position_weight };
+    let mut out = Vec::new();
+    for (geometric, velocity, energy) in [
+        (Geometric::Newton(rate), Velocity::None, Energy::None),
+        (Geometric::None, Velocity::Gradient(rate), Energy::None),
+        (Geometric::None, Velocity::None, projected(rate, POSITION_WEIGHT)),
+        (Geometric::None, Velocity::None, projected(rate, 0.0)),
+        (Geometric::Gradient(Gain::Rate(40.0)), Velocity::Gradient(rate), projected(rate, POSITION_WEIGHT)),
+        (Geometric::Newton(rate), Velocity::Gradient(rate), projected(rate, POSITION_WEIGHT)),
+        (Geometric::Gradient(Gain::Auto), Velocity::Gradient(Rate::Auto), projected(Rate::Auto, POSITION_WEIGHT)),
+    ] {
+        for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
+            out.push(Control { geometric, velocity, energy, application, projection: None });
+        }
+    }
+    out.push(methods::robust());
+    out
+}
+
+/// The projection method: as the preset sets it, and one that never
+/// converges and goes on (its failure path must not allocate either).
+fn projections() -> [Control; 2] {
+    let failing = Projection { tolerance: 1e-30, max_iterations: 2, on_failure: OnFailure::Continue };
+    [methods::projection(), Control { projection: Some(failing), ..Control::none() }]
+}
+
 /// Allocations during `steps` steps (and samples) after `warm_up` steps.
 fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: usize) -> usize {
     allocations_stepping(Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap(), warm_up, steps)
@@ -145,6 +179,28 @@ fn steps_do_not_allocate() {
             settings.solver = solver;
             let n = allocations_per_run(&chain, settings, 5, 200);
             assert_eq!(n, 0, "chain, {scheme:?}, {solver:?}: {n} allocations in 200 steps");
+        }
+
+        // The robust stabilization: its laws on both paths, the preset on
+        // the larger models, the projection method on the general path.
+        for control in robust_controls() {
+            let n = allocations_per_run(&pendulum, Settings::new(scheme, 0.01, control), 5, 200);
+            assert_eq!(n, 0, "pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+            let n = small_allocations_per_run(Settings::new(scheme, 0.01, control), 5, 200);
+            assert_eq!(n, 0, "small pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+        }
+        let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, methods::robust()), 5, 200);
+        assert_eq!(n, 0, "andrews, {scheme:?}, robust: {n} allocations in 200 steps");
+        for control in projections() {
+            let n = allocations_per_run(&pendulum, Settings::new(scheme, 0.01, control), 5, 200);
+            assert_eq!(n, 0, "pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+        }
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            for control in [methods::robust()].into_iter().chain(projections()) {
+                let settings = Settings { solver, ..Settings::new(scheme, 1e-3, control) };
+                let n = allocations_per_run(&chain, settings, 5, 200);
+                assert_eq!(n, 0, "chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
+            }
         }
     }
 }
