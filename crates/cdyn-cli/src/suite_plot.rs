@@ -52,9 +52,10 @@ fn de<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow:
     anyhow!("{e}")
 }
 
-/// The colour of the `i`-th scheme and step of a model.
+/// The colour of the `i`-th scheme and step of a model: warm for AB-3 (red,
+/// orange), cold for RK-4 (blue, purple), in the suite's order.
 fn colour(i: usize) -> RGBAColor {
-    Palette99::pick(i).to_rgba()
+    Palette99::pick([0, 4, 3, 5][i % 4]).to_rgba()
 }
 
 /// A panel's point for `ratio`: its log10, or `None` where there is nothing to draw (no
