@@ -10,6 +10,8 @@ mod plot;
 mod report;
 mod runner;
 mod scenario;
+mod suite;
+mod suite_plot;
 mod sweep;
 mod terminal;
 
@@ -80,6 +82,18 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Judge every method of `cdyn compare` on many models (examples/suite and any given) at AB-3 and RK-4,
+    /// h and h/2, against a fine reference; writes suite.json and suite.png. Misses of its checks are reported, not fatal.
+    Suite {
+        /// More scenarios (TOML) to add to the shipped ones.
+        scenarios: Vec<PathBuf>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// A quick version for CI: four models, a quarter of their t_end.
+        #[arg(long)]
+        light: bool,
     },
     /// Run a scenario file.
     Run {
@@ -180,6 +194,15 @@ fn run(cli: Cli) -> Result<()> {
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
             fail_on_error(&results, &out)
+        }
+        Command::Suite { scenarios, out, light } => {
+            let result = suite::run(&scenarios, light)?;
+            output_dir(&out)?;
+            suite::write(&result, &out)?;
+            print(&suite::table(&result))?;
+            print(&suite::summary(&result))?;
+            print(&format!("wrote {}\n", out.join("suite.json").display()))?;
+            Ok(())
         }
     }
 }

@@ -1,0 +1,487 @@
+//! `cdyn suite`: every method of `cdyn compare` on many models, at AB-3 and
+//! RK-4 and at the scenario's `h` and `h/2`, judged against a fine reference,
+//! so that a method which makes the answer worse than no control shows.
+//!
+//! The reference is the same model without control, RK-4 with step `h/20`
+//! (`h` the scenario's, the coarser step). Every run is sampled at the
+//! common times `t = k·h` (every step of the coarse runs, every second of
+//! the fine ones, every twentieth of the reference), and its error is the
+//! largest `|q_i − q_ref,i|` over those samples and all positions. A run that
+//! stops with an error counts as infinitely wrong. The violations are the
+//! largest over every step after `t = 0`; those at `t = 0` (the assembly's)
+//! are kept apart.
+
+use crate::compare;
+use crate::runner::Case;
+use crate::scenario::{self, Scenario};
+use crate::terminal::print;
+use anyhow::{Context, Result, anyhow};
+use cdyn::json_float::JsonFloat;
+use cdyn::simulate::{nearest_valid_t_end, steps_to};
+use cdyn::{Control, Scheme, Settings, Simulation};
+use rayon::prelude::*;
+use serde::Serialize;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The schemes every model runs at.
+const SCHEMES: [Scheme; 2] = [Scheme::AdamsBashforth3, Scheme::RungeKutta4];
+/// The step sizes every model runs at, as divisors of the scenario's `h`.
+const DIVISORS: [u64; 2] = [1, 2];
+/// The reference step is the scenario's `h` over this.
+const REFERENCE_DIVISOR: u64 = 20;
+/// The shipped models of `--light`, by file stem.
+const LIGHT: [&str; 4] = ["example1", "pendulum_rest", "mixed_masses", "slider_crank"];
+/// `--light` runs to this fraction of each scenario's `t_end`.
+const LIGHT_T_END: f64 = 0.5;
+
+/// The checks, by letter, as the summary states them.
+pub const CHECKS: [(&str, &str); 4] = [
+    ("a", "robust error <= 2 x projection error"),
+    ("b", "robust error <= none error, where projection error <= none error"),
+    ("c", "robust error <= none error / 10, where none error > 1e-4"),
+    ("d", "robust max|phi|, max|psi| <= none's / 10, where none's > 1e-8"),
+];
+
+/// The shipped suite, `examples/suite` of the source tree the binary was built from.
+fn shipped_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/suite")
+}
+
+/// One model of the suite: its file, read and turned into every case to run.
+struct Model {
+    name: String,
+    path: PathBuf,
+    /// The scenario's `h`: the coarser step and the sampling interval.
+    h: f64,
+    t_end: f64,
+    /// The cases of `compare` at each scheme and step.
+    setups: Vec<(Scheme, f64, Vec<Case>)>,
+}
+
+/// One method's run at one scheme and step.
+#[derive(Debug, Clone, Serialize)]
+pub struct Run {
+    /// The case name of `cdyn compare`.
+    pub method: String,
+    /// Largest `|q_i − q_ref,i|` over the samples; infinite if the run stopped.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub max_error: f64,
+    /// `max_error` over that of `none` (`theta` for a model without constraints).
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub error_vs_none: f64,
+    /// `max_error` over that of `projection`.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub error_vs_projection: f64,
+    /// Largest `|Φ|` over the steps after `t = 0`.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub max_abs_phi: f64,
+    /// Largest `|Φ̇|` over the steps after `t = 0`.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub max_abs_phi_dot: f64,
+    /// Largest `|Ψ|` over the steps after `t = 0`.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub max_abs_psi: f64,
+    /// `|Φ|`, `|Φ̇|`, `|Ψ|` at `t = 0`.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub initial: Vec<f64>,
+    /// Steps taken.
+    pub steps: u64,
+    /// The largest rate × h of its control terms (`None` if it did not start).
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub rate_h: Option<f64>,
+    /// Mean Newton iterations per step of its projection, if it projects.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub projection_iterations_per_step: Option<f64>,
+    /// The tolerance of its projection, if it projects.
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub projection_tolerance: Option<f64>,
+    /// Why it stopped, if it did.
+    pub error: Option<String>,
+}
+
+/// One check of one group: whether its condition holds there, and whether it passed.
+#[derive(Debug, Clone)]
+pub struct Verdict {
+    /// The check's condition holds (a check that does not apply passes).
+    pub applies: bool,
+    /// It passed.
+    pub pass: bool,
+    /// The numbers it compared.
+    pub numbers: String,
+}
+
+/// A model at one scheme and step: every method's run and the checks.
+#[derive(Debug, Clone)]
+pub struct Group {
+    /// The model's name (its file stem).
+    pub model: String,
+    /// Its scenario file.
+    pub file: String,
+    /// The scheme's name.
+    pub scheme: &'static str,
+    /// The step.
+    pub h: f64,
+    /// The end time.
+    pub t_end: f64,
+    /// Interval of the samples compared with the reference.
+    pub sample_interval: f64,
+    /// The reference's step.
+    pub reference_h: f64,
+    /// The method without control the others are compared with (`none` or `theta`).
+    pub baseline: String,
+    /// One per method.
+    pub runs: Vec<Run>,
+    /// The checks, in the order of [`CHECKS`].
+    pub verdicts: Vec<Verdict>,
+}
+
+/// Everything the suite measured.
+pub struct Suite {
+    /// Whether it was the `--light` suite.
+    pub light: bool,
+    /// One per model, scheme and step.
+    pub groups: Vec<Group>,
+}
+
+/// Reads the shipped suite (the light part of it with `light`) and `extra`,
+/// and builds every case: a bad file fails here, before anything runs.
+fn models(extra: &[PathBuf], light: bool) -> Result<Vec<Model>> {
+    let dir = shipped_dir();
+    let mut paths = Vec::new();
+    for entry in std::fs::read_dir(&dir).with_context(|| format!("cannot read the suite {}", dir.display()))? {
+        let path = entry.with_context(|| format!("cannot read the suite {}", dir.display()))?.path();
+        let stem = path.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned());
+        if path.extension().is_some_and(|e| e == "toml") && (!light || LIGHT.contains(&stem.as_str())) {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    paths.extend(extra.iter().cloned());
+    let mut models: Vec<Model> = Vec::new();
+    for path in paths {
+        let stem = path.file_stem().map_or("model".into(), |s| s.to_string_lossy().into_owned());
+        // Two files of the same stem stay apart by their paths.
+        let name = if models.iter().any(|m| m.name == stem) { path.display().to_string() } else { stem };
+        models.push(model(name, path, light)?);
+    }
+    Ok(models)
+}
+
+/// One suite file and its cases at every scheme and step.
+fn model(name: String, path: PathBuf, light: bool) -> Result<Model> {
+    let mut scenario: Scenario = scenario::load(&path)?;
+    scenario.refuse_sweep(&path, "suite")?;
+    // The file as written must be valid before --light shortens it.
+    scenario.case(&path)?;
+    let h = scenario.integrator.h;
+    if light {
+        scenario.integrator.t_end = nearest_valid_t_end(scenario.integrator.t_end * LIGHT_T_END, h);
+    }
+    let t_end = scenario.integrator.t_end;
+    let mut setups = Vec::new();
+    for scheme in SCHEMES {
+        for divisor in DIVISORS {
+            // The gains of `compare` depend on h: the cases are made per step.
+            scenario.integrator.scheme = scheme;
+            scenario.integrator.h = h / divisor as f64;
+            setups.push((scheme, scenario.integrator.h, compare::cases(&scenario, &path)?));
+        }
+    }
+    Ok(Model { name, path, h, t_end, setups })
+}
+
+/// Runs the suite: the shipped models (`light`: a few, shorter) and `extra`.
+pub fn run(extra: &[PathBuf], light: bool) -> Result<Suite> {
+    let models = models(extra, light)?;
+    let start = Instant::now();
+    let groups: Vec<Vec<Group>> = models.par_iter().map(run_model).collect::<Result<_>>()?;
+    print(&format!("suite: {} models in {:.1} s\n", models.len(), start.elapsed().as_secs_f64()))?;
+    Ok(Suite { light, groups: groups.into_iter().flatten().collect() })
+}
+
+/// The reference, then every case of the model.
+fn run_model(model: &Model) -> Result<Vec<Group>> {
+    let start = Instant::now();
+    let file = model.path.display().to_string();
+    let first = &model.setups[0].2[0];
+    let reference = reference(first, model.h, model.t_end).map_err(|e| anyhow!("{file}: the reference run: {e}"))?;
+    let mut groups = Vec::new();
+    for (scheme, h, cases) in &model.setups {
+        let every = (model.h / h).round() as u64;
+        let mut runs: Vec<Run> = cases.iter().map(|c| run_case(c, &reference, every)).collect();
+        let of = |pick: &dyn Fn(&Case) -> bool, what: &str| {
+            cases.iter().position(pick).ok_or_else(|| anyhow!("{file}: no {what} case"))
+        };
+        let none = of(&|c| c.settings.control == Control::none(), "uncontrolled")?;
+        let robust = of(&|c| c.name == "robust", "robust")?;
+        let projection = of(&|c| c.name == "projection", "projection")?;
+        let (e_none, e_projection) = (runs[none].max_error, runs[projection].max_error);
+        for r in &mut runs {
+            r.error_vs_none = r.max_error / e_none;
+            r.error_vs_projection = r.max_error / e_projection;
+        }
+        groups.push(Group {
+            model: model.name.clone(),
+            file: file.clone(),
+            scheme: scheme.info().name,
+            h: *h,
+            t_end: model.t_end,
+            sample_interval: model.h,
+            reference_h: model.h / REFERENCE_DIVISOR as f64,
+            baseline: cases[none].name.clone(),
+            verdicts: verdicts(&runs[none], &runs[robust], &runs[projection]),
+            runs,
+        });
+    }
+    print(&format!("  {}: {:.1} s\n", model.name, start.elapsed().as_secs_f64()))?;
+    Ok(groups)
+}
+
+/// Positions of the model without control, RK-4 at `interval / 20`, at `t = k·interval`.
+fn reference(case: &Case, interval: f64, t_end: f64) -> cdyn::Result<Vec<Vec<f64>>> {
+    let h = interval / REFERENCE_DIVISOR as f64;
+    let settings = Settings { scheme: Scheme::RungeKutta4, h, control: Control::none(), ..case.settings };
+    let ex = &case.example;
+    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
+    let mut samples = Vec::new();
+    sim.run(t_end, REFERENCE_DIVISOR, |s| {
+        samples.push(s.q().to_vec());
+        Ok::<_, cdyn::Error>(())
+    })?;
+    Ok(samples)
+}
+
+/// Largest `|a_i − b_i|`.
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// Runs `case`, comparing its positions with `reference` every `every` steps.
+fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
+    let projection = case.settings.control.projection;
+    let mut run = Run {
+        method: case.name.clone(),
+        max_error: f64::INFINITY,
+        error_vs_none: f64::NAN,
+        error_vs_projection: f64::NAN,
+        max_abs_phi: 0.0,
+        max_abs_phi_dot: 0.0,
+        max_abs_psi: 0.0,
+        initial: Vec::new(),
+        steps: 0,
+        rate_h: None,
+        projection_iterations_per_step: None,
+        projection_tolerance: projection.map(|p| p.tolerance),
+        error: None,
+    };
+    let ex = &case.example;
+    let mut sim = match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
+        Ok(sim) => sim,
+        Err(e) => {
+            run.error = Some(e.to_string());
+            return run;
+        }
+    };
+    run.rate_h = Some(sim.tuning().rate_h);
+    let m = sim.measure();
+    run.initial = vec![m.phi.abs(), m.phi_dot, m.psi.abs()];
+    let mut error = distance(sim.q(), &reference[0]);
+    // Whole steps were checked when the case was made.
+    let steps = steps_to(case.t_end, case.settings.h).unwrap_or(0);
+    while sim.steps() < steps {
+        if let Err(e) = sim.step() {
+            run.error = Some(e.to_string());
+            break;
+        }
+        let m = sim.measure();
+        run.max_abs_phi = run.max_abs_phi.max(m.phi.abs());
+        run.max_abs_phi_dot = run.max_abs_phi_dot.max(m.phi_dot);
+        run.max_abs_psi = run.max_abs_psi.max(m.psi.abs());
+        if sim.steps().is_multiple_of(every) {
+            error = error.max(distance(sim.q(), &reference[(sim.steps() / every) as usize]));
+        }
+    }
+    run.steps = sim.steps();
+    if run.error.is_none() {
+        run.max_error = error;
+    }
+    if projection.is_some() {
+        run.projection_iterations_per_step = Some(sim.projection_iterations() as f64 / sim.steps().max(1) as f64);
+    }
+    run
+}
+
+/// The checks of [`CHECKS`] on one group. A robust run that stopped fails
+/// every check that applies.
+fn verdicts(none: &Run, robust: &Run, projection: &Run) -> Vec<Verdict> {
+    let ok = robust.error.is_none();
+    let (r, n, p) = (robust.max_error, none.max_error, projection.max_error);
+    let verdict =
+        |applies: bool, pass: bool, numbers: String| Verdict { applies, pass: !applies || ok && pass, numbers };
+    let phi = none.max_abs_phi > 1e-8;
+    let psi = none.max_abs_psi > 1e-8;
+    vec![
+        verdict(true, r <= 2.0 * p, format!("robust {r:.3e}, projection {p:.3e}")),
+        verdict(p <= n, r <= n, format!("robust {r:.3e}, none {n:.3e}, projection {p:.3e}")),
+        verdict(n > 1e-4, r <= n / 10.0, format!("robust {r:.3e}, none {n:.3e}")),
+        verdict(
+            phi || psi,
+            (!phi || robust.max_abs_phi <= none.max_abs_phi / 10.0)
+                && (!psi || robust.max_abs_psi <= none.max_abs_psi / 10.0),
+            format!(
+                "max|phi| robust {:.3e}, none {:.3e}; max|psi| robust {:.3e}, none {:.3e}",
+                robust.max_abs_phi, none.max_abs_phi, robust.max_abs_psi, none.max_abs_psi
+            ),
+        ),
+    ]
+}
+
+impl Group {
+    /// `model scheme h=…`, how the summary names the group.
+    pub fn label(&self) -> String {
+        format!("{} {} h={}", self.model, self.scheme, self.h)
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let flags = |f: fn(&Verdict) -> bool| -> serde_json::Map<String, serde_json::Value> {
+            CHECKS.iter().zip(&self.verdicts).map(|((k, _), v)| (k.to_string(), f(v).into())).collect()
+        };
+        let numbers: serde_json::Map<_, _> =
+            CHECKS.iter().zip(&self.verdicts).map(|((k, _), v)| (k.to_string(), v.numbers.clone().into())).collect();
+        json!({
+            "model": self.model,
+            "file": self.file,
+            "scheme": self.scheme,
+            "h": JsonFloat(self.h),
+            "t_end": JsonFloat(self.t_end),
+            "sample_interval": JsonFloat(self.sample_interval),
+            "reference_h": JsonFloat(self.reference_h),
+            "baseline": self.baseline,
+            "runs": self.runs,
+            "checks": flags(|v| v.pass),
+            "applies": flags(|v| v.applies),
+            "compared": numbers,
+        })
+    }
+}
+
+impl Suite {
+    /// For each check: groups where it applies, and where it passed among those.
+    fn counts(&self) -> Vec<(usize, usize)> {
+        (0..CHECKS.len())
+            .map(|i| {
+                let applies = self.groups.iter().filter(|g| g.verdicts[i].applies);
+                (applies.clone().count(), applies.filter(|g| g.verdicts[i].pass).count())
+            })
+            .collect()
+    }
+
+    /// Every failed check: `model scheme h=… (a): numbers`.
+    pub fn misses(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for g in &self.groups {
+            for ((k, _), v) in CHECKS.iter().zip(&g.verdicts) {
+                if !v.pass {
+                    out.push(format!("{} ({k}): {}", g.label(), v.numbers));
+                }
+            }
+        }
+        out
+    }
+
+    /// `suite.json`: every run's numbers, the checks per group, and their counts.
+    pub fn json(&self) -> serde_json::Value {
+        let counts: serde_json::Map<_, _> = CHECKS
+            .iter()
+            .zip(self.counts())
+            .map(|((k, text), (applies, pass))| {
+                (k.to_string(), json!({ "check": text, "applies": applies, "pass": pass }))
+            })
+            .collect();
+        json!({
+            "light": self.light,
+            "error_metric": "max over t = k*sample_interval of max_i |q_i - q_ref,i| (positions); inf if the run stopped",
+            "reference": "the model without control, rk4, step reference_h = sample_interval / 20",
+            "violations": "max over every step after t = 0; runs[].initial = [|phi|, |phi_dot|, |psi|] at t = 0",
+            "cases": self.groups.iter().map(Group::json).collect::<Vec<_>>(),
+            "summary": { "groups": self.groups.len(), "checks": counts, "misses": self.misses() },
+        })
+    }
+}
+
+/// Writes `dir/suite.json` and the figure; each file appears whole or not at all.
+pub fn write(suite: &Suite, dir: &Path) -> Result<()> {
+    crate::suite_plot::write(suite, dir)?;
+    let text = serde_json::to_string_pretty(&suite.json())? + "\n";
+    let (part, path) = (dir.join(".suite.json.part"), dir.join("suite.json"));
+    std::fs::write(&part, text).with_context(|| format!("cannot write {}", part.display()))?;
+    std::fs::rename(&part, &path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// A number for the table: scientific, `inf` or `-`.
+fn num(x: f64) -> String {
+    if x.is_nan() { "-".into() } else { format!("{x:.2e}") }
+}
+
+/// The table: a row per model, scheme, step and method; the checks under each group.
+pub fn table(suite: &Suite) -> String {
+    let mut out = format!(
+        "{:<24} {:<4} {:>8} {:<22} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+        "model", "", "h", "method", "max err", "/none", "/proj", "max|phi|", "max|psi|"
+    );
+    for g in &suite.groups {
+        for r in &g.runs {
+            out += &format!(
+                "{:<24} {:<4} {:>8} {:<22} {:>9} {:>9} {:>9} {:>9} {:>9}{}\n",
+                g.model,
+                g.scheme,
+                g.h,
+                r.method,
+                num(r.max_error),
+                num(r.error_vs_none),
+                num(r.error_vs_projection),
+                num(r.max_abs_phi),
+                num(r.max_abs_psi),
+                r.error.as_ref().map_or(String::new(), |e| format!("  stopped: {e}")),
+            );
+        }
+        let marks: Vec<String> = CHECKS
+            .iter()
+            .zip(&g.verdicts)
+            .map(|((k, _), v)| {
+                format!(
+                    "{k} {}",
+                    if !v.applies {
+                        "n/a"
+                    } else if v.pass {
+                        "ok"
+                    } else {
+                        "MISS"
+                    }
+                )
+            })
+            .collect();
+        out += &format!("{:<24} checks: {}\n\n", "", marks.join(", "));
+    }
+    out
+}
+
+/// How many groups pass each check, and the misses.
+pub fn summary(suite: &Suite) -> String {
+    let mut out = format!("checks over {} (model, scheme, h):\n", suite.groups.len());
+    for ((k, text), (applies, pass)) in CHECKS.iter().zip(suite.counts()) {
+        out += &format!("  {k}) {text}: {pass} of {applies} pass");
+        if applies < suite.groups.len() {
+            out += &format!(" ({} where it does not apply)", suite.groups.len() - applies);
+        }
+        out += "\n";
+    }
+    let misses = suite.misses();
+    out += &format!("misses: {}\n", misses.len());
+    for m in misses {
+        out += &format!("  {m}\n");
+    }
+    out
+}
