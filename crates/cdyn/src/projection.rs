@@ -176,7 +176,16 @@ pub(crate) fn invariants(
     let mut energy_steps = 0;
     loop {
         let remaining = settings.max_iterations.saturating_sub(iterations);
-        iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
+        match positions(model, d, q, v, t, tol, remaining.max(1), work) {
+            Ok(taken) => iterations += taken,
+            Err(f @ Failure::Positions { .. }) => {
+                // Still the best state within reach: the velocities onto
+                // Φ̇ = 0 at the positions reached (for `on_failure = continue`).
+                velocities(model, d, v, work);
+                return Err(f);
+            }
+            Err(f) => return Err(f),
+        }
         velocities(model, d, v, work);
         let (kinetic, potential) = (model.kinetic(v), d.potential());
         let psi = kinetic + potential - e0_plus_e;
