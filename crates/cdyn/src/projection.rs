@@ -27,7 +27,10 @@ pub enum OnFailure {
     /// Stop the run with [`Error::ProjectionFailed`](crate::Error::ProjectionFailed).
     #[default]
     Stop,
-    /// Keep the best state reached, count the failure and go on.
+    /// Count the failure and go on from the state as the failed stage left
+    /// it (positions not converged: the velocities are not projected either,
+    /// since projecting them at such positions was measured to diverge
+    /// sooner with a long step).
     Continue,
 }
 
@@ -176,12 +179,8 @@ pub(crate) fn invariants(
     let mut energy_steps = 0;
     loop {
         let remaining = settings.max_iterations.saturating_sub(iterations);
-        match positions(model, d, q, v, t, tol, remaining.max(1), work) {
-            Ok(taken) => iterations += taken,
-            Err(f @ Failure::Positions { .. }) => {
-                // Still the best state within reach: the velocities onto
-                // Φ̇ = 0 at the positions reached (for `on_failure = continue`).
-                velocities(model, d, v, work);
+        iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
+        velocities(model, d, v, work);
                 return Err(f);
             }
             Err(f) => return Err(f),
