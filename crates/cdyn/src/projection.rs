@@ -181,11 +181,6 @@ pub(crate) fn invariants(
         let remaining = settings.max_iterations.saturating_sub(iterations);
         iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
         velocities(model, d, v, work);
-                return Err(f);
-            }
-            Err(f) => return Err(f),
-        }
-        velocities(model, d, v, work);
         let (kinetic, potential) = (model.kinetic(v), d.potential());
         let psi = kinetic + potential - e0_plus_e;
         // Ψ is a difference of energies: its round-off grows with them.
