@@ -383,15 +383,17 @@ impl Control {
     }
 
     /// [`Energy::Projected`] with the other terms whose gain matrix is
-    /// `S⁻¹` — [`Geometric::Newton`], [`Velocity::Gradient`] — added to `U`. Their
-    /// right-hand sides are solved together in one pass over `L`, and each
-    /// output takes one product with `M⁻¹Φ_qᵀ`, by linearity:
+    /// `S⁻¹` — [`Geometric::Newton`], [`Velocity::Gradient`] — added to `U`.
+    /// Their right-hand sides are solved together in one pass over `L`, and
+    /// each output takes one product with `M⁻¹Φ_qᵀ`, by linearity:
     ///
     /// * `U_q = −M⁻¹Φ_qᵀ(α_g z_Φ − κc y_w) − κc w`, `w = M⁻¹∇V`, and
     /// * `U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v`,
     ///
     /// with `z_x = S⁻¹x`, `y_v = S⁻¹Φ_q v`, `y_w = S⁻¹Φ_q w`: these are the
     /// laws of the README, `P v = v − M⁻¹Φ_qᵀ y_v`, `|Pv|²_M = vᵀMv − (Φ_q v)·y_v`.
+    /// Without drives (`Φ_t = 0`) `Φ_q v = Φ̇`, so `y_v = z_Φ̇` and one
+    /// right-hand side is saved.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn coupled_terms<E: Evaluation>(
@@ -403,7 +405,7 @@ impl Control {
         position_weight: f64,
         u_q: &mut [f64],
         u_v: &mut [f64],
-        [r_q, r_v, y_v, y_w, phi_q_w]: [&mut [f64]; 5],
+        [z_q, z_dot, y_v, y_w, phi_q_w]: [&mut [f64]; 5],
         w: &mut [f64],
     ) {
         let alpha_g = match self.geometric {
@@ -411,79 +413,71 @@ impl Control {
             _ => None,
         };
         let alpha_v = match self.velocity {
-            Velocity::Gradient(rate) => Some(rate.value()),
-            Velocity::None => None,
+            Velocity::Gradient(rate) => rate.value(),
+            Velocity::None => 0.0,
         };
-        let energy = (alpha_e > 0.0).then(|| (alpha_e, position_weight / (alpha_e * alpha_e)));
         let mass = d.mass();
         let (phi_dot, phi_t) = (d.phi_dot(), d.phi_t());
-        let mut rhs: [&mut [f64]; 4] = [r_q, r_v, y_v, y_w];
-        // The right-hand sides in use, packed to the front in a fixed order.
-        let positions = energy.is_some_and(|(_, c)| c > 0.0);
-        let mut used = [false; 4];
+        let energy = alpha_e > 0.0;
+        let scleronomic = phi_t.iter().all(|&x| x == 0.0);
+        // The right-hand sides in use: α_g Φ, Φ̇, and Φ_q v = Φ̇ − Φ_t where it differs from Φ̇.
         if let Some(a) = alpha_g {
-            rhs[0].iter_mut().zip(d.phi()).for_each(|(b, p)| *b = a * p);
-            used[0] = true;
+            z_q.iter_mut().zip(d.phi()).for_each(|(b, p)| *b = a * p);
         }
-        if let Some(a) = alpha_v {
-            rhs[1].iter_mut().zip(phi_dot).for_each(|(b, p)| *b = a * p);
-            used[1] = true;
+        z_dot.copy_from_slice(phi_dot);
+        let separate_y_v = energy && !scleronomic;
+        if separate_y_v {
+            y_v.iter_mut().zip(phi_dot).zip(phi_t).for_each(|((b, pd), pt)| *b = pd - pt);
         }
-        if energy.is_some() {
-            // Φ_q v = Φ̇ − Φ_t, known without a product.
-            rhs[2].iter_mut().zip(phi_dot).zip(phi_t).for_each(|((b, pd), pt)| *b = pd - pt);
-            used[2] = true;
-        }
-        if positions {
+        let c = if energy { position_weight / (alpha_e * alpha_e) } else { 0.0 };
+        let positions = c > 0.0;
+        if positions || (energy && alpha_g.is_some()) {
             mass.solve(d.grad_potential(), w);
             d.jac_mul(w, phi_q_w);
-            rhs[3].copy_from_slice(phi_q_w);
-            used[3] = true;
+        }
+        if positions {
+            y_w.copy_from_slice(phi_q_w);
         }
         {
-            let mut active: [&mut [f64]; 4] = Default::default();
+            let mut rhs: [&mut [f64]; 4] = Default::default();
             let mut k = 0;
-            for (b, u) in rhs.iter_mut().zip(used) {
-                if u {
-                    active[k] = &mut **b;
+            for (b, used) in
+                [(&mut *z_q, alpha_g.is_some()), (&mut *z_dot, true), (&mut *y_v, separate_y_v), (&mut *y_w, positions)]
+            {
+                if used {
+                    rhs[k] = b;
                     k += 1;
                 }
             }
-            d.solve_many(&mut active[..k]);
+            d.solve_many(&mut rhs[..k]);
         }
-        let [z_q, z_v, y_v, y_w] = rhs;
         let (mut kappa, mut kappa_c) = (0.0, 0.0);
-        if let Some((alpha, c)) = energy {
+        if energy {
+            let y_v: &[f64] = if separate_y_v { y_v } else { z_dot };
             let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
             let phi_q_v = |r: usize| phi_dot[r] - phi_t[r];
-            let v_y = (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>();
+            let grad = d.grad_potential();
             // The rate at which the other terms change Ψ (moving q through V,
             // v through T) is cancelled too: the whole control gives Ψ̇ = −α_e Ψ.
-            let mut others = dot(d.grad_potential(), u_q) + mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
+            let mut others = dot(grad, u_q) + mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
             if alpha_g.is_some() {
-                // ∇V·(−M⁻¹Φ_qᵀ z_Φ) = −(Φ_q w)·z_Φ, with w = M⁻¹∇V.
-                if !positions {
-                    mass.solve(d.grad_potential(), w);
-                    d.jac_mul(w, phi_q_w);
-                }
+                // ∇V·(−M⁻¹Φ_qᵀ z_Φ) = −(Φ_q w)·z_Φ
                 others -= dot(phi_q_w, z_q);
             }
-            if alpha_v.is_some() {
-                // vᵀM(−M⁻¹Φ_qᵀ z_Φ̇) = −(Φ_q v)·z_Φ̇.
-                others -= (0..z_v.len()).map(|r| phi_q_v(r) * z_v[r]).sum::<f64>();
-            }
-            let target = alpha * psi + others;
-            // N = c|P M⁻¹∇V|²_M + |P v|²_M.
-            let mut norm = 2.0 * mass.kinetic(v) - v_y;
+            // vᵀM(−α_v M⁻¹Φ_qᵀ z_Φ̇) = −α_v (Φ_q v)·z_Φ̇
+            others -= alpha_v * (0..z_dot.len()).map(|r| phi_q_v(r) * z_dot[r]).sum::<f64>();
+            let target = alpha_e * psi + others;
+            // N = c|P M⁻¹∇V|²_M + |P v|²_M, |P v|²_M = vᵀMv − (Φ_q v)·y_v.
+            let mut norm = 2.0 * mass.kinetic(v) - (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>();
             if positions {
-                norm += c * (dot(d.grad_potential(), w) - dot(phi_q_w, y_w));
+                norm += c * (dot(grad, w) - dot(phi_q_w, y_w));
             }
             // A correction is a first-order step along the gradient; where the
             // gradient is too short to reach the target without the quadratic
             // terms dominating (N < |target|/α_e: a static equilibrium, or at
             // rest at an extremum of V on the constraint surface) the gain is
             // capped so that |U| stays bounded (README).
-            let scale = target / norm.max(target.abs() / alpha);
+            let scale = target / norm.max(target.abs() / alpha_e);
             if norm > REST && scale.is_finite() {
                 (kappa, kappa_c) = (scale, scale * c);
             }
@@ -500,15 +494,17 @@ impl Control {
             d.add_weighted_jt(z_q, -1.0, u_q);
         }
         // U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v
-        if alpha_v.is_some() || kappa != 0.0 {
-            if alpha_v.is_none() {
-                z_v.fill(0.0);
+        if alpha_v != 0.0 || kappa != 0.0 {
+            if separate_y_v {
+                z_dot.iter_mut().zip(y_v.iter()).for_each(|(z, y)| *z = alpha_v * *z - kappa * y);
+            } else {
+                // y_v is z_Φ̇ itself.
+                z_dot.iter_mut().for_each(|z| *z *= alpha_v - kappa);
             }
             if kappa != 0.0 {
-                z_v.iter_mut().zip(y_v.iter()).for_each(|(z, y)| *z -= kappa * y);
                 mass.add_inverse_psi_v(v, -kappa, u_v);
             }
-            d.add_weighted_jt(z_v, -1.0, u_v);
+            d.add_weighted_jt(z_dot, -1.0, u_v);
         }
     }
 }
