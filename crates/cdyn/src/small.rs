@@ -99,8 +99,15 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
         check_rows(M, N)?;
         let system = Whole(Arc::new(system));
         let e0 = mass.kinetic(&v0) + system.energy(q0);
-        let controlled =
-            SmallControlled { system, control: settings.control, e0, evaluations: 0, d: SmallDynamics::new(mass) };
+        let controlled = SmallControlled {
+            system,
+            control: settings.control,
+            e0,
+            evaluations: 0,
+            d: SmallDynamics::new(mass),
+            rows: [[0.0; M]; 5],
+            w: [0.0; N],
+        };
         Self::start(controlled, settings, &q0, &v0)
     }
 }
@@ -142,6 +149,9 @@ pub struct SmallControlled<S, const N: usize, const M: usize> {
     e0: f64,
     evaluations: u64,
     d: SmallDynamics<N, M>,
+    /// Work space of the control laws, kept so no evaluation initializes it.
+    rows: [[f64; M]; 5],
+    w: [f64; N],
 }
 
 /// One evaluation of the dynamics of a small system (as `Dynamics`, in arrays).
@@ -351,9 +361,8 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
             let (u_q, rest) = u.split_at_mut(N);
             let (u_v, u_e) = rest.split_at_mut(N);
             u_e[0] = 0.0;
-            let mut rows = [[0.0; M]; 5];
-            let [r0, r1, r2, r3, r4] = &mut rows;
-            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut [0.0; N] };
+            let [r0, r1, r2, r3, r4] = &mut self.rows;
+            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.w };
             self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, work);
         }
         Ok(())
