@@ -5,6 +5,8 @@ mod alloc_count;
 mod bench;
 mod compare;
 mod heatmap;
+mod interrupt;
+mod output;
 mod paper;
 mod plot;
 mod report;
@@ -107,11 +109,43 @@ enum Command {
 
 fn main() -> ExitCode {
     match run(Cli::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Ended::Done) => ExitCode::SUCCESS,
+        Ok(Ended::Interrupted { signal, line }) => {
+            terminal::eprint_line(&line);
+            ExitCode::from(interrupt::exit_status(signal))
+        }
         Err(e) => {
             terminal::eprint_line(&format!("error: {}", format!("{e:#}").replace('\n', " ")));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// How a command ended without an error.
+enum Ended {
+    Done,
+    /// SIGINT or SIGTERM stopped a run; its output is written, `line` says where it stopped.
+    Interrupted {
+        signal: i32,
+        line: String,
+    },
+}
+
+/// How a run of `results` into `out` ended: interrupted, failed (an error), or done.
+fn ended(results: &[runner::CaseResult], out: &Path) -> Result<Ended> {
+    match (results.iter().find(|r| r.interrupted), interrupt::requested()) {
+        (Some(r), Some(signal)) => Ok(Ended::Interrupted {
+            signal,
+            line: format!(
+                "interrupted by {} at step {} (t = {}) of case {}; the output up to there is in {}",
+                interrupt::name(signal),
+                r.record.steps,
+                r.record.t_final,
+                r.name,
+                out.display()
+            ),
+        }),
+        _ => fail_on_error(results, out).map(|()| Ended::Done),
     }
 }
 
@@ -128,14 +162,17 @@ fn write_sweep(result: &sweep::Sweep, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn run(cli: Cli) -> Result<()> {
+fn run(cli: Cli) -> Result<Ended> {
     match cli.command {
         Command::Paper { out } => {
             output_dir(&out)?;
-            let results = paper::run(&out)?;
+            let cases = paper::cases()?;
+            output::clear(&out, &report::file_names(&cases, report::PAPER_FIGURES))?;
+            interrupt::install();
+            let results = paper::run(&cases, &out)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
-            fail_on_error(&results, &out)
+            ended(&results, &out)
         }
         Command::Run { scenario, out } => {
             let parsed = scenario::load(&scenario)?;
@@ -146,6 +183,8 @@ fn run(cli: Cli) -> Result<()> {
                 print(&format!("{}\n", report::assembly_line(a)))?;
             }
             output_dir(&out)?;
+            output::clear(&out, &report::file_names(std::slice::from_ref(&case), report::RUN_FIGURES))?;
+            interrupt::install();
             let results = [runner::run_case(&case, &out)?];
             let extra = serde_json::json!({
                 "scenario": scenario.display().to_string(),
@@ -155,23 +194,22 @@ fn run(cli: Cli) -> Result<()> {
             report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
-            fail_on_error(&results, &out)
+            ended(&results, &out)
         }
         Command::Bench { out, light } => {
             output_dir(&out)?;
             let report = bench::run(light)?;
             let path = out.join("bench.json");
-            std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            output::write(&path, (serde_json::to_string_pretty(&report)? + "\n").as_bytes())?;
             print(&bench::table(&report))?;
             print(&format!("wrote {}\n", path.display()))?;
-            Ok(())
+            Ok(Ended::Done)
         }
         Command::Sweep { scenario, out, shard, threads } => {
             let parsed = scenario::load(&scenario)?;
             let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
             let threads = sweep::worker_threads(threads)?;
-            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out)
+            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out).map(|()| Ended::Done)
         }
         Command::Merge { parts, out } => {
             let parts = parts
@@ -183,17 +221,19 @@ fn run(cli: Cli) -> Result<()> {
                     serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            write_sweep(&sweep::merge(parts)?, &out)
+            write_sweep(&sweep::merge(parts)?, &out).map(|()| Ended::Done)
         }
         Command::Compare { scenario, out } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
             let cases = compare::cases(&parsed, &scenario)?;
             output_dir(&out)?;
+            output::clear(&out, &report::file_names(&cases, report::RUN_FIGURES))?;
+            interrupt::install();
             let results = compare::run(&cases, &scenario, &out)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
-            fail_on_error(&results, &out)
+            ended(&results, &out)
         }
         Command::Suite { scenarios, out, light } => {
             let result = suite::run(&scenarios, light)?;
@@ -202,7 +242,7 @@ fn run(cli: Cli) -> Result<()> {
             print(&suite::table(&result))?;
             print(&suite::summary(&result))?;
             print(&format!("wrote {}\n", out.join("suite.json").display()))?;
-            Ok(())
+            Ok(Ended::Done)
         }
     }
 }

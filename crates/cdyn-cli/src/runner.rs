@@ -2,13 +2,16 @@
 //! per sample, written as the run goes so that a run which fails keeps what
 //! it wrote, plus the series and statistics the summary and figures need.
 
+use crate::interrupt;
+use crate::output::AtomicFile;
 use anyhow::{Context, Result};
 use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sample, Series, Sink};
+use cdyn::simulate::{Stepper, steps_to};
+use cdyn::system::System;
 use cdyn::{Settings, Simulation};
 use serde::Serialize;
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 /// One case to run.
@@ -53,18 +56,21 @@ pub struct CaseResult {
     pub projection_iterations_per_step: Option<f64>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
+    /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
+    pub interrupted: bool,
 }
 
 /// What a run reports of its method besides the record.
 #[derive(Default)]
 struct Method {
+    interrupted: bool,
     control: Option<cdyn::Control>,
     tuning: Option<cdyn::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
 }
 
 /// The series of a run that kept none (sweeps).
-static NO_SERIES: Series = Series { t: Vec::new(), phi: Vec::new(), psi: Vec::new(), error: Vec::new() };
+static NO_SERIES: Series = Series::new();
 
 impl CaseResult {
     /// The summary of `case` from its record.
@@ -82,6 +88,7 @@ impl CaseResult {
             control: method.control,
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
+            interrupted: method.interrupted,
         }
     }
 
@@ -128,33 +135,43 @@ impl<W: Write> Sink for CsvRows<'_, W> {
     }
 }
 
-/// Runs `case`, writing `dir/<name>.csv`. A simulation error is recorded in
-/// the result (the CSV keeps every row before it); I/O errors are returned.
+/// Runs `case`, writing `dir/<name>.csv` (under a temporary name until it
+/// is complete). A simulation error is recorded in the result (the CSV keeps
+/// every row before it); so is an interrupt (SIGINT, SIGTERM), which stops
+/// the run after the step it is in. I/O errors are returned, and leave no CSV.
 pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
     let path = dir.join(format!("{}.csv", case.name));
-    let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut csv = BufWriter::new(file);
-    let record = CsvRows::start(&mut csv, &case.example)
-        .and_then(|rows| simulate(case, Recorder::example(&case.example).keep_series(true).sink(rows)));
-    csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
+    let mut file = AtomicFile::create(&path)?;
+    let record = CsvRows::start(file.writer(), &case.example).and_then(|rows| {
+        simulate(case, Recorder::example(&case.example).keep_series(true).sink(rows), Watch::Interrupts)
+    });
     let record = record.with_context(|| format!("cannot write {}", path.display()))?;
+    file.commit()?;
     Ok(CaseResult::new(case, record))
 }
 
 /// Runs `case` keeping only its statistics (for sweeps).
 pub fn run_case_quietly(case: &Case) -> CaseResult {
-    let Ok(record) = simulate(case, Recorder::example(&case.example));
+    let Ok(record) = simulate(case, Recorder::example(&case.example), Watch::Nothing);
     CaseResult::new(case, record)
+}
+
+/// Whether a run stops when an interrupt was asked for.
+#[derive(Clone, Copy, PartialEq)]
+enum Watch {
+    Nothing,
+    Interrupts,
 }
 
 /// Runs `case` into `recorder`; an error of the simulation, also one
 /// starting it, is kept in the record, an error of the sink returned.
-fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<(Record, Method), K::Error> {
+fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
-            let record = recorder.run(&mut sim, case.t_end, case.every)?;
+            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch)?;
             let method = Method {
+                interrupted,
                 control: Some(sim.settings().control),
                 tuning: Some(*sim.tuning()),
                 projection_iterations_per_step: sim
@@ -168,4 +185,40 @@ fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<(Record, 
         }
         Err(e) => Ok((recorder.abandon(e), Method::default())),
     }
+}
+
+/// [`Recorder::run`], step by step so that an interrupt stops the run
+/// between two steps: the state it stopped at is sampled too (a complete
+/// CSV row), and the record says it was interrupted.
+fn drive<S: System, K: Sink>(
+    sim: &mut Stepper<S>,
+    mut recorder: Recorder<'_, K>,
+    t_end: f64,
+    every: u64,
+    watch: Watch,
+) -> Result<(Record, bool), K::Error> {
+    let steps = match steps_to(t_end, sim.settings().h) {
+        Ok(n) => n,
+        Err(e) => return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false)),
+    };
+    let every = every.max(1);
+    recorder.sample(sim)?;
+    let mut sampled = sim.steps();
+    while sim.steps() < steps {
+        if watch == Watch::Interrupts && interrupt::requested().is_some() {
+            if sampled != sim.steps() {
+                recorder.sample(sim)?;
+            }
+            return Ok((recorder.finish(sim), true));
+        }
+        if let Err(e) = sim.step() {
+            return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false));
+        }
+        let n = sim.steps();
+        if n.is_multiple_of(every) || n == steps {
+            recorder.sample(sim)?;
+            sampled = n;
+        }
+    }
+    Ok((recorder.finish(sim), false))
 }
