@@ -52,6 +52,9 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Run even if the CSV output would exceed 2 GB.
+        #[arg(long)]
+        force: bool,
     },
     /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
     Bench {
@@ -104,6 +107,9 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Run even if the CSV output would exceed 2 GB.
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -174,11 +180,16 @@ fn run(cli: Cli) -> Result<Ended> {
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)
         }
-        Command::Run { scenario, out } => {
+        Command::Run { scenario, out, force } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "run")?;
             let case = parsed.case(&scenario)?;
             case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
+            runner::Estimate::of(std::slice::from_ref(&case)).check(
+                &scenario.display().to_string(),
+                case.every,
+                force,
+            )?;
             if let Some(a) = &case.assembly {
                 print(&format!("{}\n", report::assembly_line(a)))?;
             }
@@ -223,10 +234,12 @@ fn run(cli: Cli) -> Result<Ended> {
                 .collect::<Result<Vec<_>>>()?;
             write_sweep(&sweep::merge(parts)?, &out).map(|()| Ended::Done)
         }
-        Command::Compare { scenario, out } => {
+        Command::Compare { scenario, out, force } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
             let cases = compare::cases(&parsed, &scenario)?;
+            let every = cases.first().map_or(1, |c| c.every);
+            runner::Estimate::of(&cases).check(&scenario.display().to_string(), every, force)?;
             output_dir(&out)?;
             output::clear(&out, &report::file_names(&cases, report::RUN_FIGURES))?;
             interrupt::install();

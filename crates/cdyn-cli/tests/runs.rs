@@ -121,7 +121,7 @@ fn no_partial_files(dir: &Path) {
 
 #[test]
 fn sigint_stops_a_run_with_complete_output() {
-    let (dir, path) = scenario("long.toml", &pendulum("1.0e6", "10"));
+    let (dir, path) = scenario("long.toml", &pendulum("1.0e5", "100"));
     let out_dir = dir.join("out");
     let mut child = spawn(&["run", path_str(&path), "--out", path_str(&out_dir)]);
     wait_for_rows(&out_dir, &mut child);
@@ -146,10 +146,10 @@ fn sigint_stops_a_run_with_complete_output() {
     assert_eq!(summary["interrupted_at"]["step"], steps);
     assert_eq!(summary["interrupted_at"]["case"], "long");
 
-    // Rows every 10 steps and one where the run stopped, each complete.
+    // Rows every 100 steps and one where the run stopped, each complete.
     let csv = std::fs::read_to_string(out_dir.join("long.csv")).unwrap();
     let rows = complete_rows(&csv);
-    assert_eq!(rows as u64, steps / 10 + 1 + u64::from(!steps.is_multiple_of(10)));
+    assert_eq!(rows as u64, steps / 100 + 1 + u64::from(!steps.is_multiple_of(100)));
     let last: f64 = csv.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
     assert_eq!(last, t);
     for figure in ["phi.png", "phi.svg", "psi.png", "psi.svg", "err.png", "err.svg"] {
@@ -160,7 +160,7 @@ fn sigint_stops_a_run_with_complete_output() {
 
 #[test]
 fn sigterm_stops_compare_after_the_case_it_is_in() {
-    let (dir, path) = scenario("long.toml", &pendulum("1.0e6", "100"));
+    let (dir, path) = scenario("long.toml", &pendulum("1.0e5", "1000"));
     let out_dir = dir.join("out");
     let mut child = spawn(&["compare", path_str(&path), "--out", path_str(&out_dir)]);
     wait_for_rows(&out_dir, &mut child);
@@ -194,7 +194,7 @@ fn a_killed_run_leaves_nothing_of_the_previous_run() {
     assert!(out_dir.join("summary.json").exists() && out_dir.join("phi.png").exists());
 
     // A second run, killed outright (no chance to clean up) while it writes.
-    std::fs::write(&path, pendulum("1.0e6", "10")).unwrap();
+    std::fs::write(&path, pendulum("1.0e5", "100")).unwrap();
     let mut child = spawn(&["run", path_str(&path), "--out", path_str(&out_dir)]);
     let start = Instant::now();
     while out_dir.join("summary.json").exists() || !files_in(&out_dir).iter().any(|(_, len)| *len > 0) {
@@ -274,4 +274,61 @@ fn a_full_disk_leaves_no_half_written_file() {
         }
         std::fs::remove_dir_all(&out_dir).unwrap();
     }
+}
+
+#[test]
+fn a_run_too_large_for_the_disk_is_refused_unless_forced() {
+    // 9e8 steps at every = 1: about 160 GB of CSV.
+    let (dir, path) = scenario("huge.toml", &pendulum("9.0e5", "1"));
+    for command in ["run", "compare"] {
+        let out_dir = dir.join(command);
+        let line = one_error_line(&cdyn(&[command, path_str(&path), "--out", path_str(&out_dir)]));
+        // One case for `run`, nine methods for `compare`.
+        let (rows, every) = if command == "run" { ("900000002 rows", "100") } else { ("8100000018 rows", "1000") };
+        let suggestion = format!("set [output] every = {every} or larger");
+        for needle in ["huge.toml", "GB of CSV", rows, "[output] every = 1)", &suggestion, "--force"] {
+            assert!(line.contains(needle), "{command}: {line:?} should mention {needle:?}");
+        }
+        assert!(files_in(&out_dir).is_empty(), "{command} wrote {:?}", files_in(&out_dir));
+    }
+    // The suggested `every` is accepted (the run is stopped once it has started).
+    std::fs::write(&path, pendulum("9.0e5", "100")).unwrap();
+    let out_dir = dir.join("every");
+    let mut child = spawn(&["run", path_str(&path), "--out", path_str(&out_dir)]);
+    wait_for_rows(&out_dir, &mut child);
+    signal(&child, libc::SIGINT);
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    // So is the original with --force.
+    std::fs::write(&path, pendulum("9.0e5", "1")).unwrap();
+    let out_dir = dir.join("forced");
+    let mut child = spawn(&["run", path_str(&path), "--out", path_str(&out_dir), "--force"]);
+    wait_for_rows(&out_dir, &mut child);
+    signal(&child, libc::SIGINT);
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    assert_eq!(read_json(&out_dir.join("summary.json"))["interrupted"], true);
+}
+
+#[test]
+fn a_scenario_file_is_read_with_a_bound() {
+    let dir = tempfile::tempdir().unwrap().keep();
+    let start = Instant::now();
+    let line = one_error_line(&cdyn(&["run", "/dev/zero", "--out", path_str(&dir.join("out"))]));
+    assert!(start.elapsed() < Duration::from_secs(20), "took {:?}", start.elapsed());
+    for needle in ["/dev/zero", "larger than 16 MB", "not a scenario"] {
+        assert!(line.contains(needle), "{line:?} should mention {needle:?}");
+    }
+    // A large file that is not one: refused by its size, not parsed.
+    let big = dir.join("big.toml");
+    std::fs::write(&big, format!("{}\n# {}\n", pendulum("1.0", "1"), "x".repeat(17 << 20))).unwrap();
+    let line = one_error_line(&cdyn(&["run", path_str(&big), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("big.toml: larger than 16 MB"), "{line}");
+    // Just below the bound, it is a scenario like any other.
+    std::fs::write(&big, format!("{}\n# {}\n", pendulum("1.0", "1"), "x".repeat(15 << 20))).unwrap();
+    let out = cdyn(&["run", path_str(&big), "--out", path_str(&dir.join("out"))]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // Binary bytes: one line, no dump.
+    std::fs::write(&big, [b'a', 0xff, 0xfe, b'\n']).unwrap();
+    let line = one_error_line(&cdyn(&["run", path_str(&big), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("big.toml: not UTF-8 text"), "{line}");
+    assert!(!dir.join("out").join("big.csv").exists() || files_in(&dir.join("out")).len() > 1);
 }
