@@ -332,3 +332,37 @@ fn a_scenario_file_is_read_with_a_bound() {
     assert!(line.contains("big.toml: not UTF-8 text"), "{line}");
     assert!(!dir.join("out").join("big.csv").exists() || files_in(&dir.join("out")).len() > 1);
 }
+
+/// Runs `args` to the end and returns its exit status and peak resident
+/// memory in bytes (the kernel's count for exactly this child, from wait4).
+fn peak_memory(args: &[&str]) -> (i32, u64) {
+    let child = Command::new(env!("CARGO_BIN_EXE_cdyn"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut status = 0;
+    // SAFETY: an all-zero rusage is a valid value for wait4 to fill in.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: waits for a child this test started; both pointers are to live locals.
+    let pid = unsafe { libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as libc::pid_t);
+    assert!(libc::WIFEXITED(status), "status {status}");
+    // ru_maxrss is in kilobytes on Linux.
+    (libc::WEXITSTATUS(status), usage.ru_maxrss as u64 * 1024)
+}
+
+#[test]
+fn ten_million_steps_stay_below_100_mb() {
+    // Example 1's pendulum, h = 0.001 to t = 10⁴: 10⁷ steps, a row every 1000.
+    let (dir, path) = scenario("long.toml", &pendulum("1.0e4", "1000"));
+    let out_dir = dir.join("out");
+    let (code, peak) = peak_memory(&["run", path_str(&path), "--out", path_str(&out_dir)]);
+    assert_eq!(code, 0);
+    println!("peak RSS of a 10^7-step run: {:.1} MB", peak as f64 / 1e6);
+    assert!(peak < 100_000_000, "peak RSS {peak} bytes");
+    let summary = read_json(&out_dir.join("summary.json"));
+    assert_eq!(summary["cases"][0]["steps"], 10_000_000);
+    assert_eq!(complete_rows(&std::fs::read_to_string(out_dir.join("long.csv")).unwrap()), 10_001);
+}
