@@ -335,6 +335,7 @@ fn a_scenario_file_is_read_with_a_bound() {
 
 /// Runs `args` to the end and returns its exit status and peak resident
 /// memory in bytes (the kernel's count for exactly this child, from wait4).
+#[allow(clippy::zombie_processes)] // waited for by wait4, which std's Child does not know
 fn peak_memory(args: &[&str]) -> (i32, u64) {
     let child = Command::new(env!("CARGO_BIN_EXE_cdyn"))
         .args(args)

@@ -46,7 +46,7 @@ fn a_long_series_stays_bounded_and_keeps_its_spikes() {
     s.finish();
     assert_eq!(s.samples(), n);
     let len = s.t.len();
-    assert!(len <= 2 * SERIES_BUCKETS + 2 && len >= SERIES_BUCKETS, "{len} entries");
+    assert!((SERIES_BUCKETS..=2 * SERIES_BUCKETS + 2).contains(&len), "{len} entries");
     assert_eq!((s.phi.len(), s.psi.len(), s.error.len()), (len, len, len));
     // The whole time span, in order.
     assert_eq!(s.t[0], 0.0);
