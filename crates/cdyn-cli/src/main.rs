@@ -9,6 +9,7 @@ mod interrupt;
 mod output;
 mod paper;
 mod plot;
+mod progress;
 mod report;
 mod runner;
 mod scenario;
@@ -196,7 +197,7 @@ fn run(cli: Cli) -> Result<Ended> {
             output_dir(&out)?;
             output::clear(&out, &report::file_names(std::slice::from_ref(&case), report::RUN_FIGURES))?;
             interrupt::install();
-            let results = [runner::run_case(&case, &out)?];
+            let results = report::run_cases(std::slice::from_ref(&case), &out)?;
             let extra = serde_json::json!({
                 "scenario": scenario.display().to_string(),
                 "assembly": case.assembly.as_ref().map(report::assembly_json),

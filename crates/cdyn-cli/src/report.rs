@@ -12,14 +12,16 @@ use std::path::Path;
 /// Runs `cases` into `dir` in turn; an interrupted case is the last.
 pub fn run_cases(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
     let mut results = Vec::new();
+    let bar = crate::progress::bar(crate::runner::Estimate::steps(cases), "steps");
     for case in cases {
-        let result = run_case(case, dir)?;
+        let result = run_case(case, dir, &bar)?;
         let interrupted = result.interrupted;
         results.push(result);
         if interrupted {
             break;
         }
     }
+    bar.finish_and_clear();
     Ok(results)
 }
 

@@ -4,12 +4,14 @@
 
 use crate::interrupt;
 use crate::output::AtomicFile;
+use crate::progress;
 use anyhow::{Context, Result};
 use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sample, Series, Sink};
 use cdyn::simulate::{Stepper, steps_to};
 use cdyn::system::System;
 use cdyn::{Settings, Simulation};
+use indicatif::ProgressBar;
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -54,6 +56,11 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// Steps of `cases` in all (for a progress bar).
+    pub fn steps(cases: &[Case]) -> u64 {
+        cases.iter().map(|c| steps_to(c.t_end, c.settings.h).unwrap_or(0)).sum()
+    }
+
     /// The estimate for `cases`: a row at the start, every `every` steps and
     /// at the end; the series a fixed size however long the run
     /// ([`cdyn::record::SERIES_BUCKETS`] buckets of two entries).
@@ -194,11 +201,12 @@ impl<W: Write> Sink for CsvRows<'_, W> {
 /// is complete). A simulation error is recorded in the result (the CSV keeps
 /// every row before it); so is an interrupt (SIGINT, SIGTERM), which stops
 /// the run after the step it is in. I/O errors are returned, and leave no CSV.
-pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
+pub fn run_case(case: &Case, dir: &Path, progress: &ProgressBar) -> Result<CaseResult> {
     let path = dir.join(format!("{}.csv", case.name));
     let mut file = AtomicFile::create(&path)?;
     let record = CsvRows::start(file.writer(), &case.example).and_then(|rows| {
-        simulate(case, Recorder::example(&case.example).keep_series(true).sink(rows), Watch::Interrupts)
+        let recorder = Recorder::example(&case.example).keep_series(true).sink(rows);
+        simulate(case, recorder, Watch::Interrupts(progress))
     });
     let record = record.with_context(|| format!("cannot write {}", path.display()))?;
     file.commit()?;
@@ -211,16 +219,16 @@ pub fn run_case_quietly(case: &Case) -> CaseResult {
     CaseResult::new(case, record)
 }
 
-/// Whether a run stops when an interrupt was asked for.
-#[derive(Clone, Copy, PartialEq)]
-enum Watch {
+/// Whether a run stops when an interrupt was asked for, and shows its progress.
+#[derive(Clone, Copy)]
+enum Watch<'p> {
     Nothing,
-    Interrupts,
+    Interrupts(&'p ProgressBar),
 }
 
 /// Runs `case` into `recorder`; an error of the simulation, also one
 /// starting it, is kept in the record, an error of the sink returned.
-fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch) -> Result<(Record, Method), K::Error> {
+fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch<'_>) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
@@ -250,17 +258,27 @@ fn drive<S: System, K: Sink>(
     mut recorder: Recorder<'_, K>,
     t_end: f64,
     every: u64,
-    watch: Watch,
+    watch: Watch<'_>,
 ) -> Result<(Record, bool), K::Error> {
     let steps = match steps_to(t_end, sim.settings().h) {
         Ok(n) => n,
         Err(e) => return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false)),
     };
     let every = every.max(1);
+    // Where this case's steps start on a bar shared by several cases.
+    let start = match watch {
+        Watch::Interrupts(progress) => progress.position(),
+        Watch::Nothing => 0,
+    };
     recorder.sample(sim)?;
     let mut sampled = sim.steps();
     while sim.steps() < steps {
-        if watch == Watch::Interrupts && interrupt::requested().is_some() {
+        if let Watch::Interrupts(progress) = watch
+            && sim.steps().is_multiple_of(progress::STEPS_PER_TICK)
+        {
+            progress.set_position(start + sim.steps());
+        }
+        if matches!(watch, Watch::Interrupts(_)) && interrupt::requested().is_some() {
             if sampled != sim.steps() {
                 recorder.sample(sim)?;
             }
@@ -274,6 +292,9 @@ fn drive<S: System, K: Sink>(
             recorder.sample(sim)?;
             sampled = n;
         }
+    }
+    if let Watch::Interrupts(progress) = watch {
+        progress.set_position(start + steps);
     }
     Ok((recorder.finish(sim), false))
 }

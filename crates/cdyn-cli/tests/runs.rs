@@ -367,3 +367,29 @@ fn ten_million_steps_stay_below_100_mb() {
     assert_eq!(summary["cases"][0]["steps"], 10_000_000);
     assert_eq!(complete_rows(&std::fs::read_to_string(out_dir.join("long.csv")).unwrap()), 10_001);
 }
+
+#[test]
+fn progress_is_shown_on_a_terminal_only() {
+    let (dir, path) = scenario("long.toml", &pendulum("10.0", "100"));
+    // Without a terminal (as here): nothing on standard error.
+    for command in ["run", "compare"] {
+        let out_dir = dir.join(command);
+        let out = cdyn(&[command, path_str(&path), "--out", path_str(&out_dir)]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(out.stderr.is_empty(), "{command}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    // On a terminal (a pseudo-terminal from script(1)): a bar counting steps with a time estimate.
+    std::fs::write(&path, pendulum("1.0e4", "1000")).unwrap();
+    let line = format!("{} run {} --out {}", env!("CARGO_BIN_EXE_cdyn"), path_str(&path), path_str(&dir.join("tty")));
+    let Ok(out) = Command::new("script").args(["-qec", &line, "/dev/null"]).output() else {
+        println!("skipped: no script(1) to run cdyn on a pseudo-terminal");
+        return;
+    };
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    for needle in ["/10,000,000 steps", "elapsed", "left"] {
+        assert!(text.contains(needle), "no {needle:?} in {text:?}");
+    }
+    // The bar is cleared before the table: its last line is the table's.
+    assert!(text.contains("case ") && text.contains("wrote"), "{text}");
+}
