@@ -3,7 +3,7 @@
 //! `robust` preset and exact `projection`.
 
 use crate::report;
-use crate::runner::{Case, CaseResult, run_case};
+use crate::runner::{Case, CaseResult};
 use crate::scenario::Scenario;
 use anyhow::Result;
 use cdyn::methods::compare_cases;
@@ -34,9 +34,9 @@ pub fn cases(scenario: &Scenario, path: &Path) -> Result<Vec<Case>> {
         .collect()
 }
 
-/// Runs the cases into `dir` with the summary, figures and gains used.
+/// Runs the cases into `dir` (until one is interrupted) with the summary, figures and gains used.
 pub fn run(cases: &[Case], path: &Path, dir: &Path) -> Result<Vec<CaseResult>> {
-    let results = cases.iter().map(|c| run_case(c, dir)).collect::<Result<Vec<_>>>()?;
+    let results = report::run_cases(cases, dir)?;
     let methods: Vec<_> =
         cases.iter().map(|c| json!({ "name": c.name, "control": format!("{:?}", c.settings.control) })).collect();
     let extra = json!({

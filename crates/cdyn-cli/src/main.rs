@@ -5,8 +5,11 @@ mod alloc_count;
 mod bench;
 mod compare;
 mod heatmap;
+mod interrupt;
+mod output;
 mod paper;
 mod plot;
+mod progress;
 mod report;
 mod runner;
 mod scenario;
@@ -50,6 +53,9 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Run even if the CSV output would exceed 2 GB.
+        #[arg(long)]
+        force: bool,
     },
     /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
     Bench {
@@ -102,16 +108,51 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Run even if the CSV output would exceed 2 GB.
+        #[arg(long)]
+        force: bool,
     },
 }
 
 fn main() -> ExitCode {
     match run(Cli::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Ended::Done) => ExitCode::SUCCESS,
+        Ok(Ended::Interrupted { signal, line }) => {
+            terminal::eprint_line(&line);
+            ExitCode::from(interrupt::exit_status(signal))
+        }
         Err(e) => {
             terminal::eprint_line(&format!("error: {}", format!("{e:#}").replace('\n', " ")));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// How a command ended without an error.
+enum Ended {
+    Done,
+    /// SIGINT or SIGTERM stopped a run; its output is written, `line` says where it stopped.
+    Interrupted {
+        signal: i32,
+        line: String,
+    },
+}
+
+/// How a run of `results` into `out` ended: interrupted, failed (an error), or done.
+fn ended(results: &[runner::CaseResult], out: &Path) -> Result<Ended> {
+    match (results.iter().find(|r| r.interrupted), interrupt::requested()) {
+        (Some(r), Some(signal)) => Ok(Ended::Interrupted {
+            signal,
+            line: format!(
+                "interrupted by {} at step {} (t = {}) of case {}; the output up to there is in {}",
+                interrupt::name(signal),
+                r.record.steps,
+                r.record.t_final,
+                r.name,
+                out.display()
+            ),
+        }),
+        _ => fail_on_error(results, out).map(|()| Ended::Done),
     }
 }
 
@@ -128,25 +169,35 @@ fn write_sweep(result: &sweep::Sweep, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn run(cli: Cli) -> Result<()> {
+fn run(cli: Cli) -> Result<Ended> {
     match cli.command {
         Command::Paper { out } => {
             output_dir(&out)?;
-            let results = paper::run(&out)?;
+            let cases = paper::cases()?;
+            output::clear(&out, &report::file_names(&cases, report::PAPER_FIGURES))?;
+            interrupt::install();
+            let results = paper::run(&cases, &out)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
-            fail_on_error(&results, &out)
+            ended(&results, &out)
         }
-        Command::Run { scenario, out } => {
+        Command::Run { scenario, out, force } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "run")?;
             let case = parsed.case(&scenario)?;
             case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
+            runner::Estimate::of(std::slice::from_ref(&case)).check(
+                &scenario.display().to_string(),
+                case.every,
+                force,
+            )?;
             if let Some(a) = &case.assembly {
                 print(&format!("{}\n", report::assembly_line(a)))?;
             }
             output_dir(&out)?;
-            let results = [runner::run_case(&case, &out)?];
+            output::clear(&out, &report::file_names(std::slice::from_ref(&case), report::RUN_FIGURES))?;
+            interrupt::install();
+            let results = report::run_cases(std::slice::from_ref(&case), &out)?;
             let extra = serde_json::json!({
                 "scenario": scenario.display().to_string(),
                 "assembly": case.assembly.as_ref().map(report::assembly_json),
@@ -155,23 +206,22 @@ fn run(cli: Cli) -> Result<()> {
             report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
-            fail_on_error(&results, &out)
+            ended(&results, &out)
         }
         Command::Bench { out, light } => {
             output_dir(&out)?;
             let report = bench::run(light)?;
             let path = out.join("bench.json");
-            std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            output::write(&path, (serde_json::to_string_pretty(&report)? + "\n").as_bytes())?;
             print(&bench::table(&report))?;
             print(&format!("wrote {}\n", path.display()))?;
-            Ok(())
+            Ok(Ended::Done)
         }
         Command::Sweep { scenario, out, shard, threads } => {
             let parsed = scenario::load(&scenario)?;
             let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
             let threads = sweep::worker_threads(threads)?;
-            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out)
+            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out).map(|()| Ended::Done)
         }
         Command::Merge { parts, out } => {
             let parts = parts
@@ -183,17 +233,21 @@ fn run(cli: Cli) -> Result<()> {
                     serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            write_sweep(&sweep::merge(parts)?, &out)
+            write_sweep(&sweep::merge(parts)?, &out).map(|()| Ended::Done)
         }
-        Command::Compare { scenario, out } => {
+        Command::Compare { scenario, out, force } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
             let cases = compare::cases(&parsed, &scenario)?;
+            let every = cases.first().map_or(1, |c| c.every);
+            runner::Estimate::of(&cases).check(&scenario.display().to_string(), every, force)?;
             output_dir(&out)?;
+            output::clear(&out, &report::file_names(&cases, report::RUN_FIGURES))?;
+            interrupt::install();
             let results = compare::run(&cases, &scenario, &out)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
-            fail_on_error(&results, &out)
+            ended(&results, &out)
         }
         Command::Suite { scenarios, out, light } => {
             let result = suite::run(&scenarios, light)?;
@@ -202,7 +256,7 @@ fn run(cli: Cli) -> Result<()> {
             print(&suite::table(&result))?;
             print(&suite::summary(&result))?;
             print(&format!("wrote {}\n", out.join("suite.json").display()))?;
-            Ok(())
+            Ok(Ended::Done)
         }
     }
 }

@@ -2,7 +2,7 @@
 //! t ∈ [0, 20], α_g = α_e = 40, Baumgarte β = 40 critically damped).
 
 use crate::report;
-use crate::runner::{Case, CaseResult, run_case};
+use crate::runner::{Case, CaseResult};
 use anyhow::Result;
 use cdyn::methods::{MethodGains, independent_cases, redundant_cases};
 use cdyn::models::{PendulumParams, cartesian_pendulum, theta_pendulum};
@@ -38,10 +38,10 @@ pub fn cases() -> Result<Vec<Case>> {
     Ok(cases)
 }
 
-/// Runs every case into `dir`, writes the summary and figures, and returns
+/// Runs `cases` (the paper's, from [`cases`]) into `dir` until one is interrupted, writes the summary and figures, and returns
 /// the results (failed cases carry their error).
-pub fn run(dir: &Path) -> Result<Vec<CaseResult>> {
-    let results = cases()?.iter().map(|c| run_case(c, dir)).collect::<Result<Vec<_>>>()?;
+pub fn run(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
+    let results = report::run_cases(cases, dir)?;
     let setup = json!({
         "problem": "Example 1: unit pendulum in Cartesian coordinates, X(0)=1, Y(0)=0, VX(0)=0, VY(0)=2, g=1",
         "scheme": "ab3 (rk4 start-up)", "h": H, "t_end": T_END,

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use anyhow::{Context, Result, anyhow, bail};
+use image::ImageEncoder;
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
@@ -51,14 +52,26 @@ const PALETTE: [u32; 10] =
     [0x1f77b4, 0xff7f0e, 0x2ca02c, 0xd62728, 0x9467bd, 0x8c564b, 0xe377c2, 0x7f7f7f, 0xbcbd22, 0x17becf];
 
 /// Writes `<stem>.png` (1200x800) and `<stem>.svg`. `stem` is a path without extension.
+///
+/// Both are drawn in memory and written atomically ([`crate::output`]), so
+/// a failed write leaves no truncated figure and its message is the I/O
+/// error, not a dump of plotters' error types.
 pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
     ensure_font()?;
     let data = prepare(fig);
     let (png, svg) = (with_ext(stem, "png"), with_ext(stem, "svg"));
-    render(BitMapBackend::new(&png, SIZE).into_drawing_area(), fig, &data)
-        .with_context(|| format!("writing figure {}", png.display()))?;
-    render(SVGBackend::new(&svg, SIZE).into_drawing_area(), fig, &data)
-        .with_context(|| format!("writing figure {}", svg.display()))
+    let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    render(BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(), fig, &data)
+        .with_context(|| format!("cannot draw figure {}", png.display()))?;
+    let mut encoded = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut encoded)
+        .write_image(&pixels, SIZE.0, SIZE.1, image::ColorType::Rgb8)
+        .map_err(|e| anyhow!("cannot encode figure {}: {e}", png.display()))?;
+    crate::output::write(&png, &encoded)?;
+    let mut text = String::new();
+    render(SVGBackend::with_string(&mut text, SIZE).into_drawing_area(), fig, &data)
+        .with_context(|| format!("cannot draw figure {}", svg.display()))?;
+    crate::output::write(&svg, text.as_bytes())
 }
 
 /// Registers the shipped font once; every figure needs it (there are no system fonts).
@@ -83,6 +96,9 @@ pub fn with_ext(stem: &Path, ext: &str) -> PathBuf {
 /// are shifted to start at 1 and the tick labels shift them back.
 struct Data {
     runs: Vec<Vec<Vec<(f64, f64)>>>,
+    /// For each series, a later series drawn over it along (almost) all its length: the
+    /// legend says so, since the lower one cannot be seen but for its markers.
+    under: Vec<Option<usize>>,
     x: (f64, f64),
     y: (f64, f64),
     shift: i32,
@@ -115,8 +131,9 @@ fn prepare(fig: &Figure) -> Data {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
     };
     let (x, (ylo, yhi)) = (pad(extent(|p| p.0), 0.0), extent(|p| p.1));
+    let under = coincident(&runs, (yhi - ylo) * COINCIDENT);
     if !log {
-        return Data { y: pad((ylo, yhi), 0.05), x, runs, shift: 0 };
+        return Data { y: pad((ylo, yhi), 0.05), x, runs, under, shift: 0 };
     }
     // Whole decades, so the axis always has labelled powers of ten.
     let (lo, hi) = if ylo > yhi { (-1.0, 1.0) } else { (ylo.floor(), yhi.ceil().max(ylo.floor() + 1.0)) };
@@ -124,7 +141,21 @@ fn prepare(fig: &Figure) -> Data {
     for p in runs.iter_mut().flatten().flatten() {
         p.1 = 10f64.powf((p.1 - shift).max(0.0));
     }
-    Data { runs, x, y: (10f64.powf((lo - shift).max(0.0)), 10f64.powf(hi - shift)), shift: shift as i32 }
+    Data { runs, x, y: (10f64.powf((lo - shift).max(0.0)), 10f64.powf(hi - shift)), under, shift: shift as i32 }
+}
+
+/// Two curves closer than this fraction of the y axis draw as one line.
+const COINCIDENT: f64 = 0.01;
+
+/// For each series, the first later one that covers it: same times, and
+/// within `tol` (in the drawn units: log10 |y| or y) at 95 % of them.
+fn coincident(runs: &[Vec<Vec<(f64, f64)>>], tol: f64) -> Vec<Option<usize>> {
+    let flat: Vec<Vec<(f64, f64)>> = runs.iter().map(|r| r.iter().flatten().copied().collect()).collect();
+    let covers = |a: &[(f64, f64)], b: &[(f64, f64)]| {
+        let close = a.iter().zip(b).filter(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= tol).count();
+        !a.is_empty() && a.len() == b.len() && close as f64 >= 0.95 * a.len() as f64
+    };
+    (0..flat.len()).map(|a| (a + 1..flat.len()).find(|&b| covers(&flat[a], &flat[b]))).collect()
 }
 
 /// Widens a range by `frac` of its span each side. A flat range (all values equal, up to
@@ -195,6 +226,27 @@ fn style(i: usize) -> (ShapeStyle, Option<(u32, u32)>) {
     (color.stroke_width(2), [None, Some((12, 6)), Some((2, 5))][(i / 10) % 3])
 }
 
+/// Markers along each line.
+const MARKERS: usize = 12;
+
+/// Draws the marker of series `$i` (its hue; a circle, triangle, square or
+/// cross by turns) centred on `$at` with `$draw` (a function of the element),
+/// for a chart (data coordinates) and the legend (pixels) alike.
+macro_rules! draw_marker {
+    ($i:expr, $at:expr, $draw:expr) => {{
+        let (line, _) = style($i);
+        let fill = line.color.filled();
+        let at = EmptyElement::at($at);
+        match $i % 4 {
+            0 => $draw(at + Circle::new((0, 0), 5, fill)),
+            1 => $draw(at + TriangleMarker::new((0, 0), 7, fill)),
+            2 => $draw(at + Rectangle::new([(-4, -4), (4, 4)], fill)),
+            _ => $draw(at + Cross::new((0, 0), 5, line.color.stroke_width(3))),
+        }
+        .map_err(de)
+    }};
+}
+
 /// Width in pixels of the widest of `texts` in the 18 px label font.
 fn widest<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, texts: impl Iterator<Item = String>) -> Result<u32> {
     let font = TextStyle::from((FONT, 18));
@@ -218,7 +270,8 @@ fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Da
         .series
         .iter()
         .zip(&d.runs)
-        .map(|(s, runs)| {
+        .enumerate()
+        .map(|(i, (s, runs))| {
             let mut l: String = s.label.chars().take(40).collect();
             if l.len() < s.label.len() {
                 l.pop();
@@ -226,6 +279,10 @@ fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Da
             }
             if runs.is_empty() {
                 l += " (no data)";
+            }
+            if let Some(over) = d.under[i] {
+                let over: String = fig.series[over].label.chars().take(24).collect();
+                l += &format!(" (under {over})");
             }
             l
         })
@@ -258,6 +315,7 @@ fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Da
             Some((a, b)) => legend.draw(&DashedPathElement::new(sample, a, b, st)),
         }
         .map_err(de)?;
+        draw_marker!(i, (32, y), |e| legend.draw(&e))?;
         legend.draw(&Text::new(l.as_str(), (62, y), font.clone())).map_err(de)?;
     }
     root.present().map_err(de)
@@ -311,6 +369,20 @@ where
                 (_, Some((a, b))) => ch.draw_series(DashedLineSeries::new(pts, a, b, st)),
             }
             .map_err(de)?;
+        }
+    }
+    // Markers at staggered places along each line, so a line drawn over
+    // another (the same values) leaves the lower one's markers in view.
+    let n = d.runs.len().max(1);
+    for (i, runs) in d.runs.iter().enumerate() {
+        let points: Vec<(f64, f64)> = runs.iter().flatten().copied().collect();
+        if points.len() < 2 * MARKERS {
+            continue;
+        }
+        for k in 0..MARKERS {
+            let at = ((k as f64 + (i as f64 + 0.5) / n as f64) * points.len() as f64 / MARKERS as f64) as usize;
+            let at = points[at.min(points.len() - 1)];
+            draw_marker!(i, at, |e| ch.draw_series(std::iter::once(e)).map(|_| ()))?;
         }
     }
     if d.runs.iter().all(Vec::is_empty) {
@@ -392,6 +464,32 @@ mod tests {
                 assert!(std::fs::metadata(with_ext(&stem, "png")).unwrap().len() > 5_000);
             }
         }
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn a_curve_drawn_over_another_is_named_in_the_legend() {
+        let dir = temp_dir("coincident");
+        let near = |t: f64| 1e-4 * (1.0 + t.sin().abs());
+        let series = [
+            wave("lower", near),
+            wave("apart", |t| 1e-8 * (1.0 + t)),
+            // Within 0.1 % of `lower`: one line on the figure.
+            wave("upper", |t| near(t) * 1.001),
+        ];
+        write_figure(&dir.join("fig"), &fig(&series, Scale::LogAbs)).unwrap();
+        let svg = std::fs::read_to_string(dir.join("fig.svg")).unwrap();
+        assert!(svg.contains("lower (under upper)"), "no note in the legend");
+        assert!(!svg.contains("apart (under") && !svg.contains("upper (under"));
+        // Markers: 12 along each line and one in the legend, of three shapes.
+        let circles = svg.matches("<circle").count();
+        assert!(circles >= 13, "{circles} circles");
+        assert!(svg.matches("<polygon").count() >= 13 || svg.matches("<polyline").count() >= 13);
+        let d = prepare(&fig(&series, Scale::LogAbs));
+        assert_eq!(d.under, [Some(2), None, None]);
+        // Curves a tenth of the axis apart are not one.
+        let apart = [wave("a", near), wave("b", |t| near(t) * 2.0), wave("c", |t| 1e-8 * (1.0 + t))];
+        assert_eq!(prepare(&fig(&apart, Scale::LogAbs)).under, [None, None, None]);
         std::fs::remove_dir_all(dir).unwrap();
     }
 

@@ -1,22 +1,48 @@
 //! What a set of cases leaves behind: `summary.json`, the figures, and a
 //! table on the terminal.
 
+use crate::output;
 use crate::plot::{self, Figure, Scale};
-use crate::runner::CaseResult;
-use anyhow::{Context, Result};
+use crate::runner::{Case, CaseResult, run_case};
+use anyhow::Result;
 use cdyn::json_float::JsonFloat;
 use serde_json::json;
 use std::path::Path;
 
-/// Writes `dir/summary.json` with every case.
+/// Runs `cases` into `dir` in turn; an interrupted case is the last.
+pub fn run_cases(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
+    let mut results = Vec::new();
+    let bar = crate::progress::bar(crate::runner::Estimate::steps(cases), "steps");
+    for case in cases {
+        let result = run_case(case, dir, &bar)?;
+        let interrupted = result.interrupted;
+        results.push(result);
+        if interrupted {
+            break;
+        }
+    }
+    bar.finish_and_clear();
+    Ok(results)
+}
+
+/// The files a run of `cases` writes into its directory (those of an earlier run are removed first).
+pub fn file_names(cases: &[Case], stems: Stems) -> Vec<String> {
+    let csv = cases.iter().map(|c| format!("{}.csv", c.name));
+    let figures = stems.iter().flat_map(|s| ["png", "svg"].map(|ext| format!("{s}.{ext}")));
+    csv.chain(figures).chain(["summary.json".to_string()]).collect()
+}
+
+/// Writes `dir/summary.json` with every case; `interrupted` says whether a
+/// signal stopped the run, and `interrupted_at` where (case, step, time).
 pub fn write_summary(dir: &Path, cases: &[CaseResult], extra: serde_json::Value) -> Result<()> {
-    let mut doc = json!({ "cases": cases });
+    let mut doc = json!({ "cases": cases, "interrupted": cases.iter().any(|c| c.interrupted) });
+    if let Some(c) = cases.iter().find(|c| c.interrupted) {
+        doc["interrupted_at"] = json!({ "case": c.name, "step": c.record.steps, "t": JsonFloat(c.record.t_final) });
+    }
     if let (Some(doc), serde_json::Value::Object(extra)) = (doc.as_object_mut(), extra) {
         doc.extend(extra);
     }
-    let path = dir.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&doc)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))
+    output::write(&dir.join("summary.json"), (serde_json::to_string_pretty(&doc)? + "\n").as_bytes())
 }
 
 /// Which time history a figure shows.

@@ -2,13 +2,18 @@
 //! per sample, written as the run goes so that a run which fails keeps what
 //! it wrote, plus the series and statistics the summary and figures need.
 
+use crate::interrupt;
+use crate::output::AtomicFile;
+use crate::progress;
 use anyhow::{Context, Result};
 use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sample, Series, Sink};
+use cdyn::simulate::{Stepper, steps_to};
+use cdyn::system::System;
 use cdyn::{Settings, Simulation};
+use indicatif::ProgressBar;
 use serde::Serialize;
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 /// One case to run.
@@ -33,6 +38,66 @@ impl Case {
     }
 }
 
+/// Largest output a run writes, or memory it keeps, without `--force` (2 GB).
+pub const OUTPUT_LIMIT: u64 = 2_000_000_000;
+
+/// Bytes a CSV value takes at most: `-1.2345678901234567e-100,`.
+const BYTES_PER_VALUE: u64 = 25;
+
+/// What a run of some cases is expected to write and keep, before it starts.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Estimate {
+    /// CSV rows.
+    pub rows: u64,
+    /// Bytes of CSV.
+    pub csv_bytes: u64,
+    /// Bytes of memory for the series kept for the figures.
+    pub memory_bytes: u64,
+}
+
+impl Estimate {
+    /// Steps of `cases` in all (for a progress bar).
+    pub fn steps(cases: &[Case]) -> u64 {
+        cases.iter().map(|c| steps_to(c.t_end, c.settings.h).unwrap_or(0)).sum()
+    }
+
+    /// The estimate for `cases`: a row at the start, every `every` steps and
+    /// at the end; the series a fixed size however long the run
+    /// ([`cdyn::record::SERIES_BUCKETS`] buckets of two entries).
+    pub fn of(cases: &[Case]) -> Estimate {
+        let mut total = Estimate::default();
+        for case in cases {
+            let steps = steps_to(case.t_end, case.settings.h).unwrap_or(0);
+            let rows = steps / case.every.max(1) + 2;
+            let columns = 3 + case.example.observables.len() as u64 + u64::from(case.example.reference.is_some());
+            let kept = rows.min(2 * cdyn::record::SERIES_BUCKETS as u64);
+            total.rows = total.rows.saturating_add(rows);
+            total.csv_bytes = total.csv_bytes.saturating_add(rows.saturating_mul(columns * BYTES_PER_VALUE));
+            total.memory_bytes = total.memory_bytes.saturating_add(kept * 4 * 8 + (1 << 20));
+        }
+        total
+    }
+
+    /// Refuses a run above [`OUTPUT_LIMIT`] (unless `force`), naming the
+    /// scenario `file`, the sizes, and the `every` that would fit.
+    pub fn check(&self, file: &str, every: u64, force: bool) -> Result<()> {
+        let worst = self.csv_bytes.max(self.memory_bytes);
+        if force || worst <= OUTPUT_LIMIT {
+            return Ok(());
+        }
+        let suggest = (every as f64 * worst as f64 / OUTPUT_LIMIT as f64).ceil() as u64;
+        // Rounded up to a power of ten: a value a user would write.
+        let power = 10u64.saturating_pow(suggest.max(1).ilog10());
+        let suggest = if power < suggest { power.saturating_mul(10) } else { power };
+        anyhow::bail!(
+            "{file}: the run would write about {:.1} GB of CSV ({} rows at [output] every = {every}), above the limit of {} GB; set [output] every = {suggest} or larger, or pass --force",
+            self.csv_bytes as f64 / 1e9,
+            self.rows,
+            OUTPUT_LIMIT / 1_000_000_000
+        )
+    }
+}
+
 /// What a case produced, as `summary.json` reports it: the case, then the
 /// library's record of the run.
 #[derive(Debug, Clone, Serialize)]
@@ -53,18 +118,21 @@ pub struct CaseResult {
     pub projection_iterations_per_step: Option<f64>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
+    /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
+    pub interrupted: bool,
 }
 
 /// What a run reports of its method besides the record.
 #[derive(Default)]
 struct Method {
+    interrupted: bool,
     control: Option<cdyn::Control>,
     tuning: Option<cdyn::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
 }
 
 /// The series of a run that kept none (sweeps).
-static NO_SERIES: Series = Series { t: Vec::new(), phi: Vec::new(), psi: Vec::new(), error: Vec::new() };
+static NO_SERIES: Series = Series::new();
 
 impl CaseResult {
     /// The summary of `case` from its record.
@@ -82,6 +150,7 @@ impl CaseResult {
             control: method.control,
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
+            interrupted: method.interrupted,
         }
     }
 
@@ -128,33 +197,44 @@ impl<W: Write> Sink for CsvRows<'_, W> {
     }
 }
 
-/// Runs `case`, writing `dir/<name>.csv`. A simulation error is recorded in
-/// the result (the CSV keeps every row before it); I/O errors are returned.
-pub fn run_case(case: &Case, dir: &Path) -> Result<CaseResult> {
+/// Runs `case`, writing `dir/<name>.csv` (under a temporary name until it
+/// is complete). A simulation error is recorded in the result (the CSV keeps
+/// every row before it); so is an interrupt (SIGINT, SIGTERM), which stops
+/// the run after the step it is in. I/O errors are returned, and leave no CSV.
+pub fn run_case(case: &Case, dir: &Path, progress: &ProgressBar) -> Result<CaseResult> {
     let path = dir.join(format!("{}.csv", case.name));
-    let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut csv = BufWriter::new(file);
-    let record = CsvRows::start(&mut csv, &case.example)
-        .and_then(|rows| simulate(case, Recorder::example(&case.example).keep_series(true).sink(rows)));
-    csv.flush().with_context(|| format!("cannot write {}", path.display()))?;
+    let mut file = AtomicFile::create(&path)?;
+    let record = CsvRows::start(file.writer(), &case.example).and_then(|rows| {
+        let recorder = Recorder::example(&case.example).keep_series(true).sink(rows);
+        simulate(case, recorder, Watch::Interrupts(progress))
+    });
     let record = record.with_context(|| format!("cannot write {}", path.display()))?;
+    file.commit()?;
     Ok(CaseResult::new(case, record))
 }
 
 /// Runs `case` keeping only its statistics (for sweeps).
 pub fn run_case_quietly(case: &Case) -> CaseResult {
-    let Ok(record) = simulate(case, Recorder::example(&case.example));
+    let Ok(record) = simulate(case, Recorder::example(&case.example), Watch::Nothing);
     CaseResult::new(case, record)
+}
+
+/// Whether a run stops when an interrupt was asked for, and shows its progress.
+#[derive(Clone, Copy)]
+enum Watch<'p> {
+    Nothing,
+    Interrupts(&'p ProgressBar),
 }
 
 /// Runs `case` into `recorder`; an error of the simulation, also one
 /// starting it, is kept in the record, an error of the sink returned.
-fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<(Record, Method), K::Error> {
+fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch<'_>) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
-            let record = recorder.run(&mut sim, case.t_end, case.every)?;
+            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch)?;
             let method = Method {
+                interrupted,
                 control: Some(sim.settings().control),
                 tuning: Some(*sim.tuning()),
                 projection_iterations_per_step: sim
@@ -168,4 +248,53 @@ fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>) -> Result<(Record, 
         }
         Err(e) => Ok((recorder.abandon(e), Method::default())),
     }
+}
+
+/// [`Recorder::run`], step by step so that an interrupt stops the run
+/// between two steps: the state it stopped at is sampled too (a complete
+/// CSV row), and the record says it was interrupted.
+fn drive<S: System, K: Sink>(
+    sim: &mut Stepper<S>,
+    mut recorder: Recorder<'_, K>,
+    t_end: f64,
+    every: u64,
+    watch: Watch<'_>,
+) -> Result<(Record, bool), K::Error> {
+    let steps = match steps_to(t_end, sim.settings().h) {
+        Ok(n) => n,
+        Err(e) => return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false)),
+    };
+    let every = every.max(1);
+    // Where this case's steps start on a bar shared by several cases.
+    let start = match watch {
+        Watch::Interrupts(progress) => progress.position(),
+        Watch::Nothing => 0,
+    };
+    recorder.sample(sim)?;
+    let mut sampled = sim.steps();
+    while sim.steps() < steps {
+        if let Watch::Interrupts(progress) = watch
+            && sim.steps().is_multiple_of(progress::STEPS_PER_TICK)
+        {
+            progress.set_position(start + sim.steps());
+        }
+        if matches!(watch, Watch::Interrupts(_)) && interrupt::requested().is_some() {
+            if sampled != sim.steps() {
+                recorder.sample(sim)?;
+            }
+            return Ok((recorder.finish(sim), true));
+        }
+        if let Err(e) = sim.step() {
+            return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false));
+        }
+        let n = sim.steps();
+        if n.is_multiple_of(every) || n == steps {
+            recorder.sample(sim)?;
+            sampled = n;
+        }
+    }
+    if let Watch::Interrupts(progress) = watch {
+        progress.set_position(start + steps);
+    }
+    Ok((recorder.finish(sim), false))
 }

@@ -94,7 +94,7 @@ pub struct OutputSpec {
 /// Reads and checks a scenario file.
 pub fn load(path: &Path) -> Result<Scenario> {
     let file = path.display();
-    let text = std::fs::read_to_string(path).map_err(|e| anyhow!("{file}: cannot read: {e}"))?;
+    let text = read_bounded(path)?;
     if text.trim().is_empty() {
         bail!("{file}: the scenario is empty");
     }
@@ -112,6 +112,25 @@ pub fn load(path: &Path) -> Result<Scenario> {
         let place = locate(&[], &table, e.path());
         anyhow!("{file}: {place}{}", reason(e.inner()))
     })
+}
+
+/// Largest scenario file read: scenarios are a few kilobytes, and reading
+/// stops here, so that a wrong path (`/dev/zero`, a data file) is refused at
+/// once instead of filling the memory.
+pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
+
+/// The text of the scenario file at `path`, at most [`MAX_SCENARIO_BYTES`].
+fn read_bounded(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let file = path.display();
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(|e| anyhow!("{file}: cannot read: {e}"))?;
+    if bytes.len() as u64 > MAX_SCENARIO_BYTES {
+        bail!("{file}: larger than {} MB, not a scenario (a scenario is a small TOML file)", MAX_SCENARIO_BYTES >> 20);
+    }
+    String::from_utf8(bytes).map_err(|e| anyhow!("{file}: not UTF-8 text (byte {})", e.utf8_error().valid_up_to()))
 }
 
 /// A deserialization error's message on one line, without the backticks

@@ -204,7 +204,16 @@ fn model(name: String, path: PathBuf, light: bool) -> Result<Model> {
 pub fn run(extra: &[PathBuf], light: bool) -> Result<Suite> {
     let models = models(extra, light)?;
     let start = Instant::now();
-    let groups: Vec<Vec<Group>> = models.par_iter().map(run_model).collect::<Result<_>>()?;
+    let bar = crate::progress::bar(models.len() as u64, "models");
+    let groups: Vec<Vec<Group>> = models
+        .par_iter()
+        .map(|m| {
+            let groups = run_model(m);
+            bar.inc(1);
+            groups
+        })
+        .collect::<Result<_>>()?;
+    bar.finish_and_clear();
     print(&format!("suite: {} models in {:.1} s\n", models.len(), start.elapsed().as_secs_f64()))?;
     Ok(Suite { light, groups: groups.into_iter().flatten().collect() })
 }
