@@ -168,10 +168,10 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Sweep { scenario, out, shard, threads } => {
-            let parsed = scenario::load(&scenario)?;
+            let (parsed, table) = scenario::load_with_table(&scenario)?;
             let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
             let threads = sweep::worker_threads(threads)?;
-            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out)
+            write_sweep(&sweep::run(&parsed, &table, &scenario, shard, threads)?, &out)
         }
         Command::Merge { parts, out } => {
             let parts = parts

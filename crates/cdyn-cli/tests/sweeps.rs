@@ -1,0 +1,106 @@
+//! Sweeps by content and at scale: `cdyn merge` identifies a sweep by a hash
+//! of its parsed scenario (not the path it was given by), a large grid prints
+//! a short summary, and mutated examples never panic or run with an ignored key.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const GRID: &str = r#"
+[model]
+kind = "pendulum"
+[method]
+geometric = "cvsgf"
+alpha_g = 40.0
+apply = "forward_euler"
+[integrator]
+scheme = "ab3"
+h = 0.01
+t_end = 1.0
+[sweep]
+alpha_g = [10.0, 40.0, 160.0]
+h = [0.01, 0.02]
+"#;
+
+fn cdyn_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cdyn")).current_dir(dir).args(args).output().unwrap()
+}
+
+fn ok(o: &Output) -> String {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.stderr.is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The one error line of a failed command.
+fn one_error_line(o: &Output) -> String {
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    err
+}
+
+fn sweep_json(dir: &Path, out: &str) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join(out).join("sweep.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn merge_accepts_the_same_file_by_any_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("grid.toml"), GRID).unwrap();
+    ok(&cdyn_in(d, &["sweep", "grid.toml", "--out", "one"]));
+    let absolute = d.join("grid.toml").display().to_string();
+    for (i, path) in ["grid.toml", "./grid.toml", absolute.as_str()].iter().enumerate() {
+        ok(&cdyn_in(d, &["sweep", path, "--shard", &format!("{i}/3"), "--out", &format!("part{i}")]));
+    }
+    let hashes: Vec<serde_json::Value> =
+        (0..3).map(|i| sweep_json(d, &format!("part{i}"))["scenario_hash"].clone()).collect();
+    assert!(hashes[0].as_str().is_some_and(|h| h.len() == 32), "{hashes:?}");
+    assert!(hashes.iter().all(|h| *h == hashes[0]), "{hashes:?}");
+    ok(&cdyn_in(d, &["merge", "part0", "part1", "part2", "--out", "merged"]));
+    assert_eq!(
+        std::fs::read(d.join("merged/sweep.json")).unwrap(),
+        std::fs::read(d.join("one/sweep.json")).unwrap(),
+        "shards given by other paths do not merge into the single run"
+    );
+}
+
+#[test]
+fn the_hash_follows_content_not_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Tables reordered, a comment added, 1.0 written as 1: the same scenario.
+    let (head, grid) = GRID.split_once("[sweep]").unwrap();
+    let (before, integrator) = head.split_once("[integrator]").unwrap();
+    let same =
+        format!("# a comment\n[sweep]{grid}[integrator]{}{before}", integrator.replace("t_end = 1.0", "t_end = 1"));
+    std::fs::write(d.join("a.toml"), GRID).unwrap();
+    std::fs::write(d.join("b.toml"), same).unwrap();
+    ok(&cdyn_in(d, &["sweep", "a.toml", "--shard", "0/2", "--out", "a"]));
+    ok(&cdyn_in(d, &["sweep", "b.toml", "--shard", "1/2", "--out", "b"]));
+    assert_eq!(sweep_json(d, "a")["scenario_hash"], sweep_json(d, "b")["scenario_hash"]);
+    ok(&cdyn_in(d, &["merge", "a", "b", "--out", "ab"]));
+    assert_eq!(sweep_json(d, "ab")["points"].as_array().unwrap().len(), 6);
+}
+
+#[test]
+fn merge_refuses_shards_of_an_edited_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (what, edited) in [
+        ("scheme", GRID.replace("scheme = \"ab3\"", "scheme = \"rk4\"")),
+        ("t_end", GRID.replace("t_end = 1.0", "t_end = 0.5")),
+        ("a gain", GRID.replace("alpha_g = 40.0", "alpha_g = 20.0")),
+    ] {
+        // The same path for both shards: the file was edited between them.
+        std::fs::write(d.join("grid.toml"), GRID).unwrap();
+        ok(&cdyn_in(d, &["sweep", "grid.toml", "--shard", "0/2", "--out", "p0"]));
+        std::fs::write(d.join("grid.toml"), &edited).unwrap();
+        ok(&cdyn_in(d, &["sweep", "grid.toml", "--shard", "1/2", "--out", "p1"]));
+        let o = cdyn_in(d, &["merge", "p0", "p1", "--out", "bad"]);
+        let err = one_error_line(&o);
+        assert!(err.contains("different sweeps") && err.contains("scenario_hash"), "{what}: {err}");
+        assert!(!d.join("bad/sweep.json").exists(), "{what}: a refused merge wrote output");
+    }
+}
