@@ -73,6 +73,8 @@ enum Command {
         /// Worker threads (default: one per core). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        #[command(flatten)]
+        listing: ListingArgs,
     },
     /// Join the sweep.json files of the shards of one sweep into the complete result.
     Merge {
@@ -82,6 +84,8 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        listing: ListingArgs,
     },
     /// Judge every method of `cdyn compare` on many models (examples/suite and any given) at AB-3 and RK-4,
     /// h and h/2, against a fine reference; writes suite.json and suite.png. Misses of its checks are reported, not fatal.
@@ -105,6 +109,27 @@ enum Command {
     },
 }
 
+/// How much of a sweep's table `sweep` and `merge` print.
+#[derive(clap::Args)]
+struct ListingArgs {
+    /// Print no table, only the summary line.
+    #[arg(long, conflicts_with = "all")]
+    quiet: bool,
+    /// Print every point, also above 1000 points (where the best 20 are printed by default).
+    #[arg(long)]
+    all: bool,
+}
+
+impl ListingArgs {
+    fn listing(&self) -> sweep::Listing {
+        match (self.quiet, self.all) {
+            (true, _) => sweep::Listing::Summary,
+            (false, true) => sweep::Listing::All,
+            (false, false) => sweep::Listing::Default,
+        }
+    }
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
@@ -119,12 +144,15 @@ fn output_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
 }
 
-/// Writes a sweep's (or merged sweep's) `sweep.json` and heat maps into `out` and prints its table.
-fn write_sweep(result: &sweep::Sweep, out: &Path) -> Result<()> {
+/// Writes a sweep's (or merged sweep's) `sweep.json` and heat maps into `out` and prints its table
+/// (the summary line alone with `--quiet`).
+fn write_sweep(result: &sweep::Sweep, out: &Path, listing: sweep::Listing) -> Result<()> {
     output_dir(out)?;
     sweep::write(result, out)?;
-    print(&sweep::table(result))?;
-    print(&format!("wrote {}\n", out.join("sweep.json").display()))?;
+    print(&sweep::listing(result, listing))?;
+    if listing != sweep::Listing::Summary {
+        print(&format!("wrote {}\n", out.join("sweep.json").display()))?;
+    }
     Ok(())
 }
 
@@ -167,13 +195,13 @@ fn run(cli: Cli) -> Result<()> {
             print(&format!("wrote {}\n", path.display()))?;
             Ok(())
         }
-        Command::Sweep { scenario, out, shard, threads } => {
+        Command::Sweep { scenario, out, shard, threads, listing } => {
             let (parsed, table) = scenario::load_with_table(&scenario)?;
             let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
             let threads = sweep::worker_threads(threads)?;
-            write_sweep(&sweep::run(&parsed, &table, &scenario, shard, threads)?, &out)
+            write_sweep(&sweep::run(&parsed, &table, &scenario, shard, threads)?, &out, listing.listing())
         }
-        Command::Merge { parts, out } => {
+        Command::Merge { parts, out, listing } => {
             let parts = parts
                 .iter()
                 .map(|p| {
@@ -183,7 +211,7 @@ fn run(cli: Cli) -> Result<()> {
                     serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            write_sweep(&sweep::merge(parts)?, &out)
+            write_sweep(&sweep::merge(parts)?, &out, listing.listing())
         }
         Command::Compare { scenario, out } => {
             let parsed = scenario::load(&scenario)?;

@@ -104,3 +104,80 @@ fn merge_refuses_shards_of_an_edited_scenario() {
         assert!(!d.join("bad/sweep.json").exists(), "{what}: a refused merge wrote output");
     }
 }
+
+/// A grid of `na × nb` points with two steps per run.
+fn big_grid(na: usize, nb: usize) -> String {
+    let list = |n: usize, base: f64| (0..n).map(|i| format!("{:.1}", base + i as f64)).collect::<Vec<_>>().join(", ");
+    format!(
+        "[model]\nkind = \"pendulum\"\n[method]\ngeometric = \"cvsgf\"\nalpha_g = 40.0\nenergy = \"gradient\"\nalpha_e = 40.0\napply = \"forward_euler\"\n[integrator]\nscheme = \"ab3\"\nh = 0.01\nt_end = 0.02\n[sweep]\nalpha_g = [{}]\nalpha_e = [{}]\n",
+        list(na, 1.0),
+        list(nb, 1.0)
+    )
+}
+
+fn count(text: &str, needle: &str) -> usize {
+    text.matches(needle).count()
+}
+
+/// Values printed in the cells of a heat map's SVG: text `d.dde±x` (the
+/// colour bar's labels have one decimal, the axes' none in exponent form here).
+fn cell_labels(svg: &str) -> usize {
+    svg.split('>')
+        .skip(1)
+        .filter(|t| {
+            let b = t.trim_start().as_bytes();
+            b.len() > 5
+                && b[0].is_ascii_digit()
+                && b[1] == b'.'
+                && b[2].is_ascii_digit()
+                && b[3].is_ascii_digit()
+                && b[4] == b'e'
+        })
+        .count()
+}
+
+#[test]
+fn a_large_sweep_prints_its_best_points_and_quiet_prints_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("big.toml"), big_grid(77, 13)).unwrap(); // 1001 points
+    let out = ok(&cdyn_in(d, &["sweep", "big.toml", "--out", "big"]));
+    let lines: Vec<&str> = out.lines().collect();
+    // Header, the 20 best, the line saying so, the summary, where it wrote.
+    assert_eq!(lines.len(), 24, "{out}");
+    assert!(lines[21].contains("20 best of 1001 points") && lines[21].contains("--all"), "{out}");
+    assert!(lines[22].starts_with("1001 points, 0 failed; best max|err|"), "{out}");
+    // The rows are the best by the error against the reference, in order.
+    let err: Vec<f64> = lines[1..21].iter().map(|l| l.split_whitespace().nth(4).unwrap().parse().unwrap()).collect();
+    assert!(err.windows(2).all(|w| w[0] <= w[1]), "{err:?}");
+    let doc = sweep_json(d, "big");
+    let all: Vec<f64> = doc["points"].as_array().unwrap().iter().map(|p| p["max_abs_err"].as_f64().unwrap()).collect();
+    assert_eq!(all.len(), 1001);
+    let min = all.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!((err[0] - min).abs() <= 1e-3 * min, "{} vs {min}", err[0]);
+
+    let quiet = ok(&cdyn_in(d, &["sweep", "big.toml", "--out", "big", "--quiet"]));
+    assert_eq!(quiet.lines().count(), 1, "{quiet}");
+    assert_eq!(quiet, lines[22].to_string() + "\n");
+    let every = ok(&cdyn_in(d, &["sweep", "big.toml", "--out", "big", "--all"]));
+    assert_eq!(every.lines().count(), 1 + 1001 + 2, "--all");
+    let merged = ok(&cdyn_in(d, &["merge", "big", "--out", "merged", "--quiet"]));
+    assert_eq!(merged, quiet, "merge --quiet");
+    let o = cdyn_in(d, &["sweep", "big.toml", "--out", "big", "--quiet", "--all"]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--quiet"));
+
+    // Cells of a 77 × 13 map are a few pixels wide: no values printed in
+    // them (a small map prints one per cell); both get a colour bar.
+    std::fs::write(d.join("small.toml"), big_grid(3, 2)).unwrap();
+    let small_out = ok(&cdyn_in(d, &["sweep", "small.toml", "--out", "small"]));
+    assert_eq!(small_out.lines().count(), 1 + 6 + 2, "{small_out}");
+    let (big_svg, small_svg) = (
+        std::fs::read_to_string(d.join("big/heat_phi.svg")).unwrap(),
+        std::fs::read_to_string(d.join("small/heat_phi.svg")).unwrap(),
+    );
+    assert_eq!(cell_labels(&big_svg), 0, "cell labels on a 77 × 13 map");
+    assert_eq!(cell_labels(&small_svg), 6, "a 3 × 2 map labels each cell");
+    for svg in [&big_svg, &small_svg] {
+        assert!(count(svg, "<rect") >= 100, "no colour bar: {} rectangles", count(svg, "<rect"));
+    }
+}
