@@ -44,7 +44,7 @@ const MAX_AXIS_LABELS: usize = 20;
 fn axis_label(at: f64, values: &[f64], fmt: &dyn Fn(f64) -> String) -> String {
     let i = at.floor() as usize;
     let every = values.len().div_ceil(MAX_AXIS_LABELS).max(1);
-    if (at - i as f64 - 0.5).abs() < 1e-9 && i < values.len() && i % every == 0 {
+    if (at - i as f64 - 0.5).abs() < 1e-9 && i < values.len() && i.is_multiple_of(every) {
         fmt(values[i])
     } else {
         String::new()
