@@ -181,3 +181,35 @@ fn a_large_sweep_prints_its_best_points_and_quiet_prints_one_line() {
         assert!(count(svg, "<rect") >= 100, "no colour bar: {} rectangles", count(svg, "<rect"));
     }
 }
+
+/// The shipped example directory.
+fn examples() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
+}
+
+/// `max_abs_psi` and `max_abs_err_x` of the run of `scenario` (text).
+fn psi_and_err(d: &Path, name: &str, scenario: &str) -> (f64, f64) {
+    std::fs::write(d.join(format!("{name}.toml")), scenario).unwrap();
+    ok(&cdyn_in(d, &["run", &format!("{name}.toml"), "--out", name]));
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join(name).join("summary.json")).unwrap()).unwrap();
+    let case = &doc["cases"][0];
+    (case["max_abs_psi"].as_f64().unwrap(), case["max_abs_err_x"].as_f64().unwrap())
+}
+
+#[test]
+fn theta_energy_is_better_with_its_energy_control() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = std::fs::read_to_string(examples().join("theta_energy.toml")).unwrap();
+    assert!(text.contains("with energy control") && text.contains("energy = \"gradient\""), "{text}");
+    let without: String = text
+        .lines()
+        .filter(|l| !l.starts_with("energy") && !l.starts_with("alpha_e"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let (psi_with, err_with) = psi_and_err(d, "with", &text);
+    let (psi_without, err_without) = psi_and_err(d, "without", &without);
+    assert!(psi_with < 0.7 * psi_without, "max|Ψ| {psi_with:e} with energy control, {psi_without:e} without");
+    assert!(err_with < err_without, "max|err_x| {err_with:e} with energy control, {err_without:e} without");
+}
