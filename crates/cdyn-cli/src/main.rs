@@ -208,7 +208,15 @@ fn run(cli: Cli) -> Result<()> {
                     let file = if p.is_dir() { p.join("sweep.json") } else { p.clone() };
                     let text =
                         std::fs::read_to_string(&file).with_context(|| format!("cannot read {}", file.display()))?;
-                    serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
+                    let doc: serde_json::Value = serde_json::from_str(&text)
+                        .with_context(|| format!("{}: not a sweep.json", file.display()))?;
+                    if doc.get("points").is_some() && doc.get("scenario_hash").is_none() {
+                        bail!(
+                            "{}: no scenario_hash (written by an older cdyn, which merged by path); run that shard again",
+                            file.display()
+                        );
+                    }
+                    serde_json::from_value(doc).with_context(|| format!("{}: not a sweep.json", file.display()))
                 })
                 .collect::<Result<Vec<_>>>()?;
             write_sweep(&sweep::merge(parts)?, &out, listing.listing())

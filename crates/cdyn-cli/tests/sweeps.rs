@@ -103,6 +103,13 @@ fn merge_refuses_shards_of_an_edited_scenario() {
         assert!(err.contains("different sweeps") && err.contains("scenario_hash"), "{what}: {err}");
         assert!(!d.join("bad/sweep.json").exists(), "{what}: a refused merge wrote output");
     }
+    // A shard written before sweeps were identified by content cannot be checked: refused, saying why.
+    let path = d.join("p1/sweep.json");
+    let mut old: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    old.as_object_mut().unwrap().remove("scenario_hash");
+    std::fs::write(&path, serde_json::to_string_pretty(&old).unwrap()).unwrap();
+    let err = one_error_line(&cdyn_in(d, &["merge", "p0", "p1", "--out", "bad"]));
+    assert!(err.contains("p1/sweep.json: no scenario_hash"), "{err}");
 }
 
 /// A grid of `na × nb` points with two steps per run.
