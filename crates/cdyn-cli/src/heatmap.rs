@@ -1,8 +1,9 @@
-//! Heat maps of a sweep: one coloured cell per grid point of two axes, the
-//! value printed in the cell (log colour scale; grey where the run failed).
+//! Heat maps of a sweep: one coloured cell per grid point of two axes, a
+//! colour bar for the log scale, the value printed in the cell while cells
+//! are large enough to hold it (grey where the run failed).
 
-use crate::plot::{ensure_font, with_ext};
-use anyhow::{Context, Result};
+use crate::plot::write_drawing;
+use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -19,12 +20,57 @@ pub struct HeatMap<'a> {
 
 /// Writes `<stem>.png` and `<stem>.svg`.
 pub fn write_heatmap(stem: &Path, map: &HeatMap) -> Result<()> {
-    ensure_font()?;
-    let (png, svg) = (with_ext(stem, "png"), with_ext(stem, "svg"));
-    draw(BitMapBackend::new(&png, (1000, 800)).into_drawing_area(), map)
-        .with_context(|| format!("writing figure {}", png.display()))?;
-    draw(SVGBackend::new(&svg, (1000, 800)).into_drawing_area(), map)
-        .with_context(|| format!("writing figure {}", svg.display()))
+    write_drawing(stem, (1000, 800), |area| draw(area, map), |area| draw(area, map))
+}
+
+/// Pixels kept on the right for the colour bar and its labels.
+const COLOUR_BAR_WIDTH: u32 = 150;
+
+/// Cells narrower or lower than this many pixels do not get their value
+/// printed: the text would overlap its neighbours (a 100 × 100 grid); the
+/// colour bar reads them instead.
+const MIN_LABELLED_CELL: usize = 24;
+
+/// At most this many values labelled along an axis, so a long axis stays readable.
+const MAX_AXIS_LABELS: usize = 20;
+
+/// The label at `at` (a cell centre, `i + 0.5`) of an axis with `values`:
+/// every cell's value on a short axis, every k-th on a long one.
+fn axis_label(at: f64, values: &[f64], fmt: &dyn Fn(f64) -> String) -> String {
+    let i = at.floor() as usize;
+    let every = values.len().div_ceil(MAX_AXIS_LABELS).max(1);
+    if (at - i as f64 - 0.5).abs() < 1e-9 && i < values.len() && i.is_multiple_of(every) {
+        fmt(values[i])
+    } else {
+        String::new()
+    }
+}
+
+/// The colour scale: log10 from `lo` to `hi`, labelled with the values.
+fn colour_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, lo: f64, hi: f64) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(68)
+        .margin_bottom(80)
+        .margin_right(10)
+        .y_label_area_size(90)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(8)
+        .y_label_formatter(&|v| format!("{:.1e}", 10f64.powf(*v)))
+        .label_style(("sans-serif", 16))
+        .draw()?;
+    const STEPS: usize = 100;
+    let step = (hi - lo) / STEPS as f64;
+    bar.draw_series((0..STEPS).map(|k| {
+        let y = lo + k as f64 * step;
+        Rectangle::new([(0.0, y), (1.0, y + step)], colour(k as f64 / (STEPS - 1) as f64).filled())
+    }))?;
+    Ok(())
 }
 
 /// Blue (small) to red (large) on log10 of the value.
@@ -43,6 +89,11 @@ where
         map.z.iter().flatten().flatten().filter(|v| **v > 0.0 && v.is_finite()).map(|v| v.log10()).collect();
     let (lo, hi) = logs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
     let span = if hi > lo { hi - lo } else { 1.0 };
+    let (width, _) = root.dim_in_pixel();
+    let (root, bar) = root.split_horizontally(width.saturating_sub(COLOUR_BAR_WIDTH));
+    if lo.is_finite() {
+        colour_bar(&bar, lo, lo + span)?;
+    }
     let mut chart = ChartBuilder::on(&root)
         .caption(map.title, ("sans-serif", 28))
         .margin(20)
@@ -58,17 +109,16 @@ where
         .y_desc(map.y_label)
         .x_labels(nx * 2 + 1)
         .y_labels(ny * 2 + 1)
-        .x_label_formatter(&|x| {
-            let i = x.floor() as usize;
-            if (x - i as f64 - 0.5).abs() < 1e-9 && i < xs.len() { fmt(xs[i]) } else { String::new() }
-        })
-        .y_label_formatter(&|y| {
-            let i = y.floor() as usize;
-            if (y - i as f64 - 0.5).abs() < 1e-9 && i < ys.len() { fmt(ys[i]) } else { String::new() }
-        })
+        .x_label_formatter(&|x| axis_label(*x, &xs, &fmt))
+        .y_label_formatter(&|y| axis_label(*y, &ys, &fmt))
         .label_style(("sans-serif", 18))
         .axis_desc_style(("sans-serif", 20))
         .draw()?;
+    let (cell_w, cell_h) = {
+        let (w, h) = chart.plotting_area().dim_in_pixel();
+        (w as usize / nx.max(1), h as usize / ny.max(1))
+    };
+    let labelled = cell_w >= MIN_LABELLED_CELL && cell_h >= MIN_LABELLED_CELL;
     for (iy, row) in map.z.iter().enumerate() {
         for (ix, value) in row.iter().enumerate() {
             let (x, y) = (ix as f64, iy as f64);
@@ -78,6 +128,9 @@ where
                 None => (RGBColor(160, 160, 160), "failed".to_string()),
             };
             chart.draw_series(std::iter::once(Rectangle::new([(x, y), (x + 1.0, y + 1.0)], fill.filled())))?;
+            if !labelled {
+                continue;
+            }
             chart.draw_series(std::iter::once(Text::new(
                 text,
                 (x + 0.5, y + 0.5),

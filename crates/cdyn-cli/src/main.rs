@@ -79,6 +79,8 @@ enum Command {
         /// Worker threads (default: one per core). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        #[command(flatten)]
+        listing: ListingArgs,
     },
     /// Join the sweep.json files of the shards of one sweep into the complete result.
     Merge {
@@ -88,6 +90,8 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        listing: ListingArgs,
     },
     /// Judge every method of `cdyn compare` on many models (examples/suite and any given) at AB-3 and RK-4,
     /// h and h/2, against a fine reference; writes suite.json and suite.png. Misses of its checks are reported, not fatal.
@@ -112,6 +116,27 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+}
+
+/// How much of a sweep's table `sweep` and `merge` print.
+#[derive(clap::Args)]
+struct ListingArgs {
+    /// Print no table, only the summary line.
+    #[arg(long, conflicts_with = "all")]
+    quiet: bool,
+    /// Print every point, also above 1000 points (where the best 20 are printed by default).
+    #[arg(long)]
+    all: bool,
+}
+
+impl ListingArgs {
+    fn listing(&self) -> sweep::Listing {
+        match (self.quiet, self.all) {
+            (true, _) => sweep::Listing::Summary,
+            (false, true) => sweep::Listing::All,
+            (false, false) => sweep::Listing::Default,
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -160,12 +185,15 @@ fn output_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
 }
 
-/// Writes a sweep's (or merged sweep's) `sweep.json` and heat maps into `out` and prints its table.
-fn write_sweep(result: &sweep::Sweep, out: &Path) -> Result<()> {
+/// Writes a sweep's (or merged sweep's) `sweep.json` and heat maps into `out` and prints its table
+/// (the summary line alone with `--quiet`).
+fn write_sweep(result: &sweep::Sweep, out: &Path, listing: sweep::Listing) -> Result<()> {
     output_dir(out)?;
     sweep::write(result, out)?;
-    print(&sweep::table(result))?;
-    print(&format!("wrote {}\n", out.join("sweep.json").display()))?;
+    print(&sweep::listing(result, listing))?;
+    if listing != sweep::Listing::Summary {
+        print(&format!("wrote {}\n", out.join("sweep.json").display()))?;
+    }
     Ok(())
 }
 
@@ -217,23 +245,32 @@ fn run(cli: Cli) -> Result<Ended> {
             print(&format!("wrote {}\n", path.display()))?;
             Ok(Ended::Done)
         }
-        Command::Sweep { scenario, out, shard, threads } => {
-            let parsed = scenario::load(&scenario)?;
+        Command::Sweep { scenario, out, shard, threads, listing } => {
+            let (parsed, table) = scenario::load_with_table(&scenario)?;
             let shard = shard.as_deref().map(sweep::parse_shard).transpose()?;
             let threads = sweep::worker_threads(threads)?;
-            write_sweep(&sweep::run(&parsed, &scenario, shard, threads)?, &out).map(|()| Ended::Done)
+            write_sweep(&sweep::run(&parsed, &table, &scenario, shard, threads)?, &out, listing.listing())
+                .map(|()| Ended::Done)
         }
-        Command::Merge { parts, out } => {
+        Command::Merge { parts, out, listing } => {
             let parts = parts
                 .iter()
                 .map(|p| {
                     let file = if p.is_dir() { p.join("sweep.json") } else { p.clone() };
                     let text =
                         std::fs::read_to_string(&file).with_context(|| format!("cannot read {}", file.display()))?;
-                    serde_json::from_str(&text).with_context(|| format!("{}: not a sweep.json", file.display()))
+                    let doc: serde_json::Value = serde_json::from_str(&text)
+                        .with_context(|| format!("{}: not a sweep.json", file.display()))?;
+                    if doc.get("points").is_some() && doc.get("scenario_hash").is_none() {
+                        bail!(
+                            "{}: no scenario_hash (written by an older cdyn, which merged by path); run that shard again",
+                            file.display()
+                        );
+                    }
+                    serde_json::from_value(doc).with_context(|| format!("{}: not a sweep.json", file.display()))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            write_sweep(&sweep::merge(parts)?, &out).map(|()| Ended::Done)
+            write_sweep(&sweep::merge(parts)?, &out, listing.listing()).map(|()| Ended::Done)
         }
         Command::Compare { scenario, out, force } => {
             let parsed = scenario::load(&scenario)?;

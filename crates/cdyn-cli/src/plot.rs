@@ -52,26 +52,35 @@ const PALETTE: [u32; 10] =
     [0x1f77b4, 0xff7f0e, 0x2ca02c, 0xd62728, 0x9467bd, 0x8c564b, 0xe377c2, 0x7f7f7f, 0xbcbd22, 0x17becf];
 
 /// Writes `<stem>.png` (1200x800) and `<stem>.svg`. `stem` is a path without extension.
-///
-/// Both are drawn in memory and written atomically ([`crate::output`]), so
-/// a failed write leaves no truncated figure and its message is the I/O
-/// error, not a dump of plotters' error types.
 pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
-    ensure_font()?;
     let data = prepare(fig);
-    let (png, svg) = (with_ext(stem, "png"), with_ext(stem, "svg"));
-    let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    render(BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(), fig, &data)
-        .with_context(|| format!("cannot draw figure {}", png.display()))?;
+    write_drawing(stem, SIZE, |area| render(area, fig, &data), |area| render(area, fig, &data))
+}
+
+/// Writes `<stem>.png` and `<stem>.svg` of `size`, drawn by `png` and `svg`
+/// (the same drawing on each backend). Both are drawn in memory and written
+/// atomically ([`crate::output`]), so a failed write leaves no truncated
+/// figure and its message is the I/O error, not a dump of plotters' error types.
+pub fn write_drawing(
+    stem: &Path,
+    size: (u32, u32),
+    png: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<()>,
+    svg: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
+    ensure_font()?;
+    let (png_path, svg_path) = (with_ext(stem, "png"), with_ext(stem, "svg"));
+    let mut pixels = vec![0u8; (size.0 * size.1 * 3) as usize];
+    png(BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area())
+        .with_context(|| format!("cannot draw figure {}", png_path.display()))?;
     let mut encoded = Vec::new();
     image::codecs::png::PngEncoder::new(&mut encoded)
-        .write_image(&pixels, SIZE.0, SIZE.1, image::ColorType::Rgb8)
-        .map_err(|e| anyhow!("cannot encode figure {}: {e}", png.display()))?;
-    crate::output::write(&png, &encoded)?;
+        .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
+        .map_err(|e| anyhow!("cannot encode figure {}: {e}", png_path.display()))?;
+    crate::output::write(&png_path, &encoded)?;
     let mut text = String::new();
-    render(SVGBackend::with_string(&mut text, SIZE).into_drawing_area(), fig, &data)
-        .with_context(|| format!("cannot draw figure {}", svg.display()))?;
-    crate::output::write(&svg, text.as_bytes())
+    svg(SVGBackend::with_string(&mut text, size).into_drawing_area())
+        .with_context(|| format!("cannot draw figure {}", svg_path.display()))?;
+    crate::output::write(&svg_path, text.as_bytes())
 }
 
 /// Registers the shipped font once; every figure needs it (there are no system fonts).

@@ -93,6 +93,12 @@ pub struct OutputSpec {
 
 /// Reads and checks a scenario file.
 pub fn load(path: &Path) -> Result<Scenario> {
+    load_with_table(path).map(|(scenario, _)| scenario)
+}
+
+/// Reads and checks a scenario file; also returns the parsed table, which
+/// identifies the scenario by content (`cdyn merge`), whatever its path.
+pub fn load_with_table(path: &Path) -> Result<(Scenario, toml::Table)> {
     let file = path.display();
     let text = read_bounded(path)?;
     if text.trim().is_empty() {
@@ -108,10 +114,11 @@ pub fn load(path: &Path) -> Result<Scenario> {
     })?;
     // The library's types check every key; the path to a refused one names
     // the table, entry and key as the file writes them.
-    serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
+    let scenario = serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
         let place = locate(&[], &table, e.path());
         anyhow!("{file}: {place}{}", reason(e.inner()))
-    })
+    })?;
+    Ok((scenario, table))
 }
 
 /// Largest scenario file read: scenarios are a few kilobytes, and reading

@@ -438,9 +438,7 @@ impl Suite {
 pub fn write(suite: &Suite, dir: &Path) -> Result<()> {
     crate::suite_plot::write(suite, dir)?;
     let text = serde_json::to_string_pretty(&suite.json())? + "\n";
-    let (part, path) = (dir.join(".suite.json.part"), dir.join("suite.json"));
-    std::fs::write(&part, text).with_context(|| format!("cannot write {}", part.display()))?;
-    std::fs::rename(&part, &path).with_context(|| format!("cannot write {}", path.display()))
+    crate::output::write(&dir.join("suite.json"), text.as_bytes())
 }
 
 /// A number for the table: scientific, `inf` or `-`.

@@ -3,9 +3,9 @@
 //! (dots) and to `projection` (squares) on a log axis, one colour per
 //! scheme and step. A run that stopped is a cross at the right edge.
 
-use crate::plot::{ensure_font, with_ext};
+use crate::plot::write_drawing;
 use crate::suite::{Group, Suite};
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -20,20 +20,10 @@ const LEGEND: u32 = 60;
 /// Writes `dir/suite.png` and `dir/suite.svg`, each under a temporary name
 /// first, so a failure leaves no half-drawn figure.
 pub fn write(suite: &Suite, dir: &Path) -> Result<()> {
-    ensure_font()?;
     let models = panels(&suite.groups);
     let rows = models.len().div_ceil(COLUMNS).max(1);
     let size = (PANEL.0 * COLUMNS.min(models.len()).max(1) as u32, TITLE + PANEL.1 * rows as u32 + LEGEND);
-    for ext in ["png", "svg"] {
-        let (part, path) = (with_ext(&dir.join(".suite.part"), ext), with_ext(&dir.join("suite"), ext));
-        let drawn = match ext {
-            "png" => draw(BitMapBackend::new(&part, size).into_drawing_area(), &models),
-            _ => draw(SVGBackend::new(&part, size).into_drawing_area(), &models),
-        };
-        drawn.with_context(|| format!("writing figure {}", part.display()))?;
-        std::fs::rename(&part, &path).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
+    write_drawing(&dir.join("suite"), size, |area| draw(area, &models), |area| draw(area, &models))
 }
 
 /// The groups of each model, models in the order they ran.
