@@ -172,7 +172,7 @@ fn ended(results: &[runner::CaseResult], out: &Path) -> Result<Ended> {
                 "interrupted by {} at step {} (t = {}) of case {}; the output up to there is in {}",
                 interrupt::name(signal),
                 r.record.steps,
-                r.record.t_final,
+                cdyn::error::Time(r.record.t_final),
                 r.name,
                 out.display()
             ),
@@ -182,6 +182,9 @@ fn ended(results: &[runner::CaseResult], out: &Path) -> Result<Ended> {
 }
 
 fn output_dir(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("--out {} is a file, not a directory", dir.display());
+    }
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
 }
 

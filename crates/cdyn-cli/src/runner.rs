@@ -185,7 +185,7 @@ impl<'w, W: Write> CsvRows<'w, W> {
 impl<W: Write> Sink for CsvRows<'_, W> {
     type Error = std::io::Error;
     fn sample(&mut self, s: &Sample<'_>) -> std::io::Result<()> {
-        write!(self.out, "{:e}", s.t)?;
+        write!(self.out, "{:e}", cdyn::error::tidy_time(s.t))?;
         for o in s.observables {
             write!(self.out, ",{o:e}")?;
         }

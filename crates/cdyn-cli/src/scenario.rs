@@ -342,7 +342,12 @@ impl Scenario {
                 let gravity = match m.gravity {
                     None => [0.0, 0.0],
                     Some(GravitySpec::Vector(g)) if g.iter().all(|x| x.is_finite()) => g,
-                    Some(g) => bail!("{file}: [model] gravity = {g:?}: a mechanism takes a finite vector [gx, gy]"),
+                    Some(GravitySpec::Vector([gx, gy])) => {
+                        bail!("{file}: [model] gravity = [{gx}, {gy}]: a mechanism takes a finite vector [gx, gy]")
+                    }
+                    Some(GravitySpec::Magnitude(g)) => {
+                        bail!("{file}: [model] gravity = {g}: a mechanism takes a finite vector [gx, gy]")
+                    }
                 };
                 if self.bodies.is_empty() {
                     bail!("{file}: a mechanism needs at least one [[bodies]] entry");

@@ -249,3 +249,36 @@ fn infinities_are_written_as_strings_and_read_back() {
     let line = one_error_line(&o);
     assert!(line.contains("sweep.json") && line.contains("huge"), "{line}");
 }
+
+#[test]
+fn messages_show_values_and_times_as_people_write_them() {
+    // A non-finite gravity vector: the values, not a debug dump of the type.
+    let text = "[model]\nkind = \"mechanism\"\ngravity = [nan, -9.81]\n[integrator]\nscheme = \"rk4\"\nh = 0.01\n\
+                t_end = 1.0\n[[bodies]]\nname = \"a\"\nmass = 1.0\ninertia = 0.1\nposition = [1.0, 0.0]\n";
+    let (dir, path) = scenario("g.toml", text);
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("gravity = [NaN, -9.81]") && !line.contains("Vector"), "{line}");
+
+    // A huge step: the time with an exponent, not 309 digits.
+    let text = "[model]\nkind = \"pendulum\"\n[integrator]\nscheme = \"rk4\"\nh = 1e308\nt_end = 1e308\n";
+    let (dir, path) = scenario("big.toml", text);
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("t = 1e308") && line.len() < 200, "{line}");
+
+    // `--out` naming a file.
+    let file = dir.join("a_file");
+    std::fs::write(&file, "").unwrap();
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&file)]));
+    assert!(line.contains("is a file, not a directory"), "{line}");
+
+    // 3 steps of 0.1 end at 0.3, in the summary and the CSV's last row.
+    let text = "[model]\nkind = \"pendulum\"\n[integrator]\nscheme = \"rk4\"\nh = 0.1\nt_end = 0.3\n";
+    let (dir, path) = scenario("t03.toml", text);
+    let out = cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["cases"][0]["t_final"].as_f64(), Some(0.3), "{summary}");
+    let csv = std::fs::read_to_string(dir.join("out/t03.csv")).unwrap();
+    assert!(csv.lines().last().unwrap().starts_with("3e-1,"), "{csv}");
+}

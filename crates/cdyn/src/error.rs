@@ -39,7 +39,7 @@ pub enum Error {
     },
     /// `Φ_q M⁻¹ Φ_qᵀ` is singular: the constraints are redundant or degenerate here.
     #[error(
-        "singular constraint matrix at step {step}, t = {t}: constraint row {row} is linearly dependent on the others"
+        "singular constraint matrix at step {step}, t = {}: constraint row {row} is linearly dependent on the others", Time(*t)
     )]
     SingularConstraints {
         /// Steps taken before the failure.
@@ -50,7 +50,7 @@ pub enum Error {
         row: usize,
     },
     /// The state stopped being finite.
-    #[error("simulation diverged at step {step}, t = {t}: the state is no longer finite")]
+    #[error("simulation diverged at step {step}, t = {}: the state is no longer finite", Time(*t))]
     Diverged {
         /// Steps taken before the failure.
         step: u64,
@@ -58,7 +58,10 @@ pub enum Error {
         t: f64,
     },
     /// The constraint violation grew past the configured limit.
-    #[error("simulation diverged at step {step}, t = {t}: max |Φ| = {phi:.3e} exceeds the limit {limit:.1e}")]
+    #[error(
+        "simulation diverged at step {step}, t = {}: max |Φ| = {phi:.3e} exceeds the limit {limit:.1e}",
+        Time(*t)
+    )]
     ViolationLimit {
         /// Steps taken before the failure.
         step: u64,
@@ -71,7 +74,8 @@ pub enum Error {
     },
     /// The exact projection (the `projection` method) did not converge.
     #[error(
-        "projection did not converge at step {step}, t = {t}: {invariant} = {residual:.3e}{} after {iterations} Newton iterations (raise max_iterations or tolerance, or set on_failure = \"continue\")",
+        "projection did not converge at step {step}, t = {}: {invariant} = {residual:.3e}{} after {iterations} Newton iterations (raise max_iterations or tolerance, or set on_failure = \"continue\")",
+        Time(*t),
         row.map_or(String::new(), |r| format!(" in constraint row {r}"))
     )]
     ProjectionFailed {
@@ -365,6 +369,24 @@ impl From<Problem> for Error {
     }
 }
 
+/// A time as people write it: `step · h` rounded to 12 significant digits
+/// (`0.3`, not the `0.30000000000000004` of `3 × 0.1`), far below any step.
+pub fn tidy_time(t: f64) -> f64 {
+    format!("{t:.11e}").parse().unwrap_or(t)
+}
+
+/// A time in a message: [`tidy_time`], in plain decimals between 1e-4 and
+/// 1e9 and with an exponent outside (not 309 digits for 1e308).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Time(pub f64);
+
+impl std::fmt::Display for Time {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = tidy_time(self.0);
+        if t == 0.0 || (1e-4..1e9).contains(&t.abs()) { write!(f, "{t}") } else { write!(f, "{t:e}") }
+    }
+}
+
 /// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
@@ -388,5 +410,19 @@ pub fn non_negative(name: &'static str, value: f64) -> Result<f64> {
         Ok(value)
     } else {
         Err(Error::InvalidParameter { name, value, reason: "must be finite and not negative" })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_print_as_written() {
+        assert_eq!(Time(3.0 * 0.1).to_string(), "0.3");
+        assert_eq!(Time(1e308).to_string(), "1e308");
+        assert_eq!(Time(2.5e-6).to_string(), "2.5e-6");
+        assert_eq!(Time(0.0).to_string(), "0");
+        assert_eq!(Time(4766.0 * 0.001).to_string(), "4.766");
     }
 }

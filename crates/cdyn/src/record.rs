@@ -443,7 +443,8 @@ impl<'a, K: Sink> Recorder<'a, K> {
         }
         Record {
             steps: sim.steps(),
-            t_final: sim.t(),
+            // As people write it (0.3, not 0.30000000000000004).
+            t_final: crate::error::tidy_time(sim.t()),
             evaluations: sim.evaluations(),
             q_end: sim.q().to_vec(),
             v_end: sim.v().to_vec(),

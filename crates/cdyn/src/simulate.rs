@@ -300,8 +300,7 @@ pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
 /// digits so that it prints as a user would write it (`0.11`, not
 /// `0.10999999999999999`); that moves it far less than the tolerance.
 pub fn nearest_valid_t_end(t_end: f64, h: f64) -> f64 {
-    let t = (t_end / h).round().max(1.0) * h;
-    format!("{t:.11e}").parse().unwrap_or(t)
+    crate::error::tidy_time((t_end / h).round().max(1.0) * h)
 }
 
 /// The error of a failed evaluation during step `step` (steps taken before
