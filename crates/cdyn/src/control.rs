@@ -216,6 +216,13 @@ pub(crate) trait Evaluation {
     /// `out += scale · M⁻¹ Φ_qᵀ y`.
     fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]);
 
+    /// `out[k] −= M⁻¹ Φ_qᵀ y[k]` for two pairs, in one pass where the
+    /// storage allows.
+    fn add_weighted_jt_pair(&self, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
+        self.add_weighted_jt(y0, -1.0, out0);
+        self.add_weighted_jt(y1, -1.0, out1);
+    }
+
     /// `Φ_t`.
     fn phi_t(&self) -> &[f64];
 
@@ -483,28 +490,24 @@ impl Control {
             }
         }
         // U_q = −M⁻¹Φ_qᵀ(α_g z_Φ − κc y_w) − κc w
-        if alpha_g.is_some() || kappa_c != 0.0 {
-            if alpha_g.is_none() {
-                z_q.fill(0.0);
-            }
-            if kappa_c != 0.0 {
-                z_q.iter_mut().zip(y_w.iter()).for_each(|(z, y)| *z -= kappa_c * y);
-                u_q.iter_mut().zip(w.iter()).for_each(|(u, w)| *u -= kappa_c * w);
-            }
-            d.add_weighted_jt(z_q, -1.0, u_q);
+        if alpha_g.is_none() {
+            z_q.fill(0.0);
+        }
+        if kappa_c != 0.0 {
+            z_q.iter_mut().zip(y_w.iter()).for_each(|(z, y)| *z -= kappa_c * y);
+            u_q.iter_mut().zip(w.iter()).for_each(|(u, w)| *u -= kappa_c * w);
         }
         // U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v
-        if alpha_v != 0.0 || kappa != 0.0 {
-            if separate_y_v {
-                z_dot.iter_mut().zip(y_v.iter()).for_each(|(z, y)| *z = alpha_v * *z - kappa * y);
-            } else {
-                // y_v is z_Φ̇ itself.
-                z_dot.iter_mut().for_each(|z| *z *= alpha_v - kappa);
-            }
-            if kappa != 0.0 {
-                mass.add_inverse_psi_v(v, -kappa, u_v);
-            }
-            d.add_weighted_jt(z_dot, -1.0, u_v);
+        if separate_y_v {
+            z_dot.iter_mut().zip(y_v.iter()).for_each(|(z, y)| *z = alpha_v * *z - kappa * y);
+        } else {
+            // y_v is z_Φ̇ itself.
+            z_dot.iter_mut().for_each(|z| *z *= alpha_v - kappa);
         }
+        if kappa != 0.0 {
+            mass.add_inverse_psi_v(v, -kappa, u_v);
+        }
+        // Both products in one pass over the Jacobian.
+        d.add_weighted_jt_pair([z_q, z_dot], [u_q, u_v]);
     }
 }

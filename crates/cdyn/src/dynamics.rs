@@ -101,6 +101,29 @@ impl Dynamics {
         }
     }
 
+    /// `out[k] −= M⁻¹ Φ_qᵀ y[k]` for two pairs in one pass over the Jacobian
+    /// (the coupled control terms' two products), each with the arithmetic of
+    /// [`add_weighted_jt`](Self::add_weighted_jt) at scale −1.
+    pub fn add_weighted_jt_pair(&self, model: &Model, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
+        let (pattern, weight, jac) = (model.pattern(), model.mass().inverse(), &self.constraints.jac);
+        assert!(y0.len() == model.m() && y1.len() == model.m(), "vectors of the wrong length");
+        assert!(out0.len() == model.n() && out1.len() == model.n(), "vectors of the wrong length");
+        assert!(jac.len() == pattern.cols.len(), "a Jacobian of another model");
+        // SAFETY: as in `add_weighted_jt`.
+        unsafe {
+            for r in 0..y0.len() {
+                let (s0, s1) = (-*y0.get_unchecked(r), -*y1.get_unchecked(r));
+                let (a, b) = (*pattern.start.get_unchecked(r) as usize, *pattern.start.get_unchecked(r + 1) as usize);
+                for j in a..b {
+                    let c = *pattern.cols.get_unchecked(j) as usize;
+                    let (wc, jv) = (*weight.get_unchecked(c), *jac.get_unchecked(j));
+                    *out0.get_unchecked_mut(c) += s0 * wc * jv;
+                    *out1.get_unchecked_mut(c) += s1 * wc * jv;
+                }
+            }
+        }
+    }
+
     /// `out = Φ_q x` with the Jacobian of the last [`evaluate`](Self::evaluate),
     /// without bounds checks (see [`add_weighted_jt`](Self::add_weighted_jt)).
     pub fn jac_mul(&self, model: &Model, x: &[f64], out: &mut [f64]) {

@@ -237,4 +237,7 @@ impl Evaluation for Evaluated<'_> {
     fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
         self.dynamics.jac_mul(self.model, x, out);
     }
+    fn add_weighted_jt_pair(&self, y: [&[f64]; 2], out: [&mut [f64]; 2]) {
+        self.dynamics.add_weighted_jt_pair(self.model, y, out);
+    }
 }
