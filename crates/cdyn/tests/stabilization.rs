@@ -502,7 +502,7 @@ fn a_projection_that_cannot_converge_stops_by_name_or_is_counted() {
                     assert_eq!((step, t), (sim.steps(), step as f64 * h), "{case}: {e:?}");
                     assert!(iterations <= max_iterations, "{case}: {e:?}");
                     let line = e.to_string();
-                    assert!(line.contains(&format!("step {step}, t = {t}")) && !line.contains('\n'), "{case}: {line}");
+                    X
                 }
                 other => panic!("{case}: {other:?}"),
             }
