@@ -502,7 +502,8 @@ fn a_projection_that_cannot_converge_stops_by_name_or_is_counted() {
                     assert_eq!((step, t), (sim.steps(), step as f64 * h), "{case}: {e:?}");
                     assert!(iterations <= max_iterations, "{case}: {e:?}");
                     let line = e.to_string();
-                    X
+                    let at = format!("step {step}, t = {}", cdyn::error::Time(t));
+                    assert!(line.contains(&at) && !line.contains('\n'), "{case}: {line}");
                 }
                 other => panic!("{case}: {other:?}"),
             }
