@@ -38,11 +38,26 @@ pub struct Scenario {
 }
 
 /// `gravity`: a magnitude for the pendulums, a vector for mechanisms.
-#[derive(Debug, Deserialize, Clone, Copy)]
-#[serde(untagged)]
+#[derive(Debug, Clone, Copy)]
 pub enum GravitySpec {
     Magnitude(f64),
     Vector([f64; 2]),
+}
+
+impl<'de> Deserialize<'de> for GravitySpec {
+    /// Read as a TOML value and matched by hand, so that a wrong one is named
+    /// as the scenario writes it, not as an "untagged enum".
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+        let value = toml::Value::deserialize(d)?;
+        match &value {
+            v if number(v).is_some() => Ok(GravitySpec::Magnitude(number(v).unwrap_or_default())),
+            toml::Value::Array(a) if a.len() == 2 && a.iter().all(|x| number(x).is_some()) => {
+                Ok(GravitySpec::Vector([number(&a[0]).unwrap_or_default(), number(&a[1]).unwrap_or_default()]))
+            }
+            _ => Err(serde::de::Error::custom("expected a magnitude g (pendulums) or a vector [gx, gy] (mechanisms)")),
+        }
+    }
 }
 
 /// `[model]`: the kind and, for the pendulums, their parameters; the other

@@ -258,6 +258,10 @@ fn messages_show_values_and_times_as_people_write_them() {
     let (dir, path) = scenario("g.toml", text);
     let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
     assert!(line.contains("gravity = [NaN, -9.81]") && !line.contains("Vector"), "{line}");
+    let text = text.replace("[nan, -9.81]", "\"down\"");
+    let (dir, path) = scenario("g.toml", &text);
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("expected a magnitude g") && !line.contains("untagged"), "{line}");
 
     // A huge step: the time with an exponent, not 309 digits.
     let text = "[model]\nkind = \"pendulum\"\n[integrator]\nscheme = \"rk4\"\nh = 1e308\nt_end = 1e308\n";
