@@ -4,8 +4,11 @@
 //! JSON. Each test checks the exit code, the one line naming the key, and
 //! what is left on disk.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
+
+mod common;
+use common::{cdyn, one_error_line, path_str, scenario};
 
 const PENDULUM: &str = r#"
 [model]
@@ -27,33 +30,6 @@ const GRID: &str = r#"
 alpha_g = [10.0, 40.0, 160.0]
 h = [0.01, 0.02]
 "#;
-
-fn cdyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cdyn")).args(args).output().unwrap()
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Writes `text` as `name` into a fresh directory; returns the directory and the file.
-fn scenario(name: &str, text: &str) -> (PathBuf, PathBuf) {
-    let dir = tempfile::tempdir().unwrap().keep();
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    (dir, path)
-}
-
-/// The one error line of a failed command, checked to be one line without a panic.
-fn one_error_line(out: &Output) -> String {
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "expected failure, got success: {stderr}");
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "not one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    stderr
-}
 
 /// Files in `dir` (none if it does not exist).
 fn files_in(dir: &Path) -> Vec<String> {

@@ -7,8 +7,11 @@
 //! what is left on disk.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
+
+mod common;
+use common::{cdyn, one_error_line, path_str, scenario};
 
 /// The pendulum of the paper's Example 1 under CVSGF; `t_end` and `every` are substituted.
 const PENDULUM: &str = r#"
@@ -29,24 +32,8 @@ fn pendulum(t_end: &str, every: &str) -> String {
     PENDULUM.replace("T_END", t_end).replace("EVERY", every)
 }
 
-fn cdyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cdyn")).args(args).output().unwrap()
-}
-
 fn spawn(args: &[&str]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_cdyn")).args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap()
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Writes `text` as `name` into a fresh directory; returns the directory and the file.
-fn scenario(name: &str, text: &str) -> (PathBuf, PathBuf) {
-    let dir = tempfile::tempdir().unwrap().keep();
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    (dir, path)
 }
 
 /// Files in `dir` with their sizes (none if it does not exist).
@@ -58,17 +45,6 @@ fn files_in(dir: &Path) -> Vec<(String, u64)> {
         })
         .collect()
     })
-}
-
-/// The one error line of a failed command, checked to be one line without a panic.
-fn one_error_line(out: &Output) -> String {
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "expected failure, got success: {stderr}");
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "not one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    stderr
 }
 
 /// Waits until the run writing into `dir` has written some rows (a file
