@@ -6,7 +6,7 @@ use crate::energy;
 use crate::linalg::Schur;
 pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
 use crate::mass::MassMatrix;
-use crate::model::{Model, Pattern};
+use crate::model::Model;
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
 /// model; `evaluate` never allocates. The results are read through the
@@ -195,26 +195,5 @@ impl Dynamics {
     /// `A = M⁻¹ (G − Φ_qᵀ λ)` of Eq. 8.
     pub fn acc(&self) -> &[f64] {
         &self.acc
-    }
-}
-
-/// `out = Φ_q x`
-pub fn jac_mul(pattern: &Pattern, jac: &[f64], x: &[f64], out: &mut [f64]) {
-    for (r, o) in out.iter_mut().enumerate() {
-        let range = pattern.row(r);
-        let (cols, values) = (&pattern.cols[range.clone()], &jac[range]);
-        *o = cols.iter().zip(values).map(|(&c, j)| j * x[c as usize]).sum();
-    }
-}
-
-/// `out += scale · diag(weight) Φ_qᵀ y`
-pub fn add_weighted_jt(pattern: &Pattern, jac: &[f64], y: &[f64], weight: &[f64], scale: f64, out: &mut [f64]) {
-    for (r, &yr) in y.iter().enumerate() {
-        let s = scale * yr;
-        let range = pattern.row(r);
-        for (&c, j) in pattern.cols[range.clone()].iter().zip(&jac[range]) {
-            let c = c as usize;
-            out[c] += s * weight[c] * j;
-        }
     }
 }

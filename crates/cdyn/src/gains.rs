@@ -168,13 +168,6 @@ pub fn resolve(control: Control, scheme: Scheme, h: f64, coupling: f64, max_row_
     (c, Tuning { coupling, rate_h: rate * h, target })
 }
 
-/// Whether `control` has an automatic gain left to choose.
-pub fn has_auto(control: &Control) -> bool {
-    matches!(control.geometric, Geometric::Gradient(Gain::Auto) | Geometric::Newton(Rate::Auto))
-        || control.velocity == Velocity::Gradient(Rate::Auto)
-        || matches!(control.energy, Energy::Projected { alpha_e: Rate::Auto, .. })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

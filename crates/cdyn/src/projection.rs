@@ -155,7 +155,7 @@ pub(crate) fn velocities(model: &Model, d: &Dynamics, v: &mut [f64], work: &mut 
 
 /// `out = P x`, the `M`-orthogonal projection onto the null space of `Φ_q`.
 fn project(model: &Model, d: &Dynamics, x: &[f64], rows: &mut [f64], out: &mut [f64]) {
-    crate::dynamics::jac_mul(model.pattern(), d.jac(), x, rows);
+    d.jac_mul(model, x, rows);
     out.copy_from_slice(x);
     d.add_constraint_response(model, rows, out);
 }

@@ -94,14 +94,15 @@ fn accelerations_satisfy_the_constraint_equations() {
     let mut d = Dynamics::new(&model);
     d.evaluate(&model, &q, &v, t).unwrap();
     let mut ja = vec![0.0; model.m()];
-    cdyn::dynamics::jac_mul(model.pattern(), d.jac(), d.acc(), &mut ja);
+    d.jac_mul(&model, d.acc(), &mut ja);
     for r in 0..model.m() {
         assert!((ja[r] - d.gamma()[r]).abs() < 1e-12, "row {r}: Φ_q A = {} vs γ = {}", ja[r], d.gamma()[r]);
     }
+    // M⁻¹ Φ_qᵀ λ, so that M (A + M⁻¹ Φ_qᵀ λ) = G.
     let mut jt = vec![0.0; model.n()];
-    cdyn::dynamics::add_weighted_jt(model.pattern(), d.jac(), d.lambda(), &[1.0; 4], 1.0, &mut jt);
+    d.add_weighted_jt(&model, d.lambda(), 1.0, &mut jt);
     for i in 0..model.n() {
-        let residual = model.mass().diagonal()[i] * d.acc()[i] + jt[i] - d.force()[i];
+        let residual = model.mass().diagonal()[i] * (d.acc()[i] + jt[i]) - d.force()[i];
         assert!(residual.abs() < 1e-12, "coordinate {i}: residual {residual}");
     }
 }
