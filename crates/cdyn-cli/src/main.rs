@@ -1,28 +1,12 @@
 //! `cdyn`: constrained dynamics with gradient-feedback stabilization,
 //! from the command line.
 
-mod alloc_count;
-mod bench;
-mod compare;
-mod heatmap;
-mod interrupt;
-mod output;
-mod paper;
-mod plot;
-mod progress;
-mod report;
-mod runner;
-mod scenario;
-mod suite;
-mod suite_plot;
-mod sweep;
-mod terminal;
-
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use terminal::print;
+use cdyn_cli::terminal::print;
+use cdyn_cli::{alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal};
 
 #[global_allocator]
 static ALLOCATOR: alloc_count::Counting = alloc_count::Counting;

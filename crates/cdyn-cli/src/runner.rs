@@ -160,8 +160,26 @@ impl CaseResult {
     }
 }
 
-/// Writes each sample as a CSV row: `t`, the observables, `phi`, `psi`,
-/// and the error when there is a reference.
+/// The columns of a run's samples: `t`, the observables, `phi`, `psi`, and
+/// `err_<first observable>` when there is a reference (the CSV header).
+pub fn columns(example: &Example) -> Vec<String> {
+    let mut names = vec!["t".to_string()];
+    names.extend(example.observables.iter().cloned());
+    names.extend(["phi".to_string(), "psi".to_string()]);
+    if example.reference.is_some() {
+        names.push(format!("err_{}", example.observables[0].to_lowercase()));
+    }
+    names
+}
+
+/// The values of one sample in the order of [`columns`]: the one source of
+/// both the CSV rows and the rows kept in memory (Python), so the two agree bit for bit.
+pub fn row_values<'s>(s: &'s Sample<'_>) -> impl Iterator<Item = f64> + 's {
+    let t = cdyn::error::tidy_time(s.t);
+    std::iter::once(t).chain(s.observables.iter().copied()).chain([s.measures.phi, s.measures.psi]).chain(s.error)
+}
+
+/// Writes each sample as a CSV row of [`row_values`] under the header [`columns`].
 struct CsvRows<'w, W: Write> {
     out: &'w mut W,
 }
@@ -169,15 +187,7 @@ struct CsvRows<'w, W: Write> {
 impl<'w, W: Write> CsvRows<'w, W> {
     /// Writes the header row for `example` and returns the writer of the rows.
     fn start(out: &'w mut W, example: &Example) -> std::io::Result<Self> {
-        write!(out, "t")?;
-        for name in &example.observables {
-            write!(out, ",{name}")?;
-        }
-        write!(out, ",phi,psi")?;
-        if example.reference.is_some() {
-            write!(out, ",err_{}", example.observables[0].to_lowercase())?;
-        }
-        writeln!(out)?;
+        writeln!(out, "{}", columns(example).join(","))?;
         Ok(CsvRows { out })
     }
 }
@@ -185,16 +195,47 @@ impl<'w, W: Write> CsvRows<'w, W> {
 impl<W: Write> Sink for CsvRows<'_, W> {
     type Error = std::io::Error;
     fn sample(&mut self, s: &Sample<'_>) -> std::io::Result<()> {
-        write!(self.out, "{:e}", cdyn::error::tidy_time(s.t))?;
-        for o in s.observables {
-            write!(self.out, ",{o:e}")?;
-        }
-        write!(self.out, ",{:e},{:e}", s.measures.phi, s.measures.psi)?;
-        if let Some(e) = s.error {
-            write!(self.out, ",{e:e}")?;
+        for (i, x) in row_values(s).enumerate() {
+            if i > 0 {
+                write!(self.out, ",")?;
+            }
+            write!(self.out, "{x:e}")?;
         }
         writeln!(self.out)
     }
+}
+
+/// The samples of a run kept in memory: the rows the CSV would hold, and
+/// the coordinates `q` and velocities `v` at each sample.
+#[derive(Debug, Clone, Default)]
+pub struct Rows {
+    /// Column names ([`columns`]).
+    pub columns: Vec<String>,
+    /// The rows one after another, `columns.len()` values each ([`row_values`]).
+    pub values: Vec<f64>,
+    /// `q` at each sample, one after another.
+    pub q: Vec<f64>,
+    /// `v` at each sample, one after another.
+    pub v: Vec<f64>,
+}
+
+impl Sink for &mut Rows {
+    type Error = std::convert::Infallible;
+    fn sample(&mut self, s: &Sample<'_>) -> Result<(), Self::Error> {
+        self.values.extend(row_values(s));
+        Ok(())
+    }
+}
+
+/// Runs `case` keeping every sample in memory (no files, no progress, no
+/// interrupts): the Python package's run.
+pub fn run_case_in_memory(case: &Case) -> (CaseResult, Rows) {
+    let mut rows = Rows { columns: columns(&case.example), ..Rows::default() };
+    let mut states = (Vec::new(), Vec::new());
+    let recorder = Recorder::example(&case.example).keep_series(false).sink(&mut rows);
+    let Ok(record) = simulate(case, recorder, Watch::Nothing, Some(&mut states));
+    (rows.q, rows.v) = states;
+    (CaseResult::new(case, record), rows)
 }
 
 /// Runs `case`, writing `dir/<name>.csv` (under a temporary name until it
@@ -206,7 +247,7 @@ pub fn run_case(case: &Case, dir: &Path, progress: &ProgressBar) -> Result<CaseR
     let mut file = AtomicFile::create(&path)?;
     let record = CsvRows::start(file.writer(), &case.example).and_then(|rows| {
         let recorder = Recorder::example(&case.example).keep_series(true).sink(rows);
-        simulate(case, recorder, Watch::Interrupts(progress))
+        simulate(case, recorder, Watch::Interrupts(progress), None)
     });
     let record = record.with_context(|| format!("cannot write {}", path.display()))?;
     file.commit()?;
@@ -215,7 +256,7 @@ pub fn run_case(case: &Case, dir: &Path, progress: &ProgressBar) -> Result<CaseR
 
 /// Runs `case` keeping only its statistics (for sweeps).
 pub fn run_case_quietly(case: &Case) -> CaseResult {
-    let Ok(record) = simulate(case, Recorder::example(&case.example), Watch::Nothing);
+    let Ok(record) = simulate(case, Recorder::example(&case.example), Watch::Nothing, None);
     CaseResult::new(case, record)
 }
 
@@ -226,13 +267,21 @@ enum Watch<'p> {
     Interrupts(&'p ProgressBar),
 }
 
-/// Runs `case` into `recorder`; an error of the simulation, also one
-/// starting it, is kept in the record, an error of the sink returned.
-fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch<'_>) -> Result<(Record, Method), K::Error> {
+/// `q` and `v` at each sample, one after another, where they are kept.
+type States<'s> = Option<&'s mut (Vec<f64>, Vec<f64>)>;
+
+/// Runs `case` into `recorder` (and `states`); an error of the simulation,
+/// also one starting it, is kept in the record, an error of the sink returned.
+fn simulate<K: Sink>(
+    case: &Case,
+    recorder: Recorder<'_, K>,
+    watch: Watch<'_>,
+    states: States<'_>,
+) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
-            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch)?;
+            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch, states)?;
             let method = Method {
                 interrupted,
                 control: Some(sim.settings().control),
@@ -259,7 +308,16 @@ fn drive<S: System, K: Sink>(
     t_end: f64,
     every: u64,
     watch: Watch<'_>,
+    mut states: States<'_>,
 ) -> Result<(Record, bool), K::Error> {
+    // A sample of the recorder, and of `q` and `v` where they are kept.
+    let mut sample = |recorder: &mut Recorder<'_, K>, sim: &mut Stepper<S>| {
+        if let Some((q, v)) = states.as_deref_mut() {
+            q.extend_from_slice(sim.q());
+            v.extend_from_slice(sim.v());
+        }
+        recorder.sample(sim)
+    };
     let steps = match steps_to(t_end, sim.settings().h) {
         Ok(n) => n,
         Err(e) => return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false)),
@@ -270,7 +328,7 @@ fn drive<S: System, K: Sink>(
         Watch::Interrupts(progress) => progress.position(),
         Watch::Nothing => 0,
     };
-    recorder.sample(sim)?;
+    sample(&mut recorder, sim)?;
     let mut sampled = sim.steps();
     while sim.steps() < steps {
         if let Watch::Interrupts(progress) = watch
@@ -280,7 +338,7 @@ fn drive<S: System, K: Sink>(
         }
         if matches!(watch, Watch::Interrupts(_)) && interrupt::requested().is_some() {
             if sampled != sim.steps() {
-                recorder.sample(sim)?;
+                sample(&mut recorder, sim)?;
             }
             return Ok((recorder.finish(sim), true));
         }
@@ -289,7 +347,7 @@ fn drive<S: System, K: Sink>(
         }
         let n = sim.steps();
         if n.is_multiple_of(every) || n == steps {
-            recorder.sample(sim)?;
+            sample(&mut recorder, sim)?;
             sampled = n;
         }
     }

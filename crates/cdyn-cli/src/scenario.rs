@@ -114,12 +114,16 @@ pub fn load(path: &Path) -> Result<Scenario> {
 /// Reads and checks a scenario file; also returns the parsed table, which
 /// identifies the scenario by content (`cdyn merge`), whatever its path.
 pub fn load_with_table(path: &Path) -> Result<(Scenario, toml::Table)> {
-    let file = path.display();
-    let text = read_bounded(path)?;
+    parse(&read_bounded(path)?, &path.display().to_string())
+}
+
+/// Reads and checks the scenario `text`; `file` names it in errors (the
+/// path, or `<string>` for text given directly). Also returns the parsed table.
+pub fn parse(text: &str, file: &str) -> Result<(Scenario, toml::Table)> {
     if text.trim().is_empty() {
         bail!("{file}: the scenario is empty");
     }
-    let table: toml::Table = toml::from_str(&text).map_err(|e| {
+    let table: toml::Table = toml::from_str(text).map_err(|e| {
         let at = e.span().map_or(String::new(), |s| {
             let line = text[..s.start].matches('\n').count() + 1;
             let col = s.start - text[..s.start].rfind('\n').map_or(0, |i| i + 1) + 1;
@@ -127,6 +131,12 @@ pub fn load_with_table(path: &Path) -> Result<(Scenario, toml::Table)> {
         });
         anyhow!("{file}{at}: {}", e.message().trim().replace('\n', " "))
     })?;
+    from_table(table, file)
+}
+
+/// Checks the parsed scenario `table` (from a file, or built from a Python
+/// dict); `file` names it in errors. Returns the table too.
+pub fn from_table(table: toml::Table, file: &str) -> Result<(Scenario, toml::Table)> {
     // The library's types check every key; the path to a refused one names
     // the table, entry and key as the file writes them.
     let scenario = serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
