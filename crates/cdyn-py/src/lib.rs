@@ -1,0 +1,226 @@
+//! `cdyn._cdyn`, the native part of the Python package `cdyn`: thin over the
+//! CLI's library (crates/cdyn-cli), so scenarios are read, cases built and
+//! run, and errors worded exactly as `cdyn run`, `compare`, `sweep` and
+//! `paper` do. The Python layer (python/cdyn) wraps what these functions
+//! return in result classes.
+//!
+//! Every run happens with the GIL released; failures become `cdyn.Error`
+//! subclasses carrying the CLI's one-line message, never a crash.
+
+use cdyn_cli::runner::{Case, CaseResult, Rows, run_case_in_memory};
+use cdyn_cli::{paper, scenario, sweep};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use std::path::PathBuf;
+
+create_exception!(_cdyn, Error, PyException, "Any error of cdyn; the message is the CLI's one line.");
+create_exception!(_cdyn, ScenarioError, Error, "A scenario that cannot be read or run as written.");
+create_exception!(_cdyn, SimulationError, Error, "A run that failed part-way (diverged, singular, ...).");
+
+/// The CLI's one-line wording of `e` (as after `error: `).
+fn line(e: &anyhow::Error) -> String {
+    format!("{e:#}").replace('\n', " ")
+}
+
+fn scenario_error(e: anyhow::Error) -> PyErr {
+    ScenarioError::new_err(line(&e))
+}
+
+/// A checked scenario, as read from a file, a TOML string or a dict.
+#[pyclass(frozen, module = "cdyn._cdyn")]
+struct Scenario {
+    parsed: scenario::Scenario,
+    table: toml::Table,
+    /// What errors name: the path, `<string>` or `<dict>`.
+    file: String,
+}
+
+#[pymethods]
+impl Scenario {
+    /// What errors name this scenario by: its path, `<string>` or `<dict>`.
+    #[getter]
+    fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// Whether the scenario has a `[sweep]` table.
+    #[getter]
+    fn has_sweep(&self) -> bool {
+        self.parsed.sweep.is_some()
+    }
+
+    /// The scenario as TOML text (the parsed table, written back).
+    fn to_toml(&self) -> PyResult<String> {
+        toml::to_string(&self.table).map_err(|e| Error::new_err(e.to_string()))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Scenario({:?})", self.file)
+    }
+}
+
+impl Scenario {
+    fn path(&self) -> PathBuf {
+        PathBuf::from(&self.file)
+    }
+
+    /// The case `cdyn run` would run, checked as it checks it.
+    fn case(&self) -> anyhow::Result<Case> {
+        let path = self.path();
+        self.parsed.refuse_sweep(&path, "run")?;
+        let mut case = self.parsed.case(&path)?;
+        case.check().map_err(|e| anyhow::anyhow!("{}: {e}", self.file))?;
+        if self.parsed.output.name.is_none() && !std::path::Path::new(&self.file).exists() {
+            // A string or dict has no file stem to name the case by.
+            case.name = "run".into();
+        }
+        Ok(case)
+    }
+}
+
+/// Reads and checks the scenario file at `path`.
+#[pyfunction]
+fn load(path: PathBuf) -> PyResult<Scenario> {
+    let (parsed, table) = scenario::load_with_table(&path).map_err(scenario_error)?;
+    Ok(Scenario { parsed, table, file: path.display().to_string() })
+}
+
+/// Reads and checks the scenario TOML `text`; `file` names it in errors.
+#[pyfunction]
+#[pyo3(signature = (text, file = "<string>"))]
+fn loads(text: &str, file: &str) -> PyResult<Scenario> {
+    let (parsed, table) = scenario::parse(text, file).map_err(scenario_error)?;
+    Ok(Scenario { parsed, table, file: file.into() })
+}
+
+/// Reads and checks a scenario given as a dict of the file's schema; `file` names it in errors.
+#[pyfunction]
+#[pyo3(signature = (data, file = "<dict>"))]
+fn from_dict(data: &Bound<'_, PyAny>, file: &str) -> PyResult<Scenario> {
+    let table = match to_toml(data, "")? {
+        toml::Value::Table(t) => t,
+        _ => return Err(ScenarioError::new_err(format!("{file}: expected a dict of tables ([model], [integrator], ...)"))),
+    };
+    let (parsed, table) = scenario::from_table(table, file).map_err(scenario_error)?;
+    Ok(Scenario { parsed, table, file: file.into() })
+}
+
+/// `value` as a TOML value; `at` is its key path, for the error.
+fn to_toml(value: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
+    let unsupported = || {
+        let kind = value.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "?".into());
+        ScenarioError::new_err(format!(
+            "<dict>: {}: a value of type {kind} has no TOML form (use dict, list, str, int, float, bool)",
+            if at.is_empty() { "the scenario" } else { at }
+        ))
+    };
+    if value.is_instance_of::<PyBool>() {
+        Ok(toml::Value::Boolean(value.extract()?))
+    } else if value.is_instance_of::<PyInt>() {
+        Ok(toml::Value::Integer(value.extract().map_err(|_| unsupported())?))
+    } else if value.is_instance_of::<PyFloat>() {
+        Ok(toml::Value::Float(value.extract()?))
+    } else if value.is_instance_of::<PyString>() {
+        Ok(toml::Value::String(value.extract()?))
+    } else if let Ok(d) = value.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in d.iter() {
+            let key: String = k.extract().map_err(|_| unsupported())?;
+            let here = if at.is_empty() { key.clone() } else { format!("{at}.{key}") };
+            table.insert(key, to_toml(&v, &here)?);
+        }
+        Ok(toml::Value::Table(table))
+    } else if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items = value.try_iter()?.enumerate().map(|(i, v)| to_toml(&v?, &format!("{at}[{i}]")));
+        Ok(toml::Value::Array(items.collect::<PyResult<_>>()?))
+    } else if let Ok(x) = value.extract::<f64>() {
+        // NumPy scalars and other numbers.
+        Ok(toml::Value::Float(x))
+    } else {
+        Err(unsupported())
+    }
+}
+
+/// What a run hands to Python: the summary entry (JSON text, as in
+/// `summary.json`), the column names, and the samples as flat arrays.
+fn to_python<'py>(py: Python<'py>, result: &CaseResult, rows: Rows) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let summary = serde_json::to_string(result).map_err(|e| Error::new_err(e.to_string()))?;
+    d.set_item("summary", summary)?;
+    d.set_item("error", result.error.clone())?;
+    let (width, n) = (rows.columns.len(), result.record.q_end.len().max(1));
+    d.set_item("columns", rows.columns)?;
+    let samples = rows.values.len() / width.max(1);
+    d.set_item("values", PyArray1::from_vec(py, rows.values).reshape([samples, width])?)?;
+    let states = rows.q.len() / n;
+    d.set_item("q", PyArray1::from_vec(py, rows.q).reshape([states, n])?)?;
+    d.set_item("v", PyArray1::from_vec(py, rows.v).reshape([states, n])?)?;
+    Ok(d)
+}
+
+/// Runs `cases` in turn with the GIL released.
+fn run_all<'py>(py: Python<'py>, cases: Vec<Case>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let done = py.detach(move || cases.iter().map(run_case_in_memory).collect::<Vec<_>>());
+    done.into_iter().map(|(result, rows)| to_python(py, &result, rows)).collect()
+}
+
+/// Runs the scenario as `cdyn run` does; returns the raw result (see `cdyn.run`).
+#[pyfunction]
+fn run<'py>(py: Python<'py>, scenario: &Scenario) -> PyResult<Bound<'py, PyDict>> {
+    let case = scenario.case().map_err(scenario_error)?;
+    let mut all = run_all(py, vec![case])?;
+    Ok(all.remove(0))
+}
+
+/// Runs the scenario under every method of `cdyn compare`.
+#[pyfunction]
+fn compare<'py>(py: Python<'py>, scenario: &Scenario) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let path = scenario.path();
+    scenario.parsed.refuse_sweep(&path, "compare").map_err(scenario_error)?;
+    let cases = cdyn_cli::compare::cases(&scenario.parsed, &path).map_err(scenario_error)?;
+    run_all(py, cases)
+}
+
+/// Runs every case of the paper's Example 1 (`cdyn paper`).
+#[pyfunction]
+fn paper_cases<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let cases = paper::cases().map_err(scenario_error)?;
+    run_all(py, cases)
+}
+
+/// Runs the scenario's `[sweep]` grid on `threads` threads (one per core by
+/// default); returns `sweep.json` as text.
+#[pyfunction]
+#[pyo3(signature = (scenario, threads = None))]
+fn run_sweep(py: Python<'_>, scenario: &Scenario, threads: Option<usize>) -> PyResult<String> {
+    if threads == Some(0) {
+        return Err(Error::new_err("threads = 0: need at least one thread"));
+    }
+    let path = scenario.path();
+    let result = py
+        .detach(|| sweep::run(&scenario.parsed, &scenario.table, &path, None, threads))
+        .map_err(scenario_error)?;
+    serde_json::to_string(&result).map_err(|e| Error::new_err(e.to_string()))
+}
+
+/// The native module.
+#[pymodule]
+fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("Error", py.get_type::<Error>())?;
+    m.add("ScenarioError", py.get_type::<ScenarioError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    m.add_class::<Scenario>()?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(loads, m)?)?;
+    m.add_function(wrap_pyfunction!(from_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(paper_cases, m)?)?;
+    m.add_function(wrap_pyfunction!(run_sweep, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,266 @@
+"""cdyn: constrained multibody dynamics in redundant coordinates, with
+constraint and energy violations pushed back (CVSGF), from Python.
+
+A thin layer over the Rust library and the ``cdyn`` command line: scenarios
+are read, cases run and errors worded exactly as ``cdyn run``, ``cdyn
+compare``, ``cdyn sweep`` and ``cdyn paper`` do. Runs release the GIL.
+
+>>> import cdyn
+>>> s = cdyn.model("pendulum", scheme="rk4", h=0.01, t_end=1.0)
+>>> r = cdyn.run(s)
+>>> r.t[-1], r.q.shape
+(1.0, (101, 2))
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+import os
+
+import numpy as np
+
+from . import _cdyn
+from ._cdyn import Error, Scenario, ScenarioError, SimulationError
+
+__version__: str = _cdyn.__version__
+
+__all__ = [
+    "Error",
+    "ScenarioError",
+    "SimulationError",
+    "Scenario",
+    "Result",
+    "Sweep",
+    "load",
+    "loads",
+    "from_dict",
+    "model",
+    "scenario",
+    "run",
+    "compare",
+    "sweep",
+    "example1",
+]
+
+ScenarioLike = Union[Scenario, str, "os.PathLike[str]", Mapping[str, Any]]
+
+
+class Result:
+    """One run: its samples as NumPy arrays and its summary as a dict.
+
+    The samples are the rows ``cdyn run`` writes to CSV (the same values,
+    bit for bit), plus the coordinates and velocities at each sample.
+
+    Attributes:
+        name: the case's name (the CSV file's stem in the CLI).
+        columns: the CSV header: ``t``, the observables, ``phi``, ``psi``,
+            and ``err_<observable>`` when the model has a reference solution.
+        table: every sample, one row each, in the order of ``columns``.
+        t: sample times.
+        observables: the observables (``table``'s columns between ``t`` and
+            ``phi``), one column each; ``observable_names`` names them.
+        phi: the constraint violation of largest magnitude, with its sign.
+        psi: the energy constraint Ψ.
+        err: the error of the first observable against the reference, or
+            None without a reference.
+        q, v: coordinates and velocities at each sample (samples × n).
+        summary: the case's entry of ``summary.json`` (a plain dict).
+        error: None when the run finished; else the CLI's one-line message.
+    """
+
+    __slots__ = ("name", "columns", "table", "q", "v", "summary", "error")
+
+    def __init__(self, raw: Dict[str, Any]) -> None:
+        self.summary: Dict[str, Any] = json.loads(raw["summary"])
+        self.name: str = self.summary["name"]
+        self.columns: List[str] = list(raw["columns"])
+        self.table: np.ndarray = raw["values"]
+        self.q: np.ndarray = raw["q"]
+        self.v: np.ndarray = raw["v"]
+        self.error: Optional[str] = raw["error"]
+        for a in (self.table, self.q, self.v):
+            a.flags.writeable = False
+
+    def column(self, name: str) -> np.ndarray:
+        """The column ``name`` of ``table`` (e.g. ``"X"``, ``"phi"``)."""
+        return self.table[:, self.columns.index(name)]
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.table[:, 0]
+
+    @property
+    def observable_names(self) -> List[str]:
+        return self.columns[1 : self.columns.index("phi")]
+
+    @property
+    def observables(self) -> np.ndarray:
+        return self.table[:, 1 : self.columns.index("phi")]
+
+    @property
+    def phi(self) -> np.ndarray:
+        return self.column("phi")
+
+    @property
+    def psi(self) -> np.ndarray:
+        return self.column("psi")
+
+    @property
+    def err(self) -> Optional[np.ndarray]:
+        last = self.columns[-1]
+        return self.column(last) if last.startswith("err_") else None
+
+    def to_pandas(self) -> "Any":
+        """The samples as a pandas DataFrame: the CSV's columns, then
+        ``q0..`` and ``v0..`` (needs pandas, an optional dependency)."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("Result.to_pandas() needs pandas: pip install pandas") from e
+        data = {c: self.table[:, i] for i, c in enumerate(self.columns)}
+        for k in range(self.q.shape[1]):
+            data[f"q{k}"] = self.q[:, k]
+        for k in range(self.v.shape[1]):
+            data[f"v{k}"] = self.v[:, k]
+        return pd.DataFrame(data)
+
+    def __repr__(self) -> str:
+        status = "ok" if self.error is None else "failed"
+        return f"<cdyn.Result {self.name!r}: {self.table.shape[0]} samples, {status}>"
+
+
+class Sweep:
+    """A sweep's result: ``summary`` is ``sweep.json`` as a dict; the grid's
+    values and worst violations and errors as NumPy arrays (one entry per
+    grid point, last axis fastest)."""
+
+    __slots__ = ("summary",)
+
+    def __init__(self, text: str) -> None:
+        self.summary: Dict[str, Any] = json.loads(text)
+
+    @property
+    def axes(self) -> Dict[str, np.ndarray]:
+        """Axis name → its values."""
+        return {a["name"]: np.array(a["values"], dtype=float) for a in self.summary["axes"]}
+
+    @property
+    def values(self) -> np.ndarray:
+        """The axis values of each point (points × axes)."""
+        return np.array([p["values"] for p in self.summary["points"]], dtype=float).reshape(-1, len(self.summary["axes"]))
+
+    def _field(self, key: str) -> np.ndarray:
+        return np.array([np.nan if p[key] is None else p[key] for p in self.summary["points"]], dtype=float)
+
+    @property
+    def max_abs_phi(self) -> np.ndarray:
+        return self._field("max_abs_phi")
+
+    @property
+    def max_abs_psi(self) -> np.ndarray:
+        return self._field("max_abs_psi")
+
+    @property
+    def max_abs_err(self) -> np.ndarray:
+        """NaN where there is no reference."""
+        return self._field("max_abs_err")
+
+    @property
+    def errors(self) -> List[Optional[str]]:
+        """Each point's failure message, or None."""
+        return [p["error"] for p in self.summary["points"]]
+
+    def __repr__(self) -> str:
+        return f"<cdyn.Sweep {len(self.summary['points'])} points over {[a['name'] for a in self.summary['axes']]}>"
+
+
+def load(path: Union[str, "os.PathLike[str]"]) -> Scenario:
+    """Reads and checks the scenario file at ``path`` (as ``cdyn run`` does)."""
+    return _cdyn.load(os.fspath(path))
+
+
+def loads(text: str, file: str = "<string>") -> Scenario:
+    """Reads and checks a scenario given as TOML text; ``file`` names it in errors."""
+    return _cdyn.loads(text, file)
+
+
+def from_dict(data: Mapping[str, Any], file: str = "<dict>") -> Scenario:
+    """Reads and checks a scenario given as a dict of the files' schema,
+    e.g. ``{"model": {"kind": "pendulum"}, "integrator": {...}}``."""
+    return _cdyn.from_dict(dict(data), file)
+
+
+def model(
+    kind: str,
+    *,
+    scheme: str = "rk4",
+    h: float = 0.01,
+    t_end: float = 10.0,
+    method: Optional[Mapping[str, Any]] = None,
+    initial: Optional[Mapping[str, Any]] = None,
+    every: Optional[int] = None,
+    name: Optional[str] = None,
+    **parameters: Any,
+) -> Scenario:
+    """A built-in model by name (``kind`` as in ``[model] kind``) with its
+    parameters as keywords: the pendulums take theirs in ``[model]``
+    (``length``, ``gravity``, ...), the other models in ``[model.parameters]``.
+    ``method`` is the ``[method]`` table (default: the ``robust`` preset)."""
+    m: Dict[str, Any] = {"kind": kind}
+    if kind in ("pendulum", "pendulum_theta"):
+        m.update(parameters)
+    elif parameters:
+        m["parameters"] = dict(parameters)
+    data: Dict[str, Any] = {"model": m, "integrator": {"scheme": scheme, "h": h, "t_end": t_end}}
+    if method is not None:
+        data["method"] = dict(method)
+    if initial is not None:
+        data["initial"] = dict(initial)
+    output = {k: v for k, v in (("every", every), ("name", name)) if v is not None}
+    if output:
+        data["output"] = output
+    return from_dict(data)
+
+
+def scenario(source: ScenarioLike) -> Scenario:
+    """A Scenario from a Scenario, a dict, or a file path."""
+    if isinstance(source, Scenario):
+        return source
+    if isinstance(source, Mapping):
+        return from_dict(source)
+    return load(source)
+
+
+def run(source: ScenarioLike, *, check: bool = True) -> Result:
+    """Runs the scenario as ``cdyn run`` does (without writing files).
+
+    A run that fails part-way raises SimulationError with the CLI's message
+    (its ``result`` attribute holds what was recorded up to the failure);
+    with ``check=False`` the Result is returned and its ``error`` says why.
+    """
+    result = Result(_cdyn.run(scenario(source)))
+    if check and result.error is not None:
+        e = SimulationError(result.error)
+        e.result = result  # type: ignore[attr-defined]
+        raise e
+    return result
+
+
+def compare(source: ScenarioLike) -> Dict[str, Result]:
+    """Runs the scenario's model under every method of ``cdyn compare``:
+    method name → Result (failed methods carry their ``error``)."""
+    return {r.name: r for r in map(Result, _cdyn.compare(scenario(source)))}
+
+
+def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:
+    """Runs the scenario's ``[sweep]`` grid in parallel on ``threads`` threads
+    (default: one per core), as ``cdyn sweep`` does; the result does not
+    depend on ``threads``."""
+    return Sweep(_cdyn.run_sweep(scenario(source), threads))
+
+
+def example1() -> Dict[str, Result]:
+    """The paper's Example 1 as ``cdyn paper`` runs it (AB-3, h = 0.01,
+    t ∈ [0, 20]): case name → Result."""
+    return {r.name: r for r in map(Result, _cdyn.paper_cases())}
