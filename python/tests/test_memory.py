@@ -1,0 +1,45 @@
+"""No reference cycles and no leaks: 1000 runs keep the memory flat."""
+
+import gc
+
+import cdyn
+
+SMALL = cdyn.model("pendulum", scheme="rk4", h=0.01, t_end=0.2)
+PAGE = 4096
+
+
+def rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * PAGE
+
+
+def test_results_make_no_reference_cycles():
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(50):
+            r = cdyn.run(SMALL)
+            cdyn.compare(SMALL)
+            del r
+        assert gc.collect() == 0, "results left garbage only the cycle collector could free"
+    finally:
+        gc.enable()
+
+
+def test_memory_stays_flat_over_1000_runs():
+    for _ in range(100):  # warm up: allocator pools, caches
+        cdyn.run(SMALL)
+    gc.collect()
+    before = rss_bytes()
+    for _ in range(1000):
+        r = cdyn.run(SMALL)
+        assert r.table.shape[0] == 21
+        try:
+            cdyn.run({"model": {"kind": "pendulum"}, "integrator": {"scheme": "rk4", "h": 0.0, "t_end": 1.0}})
+        except cdyn.ScenarioError:
+            pass
+    gc.collect()
+    grown = rss_bytes() - before
+    # A run keeps about 21 × (8 + 2 + 2) doubles (~2 KB) and a summary; 1000
+    # leaked runs would be several MB. Allow 2 MB for allocator noise.
+    assert grown < 2 << 20, f"RSS grew by {grown / 1e6:.2f} MB over 1000 runs"
