@@ -8,8 +8,10 @@ compare``, ``cdyn sweep`` and ``cdyn paper`` do. Runs release the GIL.
 >>> import cdyn
 >>> s = cdyn.model("pendulum", scheme="rk4", h=0.01, t_end=1.0)
 >>> r = cdyn.run(s)
->>> r.t[-1], r.q.shape
-(1.0, (101, 2))
+>>> float(r.t[-1]), r.q.shape, r.columns
+(1.0, (101, 2), ['t', 'X', 'Y', 'VX', 'VY', 'phi', 'psi', 'err_x'])
+>>> bool(abs(r.phi).max() < 1e-12)
+True
 """
 
 from __future__ import annotations

@@ -2,11 +2,13 @@
 //! from the command line.
 
 use anyhow::{Context, Result, bail};
+use cdyn_cli::terminal::print;
+use cdyn_cli::{
+    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal,
+};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use cdyn_cli::terminal::print;
-use cdyn_cli::{alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal};
 
 #[global_allocator]
 static ALLOCATOR: alloc_count::Counting = alloc_count::Counting;

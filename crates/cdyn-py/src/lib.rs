@@ -102,7 +102,11 @@ fn loads(text: &str, file: &str) -> PyResult<Scenario> {
 fn from_dict(data: &Bound<'_, PyAny>, file: &str) -> PyResult<Scenario> {
     let table = match to_toml(data, "")? {
         toml::Value::Table(t) => t,
-        _ => return Err(ScenarioError::new_err(format!("{file}: expected a dict of tables ([model], [integrator], ...)"))),
+        _ => {
+            return Err(ScenarioError::new_err(format!(
+                "{file}: expected a dict of tables ([model], [integrator], ...)"
+            )));
+        }
     };
     let (parsed, table) = scenario::from_table(table, file).map_err(scenario_error)?;
     Ok(Scenario { parsed, table, file: file.into() })
@@ -200,9 +204,8 @@ fn run_sweep(py: Python<'_>, scenario: &Scenario, threads: Option<usize>) -> PyR
         return Err(Error::new_err("threads = 0: need at least one thread"));
     }
     let path = scenario.path();
-    let result = py
-        .detach(|| sweep::run(&scenario.parsed, &scenario.table, &path, None, threads))
-        .map_err(scenario_error)?;
+    let result =
+        py.detach(|| sweep::run(&scenario.parsed, &scenario.table, &path, None, threads)).map_err(scenario_error)?;
     serde_json::to_string(&result).map_err(|e| Error::new_err(e.to_string()))
 }
 
