@@ -43,3 +43,34 @@ def test_memory_stays_flat_over_1000_runs():
     # A run keeps about 21 × (8 + 2 + 2) doubles (~2 KB) and a summary; 1000
     # leaked runs would be several MB. Allow 2 MB for allocator noise.
     assert grown < 2 << 20, f"RSS grew by {grown / 1e6:.2f} MB over 1000 runs"
+
+
+def test_a_run_releases_the_gil():
+    """While one thread is inside a run, another runs Python code. With a
+    switch interval far longer than the run, the waiting thread gets the
+    GIL only if the run released it."""
+    import sys
+    import threading
+
+    long_run = cdyn.model("pendulum", scheme="rk4", h=1e-4, t_end=20.0, every=1000)
+    inside = threading.Event()
+    done = []
+
+    def work():
+        inside.set()
+        done.append(cdyn.run(long_run))
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1000.0)
+    try:
+        t = threading.Thread(target=work)
+        t.start()
+        inside.wait()
+        turns = 0
+        while t.is_alive():
+            turns += 1
+            t.join(0.0005)
+    finally:
+        sys.setswitchinterval(interval)
+    assert done and done[0].t[-1] == 20.0
+    assert turns >= 10, f"the other thread ran only {turns} times during the run"
