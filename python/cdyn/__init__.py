@@ -67,11 +67,13 @@ class Result:
         err: the error of the first observable against the reference, or
             None without a reference.
         q, v: coordinates and velocities at each sample (samples × n).
+        lam: the Lagrange multipliers λ (Eq. 7) at each sampled state
+            (samples × m) when the run was asked for them, else None.
         summary: the case's entry of ``summary.json`` (a plain dict).
         error: None when the run finished; else the CLI's one-line message.
     """
 
-    __slots__ = ("name", "columns", "table", "q", "v", "summary", "error")
+    __slots__ = ("name", "columns", "table", "q", "v", "lam", "summary", "error")
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.summary: Dict[str, Any] = json.loads(raw["summary"])
@@ -80,9 +82,11 @@ class Result:
         self.table: np.ndarray = raw["values"]
         self.q: np.ndarray = raw["q"]
         self.v: np.ndarray = raw["v"]
+        self.lam: Optional[np.ndarray] = raw["lambda"]
         self.error: Optional[str] = raw["error"]
-        for a in (self.table, self.q, self.v):
-            a.flags.writeable = False
+        for a in (self.table, self.q, self.v, self.lam):
+            if a is not None:
+                a.flags.writeable = False
 
     def column(self, name: str) -> np.ndarray:
         """The column ``name`` of ``table`` (e.g. ``"X"``, ``"phi"``)."""
@@ -234,14 +238,15 @@ def scenario(source: ScenarioLike) -> Scenario:
     return load(source)
 
 
-def run(source: ScenarioLike, *, check: bool = True) -> Result:
-    """Runs the scenario as ``cdyn run`` does (without writing files).
+def run(source: ScenarioLike, *, check: bool = True, multipliers: bool = False) -> Result:
+    """Runs the scenario as ``cdyn run`` does (without writing files);
+    with ``multipliers``, the result's ``lam`` holds λ at every sample.
 
     A run that fails part-way raises SimulationError with the CLI's message
     (its ``result`` attribute holds what was recorded up to the failure);
     with ``check=False`` the Result is returned and its ``error`` says why.
     """
-    result = Result(_cdyn.run(scenario(source)))
+    result = Result(_cdyn.run(scenario(source), multipliers))
     if check and result.error is not None:
         e = SimulationError(result.error)
         e.result = result  # type: ignore[attr-defined]
@@ -249,10 +254,10 @@ def run(source: ScenarioLike, *, check: bool = True) -> Result:
     return result
 
 
-def compare(source: ScenarioLike) -> Dict[str, Result]:
+def compare(source: ScenarioLike, *, multipliers: bool = False) -> Dict[str, Result]:
     """Runs the scenario's model under every method of ``cdyn compare``:
     method name → Result (failed methods carry their ``error``)."""
-    return {r.name: r for r in map(Result, _cdyn.compare(scenario(source)))}
+    return {r.name: r for r in map(Result, _cdyn.compare(scenario(source), multipliers))}
 
 
 def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:
@@ -262,7 +267,7 @@ def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:
     return Sweep(_cdyn.run_sweep(scenario(source), threads))
 
 
-def example1() -> Dict[str, Result]:
+def example1(*, multipliers: bool = False) -> Dict[str, Result]:
     """The paper's Example 1 as ``cdyn paper`` runs it (AB-3, h = 0.01,
     t ∈ [0, 20]): case name → Result."""
-    return {r.name: r for r in map(Result, _cdyn.paper_cases())}
+    return {r.name: r for r in map(Result, _cdyn.paper_cases(multipliers))}

@@ -127,3 +127,19 @@ def test_to_pandas(tmp_path):
     df = r.to_pandas()
     assert isinstance(df, pd.DataFrame) and list(df.columns[: len(r.columns)]) == r.columns
     assert same_bits(df["phi"].to_numpy(), r.phi)
+
+
+def test_multipliers_are_the_pendulum_tension():
+    # Unit mass, length and gravity; Φ = (X² + Y² − 1)/2, so Φ_q = (X, Y) and
+    # M a = G − Φ_qᵀ λ with X·a + |v|² = 0 give λ = (|v|² − g Y) / (X² + Y²).
+    r = cdyn.run(cdyn.model("pendulum", scheme="rk4", h=0.01, t_end=2.0), multipliers=True)
+    assert r.lam.shape == (r.table.shape[0], 1)
+    (x, y), (vx, vy) = r.q.T, r.v.T
+    expected = (vx**2 + vy**2 - y) / (x**2 + y**2)
+    assert np.allclose(r.lam[:, 0], expected, rtol=1e-12, atol=1e-12)
+    assert cdyn.run(cdyn.model("pendulum", h=0.01, t_end=0.1)).lam is None
+
+
+def test_multipliers_of_a_mechanism_have_one_column_per_constraint():
+    r = cdyn.run(cdyn.load(EXAMPLES / "four_bar.toml"), multipliers=True)
+    assert r.lam.shape[0] == r.table.shape[0] and r.lam.shape[1] > 0 and np.isfinite(r.lam).all()

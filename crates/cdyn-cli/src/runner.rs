@@ -217,6 +217,9 @@ pub struct Rows {
     pub q: Vec<f64>,
     /// `v` at each sample, one after another.
     pub v: Vec<f64>,
+    /// The time of each sample as the integrator reached it (`t` in the
+    /// rows is written as people write it: 0.3, not 0.30000000000000004).
+    pub t_exact: Vec<f64>,
 }
 
 impl Sink for &mut Rows {
@@ -231,10 +234,10 @@ impl Sink for &mut Rows {
 /// interrupts): the Python package's run.
 pub fn run_case_in_memory(case: &Case) -> (CaseResult, Rows) {
     let mut rows = Rows { columns: columns(&case.example), ..Rows::default() };
-    let mut states = (Vec::new(), Vec::new());
+    let mut states = States::default();
     let recorder = Recorder::example(&case.example).keep_series(false).sink(&mut rows);
     let Ok(record) = simulate(case, recorder, Watch::Nothing, Some(&mut states));
-    (rows.q, rows.v) = states;
+    (rows.t_exact, rows.q, rows.v) = (states.t, states.q, states.v);
     (CaseResult::new(case, record), rows)
 }
 
@@ -267,8 +270,13 @@ enum Watch<'p> {
     Interrupts(&'p ProgressBar),
 }
 
-/// `q` and `v` at each sample, one after another, where they are kept.
-type States<'s> = Option<&'s mut (Vec<f64>, Vec<f64>)>;
+/// The time, `q` and `v` of each sample, one after another.
+#[derive(Default)]
+struct States {
+    t: Vec<f64>,
+    q: Vec<f64>,
+    v: Vec<f64>,
+}
 
 /// Runs `case` into `recorder` (and `states`); an error of the simulation,
 /// also one starting it, is kept in the record, an error of the sink returned.
@@ -276,7 +284,7 @@ fn simulate<K: Sink>(
     case: &Case,
     recorder: Recorder<'_, K>,
     watch: Watch<'_>,
-    states: States<'_>,
+    states: Option<&mut States>,
 ) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
@@ -308,13 +316,14 @@ fn drive<S: System, K: Sink>(
     t_end: f64,
     every: u64,
     watch: Watch<'_>,
-    mut states: States<'_>,
+    mut states: Option<&mut States>,
 ) -> Result<(Record, bool), K::Error> {
     // A sample of the recorder, and of `q` and `v` where they are kept.
     let mut sample = |recorder: &mut Recorder<'_, K>, sim: &mut Stepper<S>| {
-        if let Some((q, v)) = states.as_deref_mut() {
-            q.extend_from_slice(sim.q());
-            v.extend_from_slice(sim.v());
+        if let Some(s) = states.as_deref_mut() {
+            s.t.push(sim.t());
+            s.q.extend_from_slice(sim.q());
+            s.v.extend_from_slice(sim.v());
         }
         recorder.sample(sim)
     };

@@ -150,10 +150,12 @@ fn to_toml(value: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
 
 /// What a run hands to Python: the summary entry (JSON text, as in
 /// `summary.json`), the column names, and the samples as flat arrays.
-fn to_python<'py>(py: Python<'py>, result: &CaseResult, rows: Rows) -> PyResult<Bound<'py, PyDict>> {
+fn to_python<'py>(py: Python<'py>, (result, rows, lambda): Done) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let summary = serde_json::to_string(result).map_err(|e| Error::new_err(e.to_string()))?;
+    let summary = serde_json::to_string(&result).map_err(|e| Error::new_err(e.to_string()))?;
     d.set_item("summary", summary)?;
+    let lambda = lambda.map(|(values, m)| PyArray1::from_vec(py, values).reshape([rows.t_exact.len(), m])).transpose()?;
+    d.set_item("lambda", lambda)?;
     d.set_item("error", result.error.clone())?;
     let (width, n) = (rows.columns.len(), result.record.q_end.len().max(1));
     d.set_item("columns", rows.columns)?;
@@ -165,34 +167,65 @@ fn to_python<'py>(py: Python<'py>, result: &CaseResult, rows: Rows) -> PyResult<
     Ok(d)
 }
 
-/// Runs `cases` in turn with the GIL released.
-fn run_all<'py>(py: Python<'py>, cases: Vec<Case>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let done = py.detach(move || cases.iter().map(run_case_in_memory).collect::<Vec<_>>());
-    done.into_iter().map(|(result, rows)| to_python(py, &result, rows)).collect()
+/// A finished run: its summary, its samples, and where asked the multipliers
+/// λ at each sample with their count per sample.
+type Done = (CaseResult, Rows, Option<(Vec<f64>, usize)>);
+
+/// Runs `cases` in turn with the GIL released; with `multipliers`, λ at every sample too.
+fn run_all<'py>(py: Python<'py>, cases: Vec<Case>, multipliers: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let done = py.detach(move || {
+        let run = |case: &Case| {
+            let (result, rows) = run_case_in_memory(case);
+            let lambda = multipliers.then(|| (lambda_at_samples(case, &rows), case.example.model.m()));
+            (result, rows, lambda)
+        };
+        cases.iter().map(run).collect::<Vec<Done>>()
+    });
+    done.into_iter().map(|d| to_python(py, d)).collect()
+}
+
+/// The Lagrange multipliers λ of Eq. 7 at each sampled state (t, q, v), one
+/// row of `m` per sample, NaN where the dynamics cannot be evaluated there.
+fn lambda_at_samples(case: &Case, rows: &Rows) -> Vec<f64> {
+    let model = &case.example.model;
+    let (n, m) = (model.n(), model.m());
+    let mut dynamics = cdyn::dynamics::Dynamics::new(model);
+    let mut out = Vec::with_capacity(rows.t_exact.len() * m);
+    for (k, &t) in rows.t_exact.iter().enumerate() {
+        let (q, v) = (&rows.q[k * n..(k + 1) * n], &rows.v[k * n..(k + 1) * n]);
+        match dynamics.evaluate(model, q, v, t) {
+            Ok(()) => out.extend_from_slice(dynamics.lambda()),
+            Err(_) => out.extend(std::iter::repeat_n(f64::NAN, m)),
+        }
+    }
+    out
 }
 
 /// Runs the scenario as `cdyn run` does; returns the raw result (see `cdyn.run`).
 #[pyfunction]
-fn run<'py>(py: Python<'py>, scenario: &Scenario) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (scenario, multipliers = false))]
+fn run<'py>(py: Python<'py>, scenario: &Scenario, multipliers: bool) -> PyResult<Bound<'py, PyDict>> {
     let case = scenario.case().map_err(scenario_error)?;
-    let mut all = run_all(py, vec![case])?;
+    let mut all = run_all(py, vec![case], multipliers)?;
     Ok(all.remove(0))
 }
 
 /// Runs the scenario under every method of `cdyn compare`.
 #[pyfunction]
-fn compare<'py>(py: Python<'py>, scenario: &Scenario) -> PyResult<Vec<Bound<'py, PyDict>>> {
+#[pyo3(signature = (scenario, multipliers = false))]
+fn compare<'py>(py: Python<'py>, scenario: &Scenario, multipliers: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let path = scenario.path();
     scenario.parsed.refuse_sweep(&path, "compare").map_err(scenario_error)?;
     let cases = cdyn_cli::compare::cases(&scenario.parsed, &path).map_err(scenario_error)?;
-    run_all(py, cases)
+    run_all(py, cases, multipliers)
 }
 
 /// Runs every case of the paper's Example 1 (`cdyn paper`).
 #[pyfunction]
-fn paper_cases<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+#[pyo3(signature = (multipliers = false))]
+fn paper_cases<'py>(py: Python<'py>, multipliers: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let cases = paper::cases().map_err(scenario_error)?;
-    run_all(py, cases)
+    run_all(py, cases, multipliers)
 }
 
 /// Runs the scenario's `[sweep]` grid on `threads` threads (one per core by
