@@ -22,3 +22,19 @@ def test_the_readme_example_runs_and_prints_what_it_says():
         os.chdir(here)
     printed = out.getvalue().splitlines()
     assert printed[0].startswith("9.525") and printed[-1] == "<dict>: [integrator] invalid h = 0: must be finite and positive"
+
+
+def test_the_paper_figures_example_draws_figs_3_to_5(tmp_path):
+    import subprocess
+    import sys
+
+    import pytest
+
+    pytest.importorskip("matplotlib")
+    out = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "paper_figures.py"), str(tmp_path)], capture_output=True, text=True
+    )
+    assert out.returncode == 0, out.stderr
+    for stem in ("fig3_phi", "fig4_psi", "fig5_err_x"):
+        assert (tmp_path / f"{stem}.png").stat().st_size > 10_000
+    assert "cvsgf_energy" in out.stdout
