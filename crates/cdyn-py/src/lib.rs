@@ -154,7 +154,8 @@ fn to_python<'py>(py: Python<'py>, (result, rows, lambda): Done) -> PyResult<Bou
     let d = PyDict::new(py);
     let summary = serde_json::to_string(&result).map_err(|e| Error::new_err(e.to_string()))?;
     d.set_item("summary", summary)?;
-    let lambda = lambda.map(|(values, m)| PyArray1::from_vec(py, values).reshape([rows.t_exact.len(), m])).transpose()?;
+    let lambda =
+        lambda.map(|(values, m)| PyArray1::from_vec(py, values).reshape([rows.t_exact.len(), m])).transpose()?;
     d.set_item("lambda", lambda)?;
     d.set_item("error", result.error.clone())?;
     let (width, n) = (rows.columns.len(), result.record.q_end.len().max(1));
