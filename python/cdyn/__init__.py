@@ -238,15 +238,17 @@ def scenario(source: ScenarioLike) -> Scenario:
     return load(source)
 
 
-def run(source: ScenarioLike, *, check: bool = True, multipliers: bool = False) -> Result:
+def run(source: ScenarioLike, *, check: bool = True, multipliers: bool = False, force: bool = False) -> Result:
     """Runs the scenario as ``cdyn run`` does (without writing files);
     with ``multipliers``, the result's ``lam`` holds λ at every sample.
+    A run whose samples would take more than 2 GB of memory is refused
+    (ScenarioError, naming the ``[output] every`` that fits) unless ``force``.
 
     A run that fails part-way raises SimulationError with the CLI's message
     (its ``result`` attribute holds what was recorded up to the failure);
     with ``check=False`` the Result is returned and its ``error`` says why.
     """
-    result = Result(_cdyn.run(scenario(source), multipliers))
+    result = Result(_cdyn.run(scenario(source), multipliers, force))
     if check and result.error is not None:
         e = SimulationError(result.error)
         e.result = result  # type: ignore[attr-defined]
@@ -254,10 +256,10 @@ def run(source: ScenarioLike, *, check: bool = True, multipliers: bool = False) 
     return result
 
 
-def compare(source: ScenarioLike, *, multipliers: bool = False) -> Dict[str, Result]:
+def compare(source: ScenarioLike, *, multipliers: bool = False, force: bool = False) -> Dict[str, Result]:
     """Runs the scenario's model under every method of ``cdyn compare``:
     method name → Result (failed methods carry their ``error``)."""
-    return {r.name: r for r in map(Result, _cdyn.compare(scenario(source), multipliers))}
+    return {r.name: r for r in map(Result, _cdyn.compare(scenario(source), multipliers, force))}
 
 
 def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:

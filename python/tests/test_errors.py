@@ -149,3 +149,12 @@ def test_other_bad_calls_raise_python_errors():
     with pytest.raises(cdyn.ScenarioError, match="kind"):
         cdyn.model("pendulumm")
     assert issubclass(cdyn.ScenarioError, cdyn.Error) and issubclass(cdyn.SimulationError, cdyn.Error)
+
+
+def test_a_run_too_large_for_memory_is_refused_before_it_starts():
+    # 1e9 steps of the pendulum: about 100 GB of samples at every = 1.
+    huge = cdyn.model("pendulum", scheme="rk4", h=1e-8, t_end=10.0)
+    with pytest.raises(cdyn.ScenarioError, match=r"GB of samples in memory .* every = 1\b.*every = 100 or larger, or pass force=True"):
+        cdyn.run(huge)
+    with pytest.raises(cdyn.ScenarioError, match="force=True"):
+        cdyn.compare(huge)

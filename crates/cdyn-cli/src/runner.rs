@@ -85,10 +85,7 @@ impl Estimate {
         if force || worst <= OUTPUT_LIMIT {
             return Ok(());
         }
-        let suggest = (every as f64 * worst as f64 / OUTPUT_LIMIT as f64).ceil() as u64;
-        // Rounded up to a power of ten: a value a user would write.
-        let power = 10u64.saturating_pow(suggest.max(1).ilog10());
-        let suggest = if power < suggest { power.saturating_mul(10) } else { power };
+        let suggest = every_to_fit(every, worst);
         anyhow::bail!(
             "{file}: the run would write about {:.1} GB of CSV ({} rows at [output] every = {every}), above the limit of {} GB; set [output] every = {suggest} or larger, or pass --force",
             self.csv_bytes as f64 / 1e9,
@@ -96,6 +93,14 @@ impl Estimate {
             OUTPUT_LIMIT / 1_000_000_000
         )
     }
+}
+
+/// The `[output] every` that brings `bytes`, written or kept at `every`,
+/// under [`OUTPUT_LIMIT`], rounded up to a power of ten (a value a user would write).
+pub fn every_to_fit(every: u64, bytes: u64) -> u64 {
+    let suggest = (every as f64 * bytes as f64 / OUTPUT_LIMIT as f64).ceil() as u64;
+    let power = 10u64.saturating_pow(suggest.max(1).ilog10());
+    if power < suggest { power.saturating_mul(10) } else { power }
 }
 
 /// What a case produced, as `summary.json` reports it: the case, then the

@@ -7,7 +7,7 @@
 //! Every run happens with the GIL released; failures become `cdyn.Error`
 //! subclasses carrying the CLI's one-line message, never a crash.
 
-use cdyn_cli::runner::{Case, CaseResult, Rows, run_case_in_memory};
+use cdyn_cli::runner::{Case, CaseResult, Estimate, OUTPUT_LIMIT, Rows, columns, every_to_fit, run_case_in_memory};
 use cdyn_cli::{paper, scenario, sweep};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
@@ -172,6 +172,29 @@ fn to_python<'py>(py: Python<'py>, (result, rows, lambda): Done) -> PyResult<Bou
 /// λ at each sample with their count per sample.
 type Done = (CaseResult, Rows, Option<(Vec<f64>, usize)>);
 
+/// Refuses cases whose samples would take more than [`OUTPUT_LIMIT`] of
+/// memory (unless `force`): the interpreter would run out of memory instead of
+/// raising. A sample keeps its CSV row, `q`, `v`, its time and λ where asked.
+fn check_memory(cases: &[Case], file: &str, multipliers: bool, force: bool) -> PyResult<()> {
+    let bytes = |c: &Case| {
+        let rows = Estimate::of(std::slice::from_ref(c)).rows;
+        let model = &c.example.model;
+        let per_row = columns(&c.example).len() + 2 * model.n() + 1 + if multipliers { model.m() } else { 0 };
+        rows.saturating_mul(8 * per_row as u64)
+    };
+    let total = cases.iter().map(bytes).fold(0u64, u64::saturating_add);
+    if force || total <= OUTPUT_LIMIT {
+        return Ok(());
+    }
+    let every = cases.first().map_or(1, |c| c.every);
+    Err(ScenarioError::new_err(format!(
+        "{file}: the run would keep about {:.1} GB of samples in memory at [output] every = {every}, above the limit of {} GB; set [output] every = {} or larger, or pass force=True",
+        total as f64 / 1e9,
+        OUTPUT_LIMIT / 1_000_000_000,
+        every_to_fit(every, total)
+    )))
+}
+
 /// Runs `cases` in turn with the GIL released; with `multipliers`, λ at every sample too.
 fn run_all<'py>(py: Python<'py>, cases: Vec<Case>, multipliers: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let done = py.detach(move || {
@@ -204,20 +227,27 @@ fn lambda_at_samples(case: &Case, rows: &Rows) -> Vec<f64> {
 
 /// Runs the scenario as `cdyn run` does; returns the raw result (see `cdyn.run`).
 #[pyfunction]
-#[pyo3(signature = (scenario, multipliers = false))]
-fn run<'py>(py: Python<'py>, scenario: &Scenario, multipliers: bool) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (scenario, multipliers = false, force = false))]
+fn run<'py>(py: Python<'py>, scenario: &Scenario, multipliers: bool, force: bool) -> PyResult<Bound<'py, PyDict>> {
     let case = scenario.case().map_err(scenario_error)?;
+    check_memory(std::slice::from_ref(&case), &scenario.file, multipliers, force)?;
     let mut all = run_all(py, vec![case], multipliers)?;
     Ok(all.remove(0))
 }
 
 /// Runs the scenario under every method of `cdyn compare`.
 #[pyfunction]
-#[pyo3(signature = (scenario, multipliers = false))]
-fn compare<'py>(py: Python<'py>, scenario: &Scenario, multipliers: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
+#[pyo3(signature = (scenario, multipliers = false, force = false))]
+fn compare<'py>(
+    py: Python<'py>,
+    scenario: &Scenario,
+    multipliers: bool,
+    force: bool,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let path = scenario.path();
     scenario.parsed.refuse_sweep(&path, "compare").map_err(scenario_error)?;
     let cases = cdyn_cli::compare::cases(&scenario.parsed, &path).map_err(scenario_error)?;
+    check_memory(&cases, &scenario.file, multipliers, force)?;
     run_all(py, cases, multipliers)
 }
 
