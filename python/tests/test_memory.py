@@ -74,3 +74,27 @@ def test_a_run_releases_the_gil():
         sys.setswitchinterval(interval)
     assert done and done[0].t[-1] == 20.0
     assert turns >= 10, f"the other thread ran only {turns} times during the run"
+
+
+def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt():
+    import os
+    import signal
+    import threading
+    import time
+
+    # 4·10^8 steps, minutes of work: stopped by the interrupt after 0.2 s, it
+    # returns in well under the bound; ignoring it, the run would finish
+    # first (and the KeyboardInterrupt come only after) in far more.
+    long_run = cdyn.model("pendulum", scheme="rk4", h=1e-6, t_end=400.0, every=1000000)
+    timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        cdyn.run(long_run)
+        raise AssertionError("the run was not interrupted")
+    except KeyboardInterrupt:
+        pass
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 30.0, "the run went on after Ctrl-C"
+    assert cdyn.run(SMALL).error is None  # and the next run is unaffected

@@ -235,13 +235,14 @@ impl Sink for &mut Rows {
     }
 }
 
-/// Runs `case` keeping every sample in memory (no files, no progress, no
-/// interrupts): the Python package's run.
-pub fn run_case_in_memory(case: &Case) -> (CaseResult, Rows) {
+/// Runs `case` keeping every sample in memory (no files, no progress bar):
+/// the Python package's run. `stop` is asked every few thousand steps
+/// whether to stop (Ctrl-C in Python); a stopped run is marked interrupted.
+pub fn run_case_in_memory(case: &Case, stop: &dyn Fn() -> bool) -> (CaseResult, Rows) {
     let mut rows = Rows { columns: columns(&case.example), ..Rows::default() };
     let mut states = States::default();
     let recorder = Recorder::example(&case.example).keep_series(false).sink(&mut rows);
-    let Ok(record) = simulate(case, recorder, Watch::Nothing, Some(&mut states));
+    let Ok(record) = simulate(case, recorder, Watch::Asking(stop), Some(&mut states));
     (rows.t_exact, rows.q, rows.v) = (states.t, states.q, states.v);
     (CaseResult::new(case, record), rows)
 }
@@ -273,6 +274,8 @@ pub fn run_case_quietly(case: &Case) -> CaseResult {
 enum Watch<'p> {
     Nothing,
     Interrupts(&'p ProgressBar),
+    /// Stops when this says so, asked every [`progress::STEPS_PER_TICK`] steps.
+    Asking(&'p dyn Fn() -> bool),
 }
 
 /// The time, `q` and `v` of each sample, one after another.
@@ -340,7 +343,7 @@ fn drive<S: System, K: Sink>(
     // Where this case's steps start on a bar shared by several cases.
     let start = match watch {
         Watch::Interrupts(progress) => progress.position(),
-        Watch::Nothing => 0,
+        Watch::Nothing | Watch::Asking(_) => 0,
     };
     sample(&mut recorder, sim)?;
     let mut sampled = sim.steps();
@@ -350,7 +353,12 @@ fn drive<S: System, K: Sink>(
         {
             progress.set_position(start + sim.steps());
         }
-        if matches!(watch, Watch::Interrupts(_)) && interrupt::requested().is_some() {
+        let stop = match watch {
+            Watch::Nothing => false,
+            Watch::Interrupts(_) => interrupt::requested().is_some(),
+            Watch::Asking(stop) => sim.steps().is_multiple_of(progress::STEPS_PER_TICK) && stop(),
+        };
+        if stop {
             if sampled != sim.steps() {
                 sample(&mut recorder, sim)?;
             }

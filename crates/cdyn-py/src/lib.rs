@@ -197,14 +197,31 @@ fn check_memory(cases: &[Case], file: &str, multipliers: bool, force: bool) -> P
 
 /// Runs `cases` in turn with the GIL released; with `multipliers`, λ at every sample too.
 fn run_all<'py>(py: Python<'py>, cases: Vec<Case>, multipliers: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let done = py.detach(move || {
-        let run = |case: &Case| {
-            let (result, rows) = run_case_in_memory(case);
+    // Ctrl-C: Python's signal handlers run only when asked, so a run asks
+    // every few thousand steps (taking the GIL for a moment) and keeps the
+    // KeyboardInterrupt to raise when it has stopped.
+    let interrupt = std::sync::Mutex::new(None::<PyErr>);
+    let stop = || {
+        Python::attach(|py| py.check_signals())
+            .map_err(|e| *interrupt.lock().unwrap_or_else(|p| p.into_inner()) = Some(e))
+            .is_err()
+    };
+    let done = py.detach(|| {
+        let mut done = Vec::new();
+        for case in &cases {
+            let (result, rows) = run_case_in_memory(case, &stop);
             let lambda = multipliers.then(|| (lambda_at_samples(case, &rows), case.example.model.m()));
-            (result, rows, lambda)
-        };
-        cases.iter().map(run).collect::<Vec<Done>>()
+            let interrupted = result.interrupted;
+            done.push((result, rows, lambda));
+            if interrupted {
+                break;
+            }
+        }
+        done
     });
+    if let Some(e) = interrupt.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
     done.into_iter().map(|d| to_python(py, d)).collect()
 }
 
