@@ -143,3 +143,17 @@ def test_multipliers_are_the_pendulum_tension():
 def test_multipliers_of_a_mechanism_have_one_column_per_constraint():
     r = cdyn.run(cdyn.load(EXAMPLES / "four_bar.toml"), multipliers=True)
     assert r.lam.shape[0] == r.table.shape[0] and r.lam.shape[1] > 0 and np.isfinite(r.lam).all()
+
+
+def test_numpy_numbers_in_a_dict_and_the_toml_round_trip():
+    data = {
+        "model": {"kind": "pendulum"},
+        "integrator": {"scheme": "rk4", "h": np.float64(0.01), "t_end": np.float32(0.5)},
+        "output": {"every": np.int64(5)},
+    }
+    s = cdyn.from_dict(data)
+    r = cdyn.run(s)
+    assert r.table.shape[0] == 11 and r.summary["h"] == 0.01
+    again = cdyn.loads(s.to_toml())
+    assert same_bits(cdyn.run(again).table, r.table)
+    assert s.file == "<dict>" and not s.has_sweep and "<dict>" in repr(s)

@@ -140,8 +140,11 @@ fn to_toml(value: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
     } else if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
         let items = value.try_iter()?.enumerate().map(|(i, v)| to_toml(&v?, &format!("{at}[{i}]")));
         Ok(toml::Value::Array(items.collect::<PyResult<_>>()?))
+    } else if let Ok(i) = value.extract::<i64>() {
+        // NumPy's integers and other integers (through `__index__`).
+        Ok(toml::Value::Integer(i))
     } else if let Ok(x) = value.extract::<f64>() {
-        // NumPy scalars and other numbers.
+        // NumPy's floats and other numbers.
         Ok(toml::Value::Float(x))
     } else {
         Err(unsupported())
