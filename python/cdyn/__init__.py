@@ -73,7 +73,17 @@ class Result:
         error: None when the run finished; else the CLI's one-line message.
     """
 
-    __slots__ = ("name", "columns", "table", "q", "v", "lam", "summary", "error")
+    # Documented slots: editors show these on the attributes.
+    __slots__ = {
+        "name": "The case's name (the CSV file's stem in the CLI).",
+        "columns": "The CSV header: t, the observables, phi, psi, err_<observable> with a reference.",
+        "table": "Every sample, one row each, in the order of columns (the CSV's values, bit for bit).",
+        "q": "Coordinates at each sample (samples × n).",
+        "v": "Velocities at each sample (samples × n).",
+        "lam": "Lagrange multipliers λ at each sample (samples × m), or None unless asked for.",
+        "summary": "The case's summary.json entry, a plain dict.",
+        "error": "None when the run finished, else the CLI's one-line message.",
+    }
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.summary: Dict[str, Any] = json.loads(raw["summary"])
@@ -94,26 +104,32 @@ class Result:
 
     @property
     def t(self) -> np.ndarray:
+        """Sample times (as the CSV writes them: 0.3, not 0.30000000000000004)."""
         return self.table[:, 0]
 
     @property
     def observable_names(self) -> List[str]:
+        """Names of the observables (e.g. ``X, Y, VX, VY``; a mechanism's coordinates)."""
         return self.columns[1 : self.columns.index("phi")]
 
     @property
     def observables(self) -> np.ndarray:
+        """The observables at each sample (samples × observables)."""
         return self.table[:, 1 : self.columns.index("phi")]
 
     @property
     def phi(self) -> np.ndarray:
+        """The constraint value of largest magnitude at each sample, with its sign."""
         return self.column("phi")
 
     @property
     def psi(self) -> np.ndarray:
+        """The energy constraint Ψ at each sample."""
         return self.column("psi")
 
     @property
     def err(self) -> Optional[np.ndarray]:
+        """The error of the first observable against the reference, or None without one."""
         last = self.columns[-1]
         return self.column(last) if last.startswith("err_") else None
 
@@ -141,7 +157,7 @@ class Sweep:
     values and worst violations and errors as NumPy arrays (one entry per
     grid point, last axis fastest)."""
 
-    __slots__ = ("summary",)
+    __slots__ = {"summary": "sweep.json as a dict: scenario, scenario_hash, axes, points."}
 
     def __init__(self, text: str) -> None:
         self.summary: Dict[str, Any] = json.loads(text)
@@ -161,10 +177,12 @@ class Sweep:
 
     @property
     def max_abs_phi(self) -> np.ndarray:
+        """Largest |Φ| of each point's run."""
         return self._field("max_abs_phi")
 
     @property
     def max_abs_psi(self) -> np.ndarray:
+        """Largest |Ψ| of each point's run."""
         return self._field("max_abs_psi")
 
     @property

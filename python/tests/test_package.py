@@ -2,6 +2,7 @@
 
 import ast
 import doctest
+import inspect
 import pathlib
 
 import cdyn
@@ -26,3 +27,11 @@ def test_stubs_name_exactly_what_the_native_module_has():
 def test_every_public_name_is_documented():
     for name in cdyn.__all__:
         assert getattr(cdyn, name).__doc__, name
+
+
+def test_every_method_and_property_of_the_results_is_documented():
+    for cls in (cdyn.Result, cdyn.Sweep, cdyn.Scenario):
+        for name, attr in vars(cls).items():
+            if not name.startswith("_") and (callable(attr) or isinstance(attr, property) or hasattr(attr, "__get__")):
+                # inspect.getdoc, as help() and editors: it finds a slot's doc in __slots__.
+                assert inspect.getdoc(getattr(cls, name)), f"{cls.__name__}.{name}"
