@@ -4,6 +4,7 @@
 mod alloc_count;
 mod bench;
 mod compare;
+mod frames;
 mod heatmap;
 mod interrupt;
 mod output;
@@ -17,6 +18,7 @@ mod suite;
 mod suite_plot;
 mod sweep;
 mod terminal;
+mod viewer;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -56,6 +58,8 @@ enum Command {
         /// Run even if the CSV output would exceed 2 GB.
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        viewer: viewer::ViewerArgs,
     },
     /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
     Bench {
@@ -115,6 +119,8 @@ enum Command {
         /// Run even if the CSV output would exceed 2 GB.
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        viewer: viewer::ViewerArgs,
     },
 }
 
@@ -212,7 +218,7 @@ fn run(cli: Cli) -> Result<Ended> {
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)
         }
-        Command::Run { scenario, out, force } => {
+        Command::Run { scenario, out, force, viewer } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "run")?;
             let case = parsed.case(&scenario)?;
@@ -235,6 +241,7 @@ fn run(cli: Cli) -> Result<Ended> {
             });
             report::write_summary(&out, &results, extra)?;
             report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
+            viewer.write(&out, &results[0].name, std::slice::from_ref(&case), &results)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)
@@ -275,7 +282,7 @@ fn run(cli: Cli) -> Result<Ended> {
                 .collect::<Result<Vec<_>>>()?;
             write_sweep(&sweep::merge(parts)?, &out, listing.listing()).map(|()| Ended::Done)
         }
-        Command::Compare { scenario, out, force } => {
+        Command::Compare { scenario, out, force, viewer } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
             let cases = compare::cases(&parsed, &scenario)?;
@@ -285,6 +292,8 @@ fn run(cli: Cli) -> Result<Ended> {
             output::clear(&out, &report::file_names(&cases, report::RUN_FIGURES))?;
             interrupt::install();
             let results = compare::run(&cases, &scenario, &out)?;
+            let stem = scenario.file_stem().map_or("compare".into(), |s| s.to_string_lossy().into_owned());
+            viewer.write(&out, &stem, &cases, &results)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)

@@ -2,6 +2,7 @@
 //! per sample, written as the run goes so that a run which fails keeps what
 //! it wrote, plus the series and statistics the summary and figures need.
 
+use crate::frames::Frames;
 use crate::interrupt;
 use crate::output::AtomicFile;
 use crate::progress;
@@ -29,6 +30,8 @@ pub struct Case {
     /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
     /// where the model comes from entries; errors name it instead of the row.
     pub row_entries: Vec<String>,
+    /// What the mechanism looks like, for the viewer; `None` for models without a drawing.
+    pub drawing: Option<cdyn::planar::Drawing>,
 }
 
 impl Case {
@@ -120,6 +123,9 @@ pub struct CaseResult {
     pub error: Option<String>,
     /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
     pub interrupted: bool,
+    /// Positions at some samples, for the viewer (kept when the case has a drawing).
+    #[serde(skip)]
+    pub frames: Frames,
 }
 
 /// What a run reports of its method besides the record.
@@ -129,6 +135,7 @@ struct Method {
     control: Option<cdyn::Control>,
     tuning: Option<cdyn::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
+    frames: Frames,
 }
 
 /// The series of a run that kept none (sweeps).
@@ -151,6 +158,7 @@ impl CaseResult {
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
             interrupted: method.interrupted,
+            frames: method.frames,
         }
     }
 
@@ -230,9 +238,13 @@ enum Watch<'p> {
 /// starting it, is kept in the record, an error of the sink returned.
 fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch<'_>) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
+    let mut frames = match watch {
+        Watch::Interrupts(_) if case.drawing.is_some() => Frames::of(ex.model.n()),
+        _ => Frames::none(),
+    };
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
-            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch)?;
+            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch, &mut frames)?;
             let method = Method {
                 interrupted,
                 control: Some(sim.settings().control),
@@ -243,6 +255,7 @@ fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch<'_>) -
                     .projection
                     .is_some()
                     .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
+                frames,
             };
             Ok((record, method))
         }
@@ -252,17 +265,37 @@ fn simulate<K: Sink>(case: &Case, recorder: Recorder<'_, K>, watch: Watch<'_>) -
 
 /// [`Recorder::run`], step by step so that an interrupt stops the run
 /// between two steps: the state it stopped at is sampled too (a complete
-/// CSV row), and the record says it was interrupted.
+/// CSV row), and the record says it was interrupted. `frames` is offered
+/// every sample, and the state it ends at.
 fn drive<S: System, K: Sink>(
     sim: &mut Stepper<S>,
     mut recorder: Recorder<'_, K>,
     t_end: f64,
     every: u64,
     watch: Watch<'_>,
+    frames: &mut Frames,
 ) -> Result<(Record, bool), K::Error> {
+    let (error, interrupted) = drive_frames(sim, &mut recorder, t_end, every, watch, frames)?;
+    frames.end(sim.t(), sim.q());
+    let mut record = recorder.finish(sim);
+    if error.is_some() {
+        record.error = error;
+    }
+    Ok((record, interrupted))
+}
+
+/// [`drive`] until the run ends; returns the simulation's error, if any, and whether it was interrupted.
+fn drive_frames<S: System, K: Sink>(
+    sim: &mut Stepper<S>,
+    recorder: &mut Recorder<'_, K>,
+    t_end: f64,
+    every: u64,
+    watch: Watch<'_>,
+    frames: &mut Frames,
+) -> Result<(Option<cdyn::Error>, bool), K::Error> {
     let steps = match steps_to(t_end, sim.settings().h) {
         Ok(n) => n,
-        Err(e) => return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false)),
+        Err(e) => return Ok((Some(e), false)),
     };
     let every = every.max(1);
     // Where this case's steps start on a bar shared by several cases.
@@ -270,7 +303,7 @@ fn drive<S: System, K: Sink>(
         Watch::Interrupts(progress) => progress.position(),
         Watch::Nothing => 0,
     };
-    recorder.sample(sim)?;
+    sample(recorder, sim, frames)?;
     let mut sampled = sim.steps();
     while sim.steps() < steps {
         if let Watch::Interrupts(progress) = watch
@@ -280,21 +313,32 @@ fn drive<S: System, K: Sink>(
         }
         if matches!(watch, Watch::Interrupts(_)) && interrupt::requested().is_some() {
             if sampled != sim.steps() {
-                recorder.sample(sim)?;
+                sample(recorder, sim, frames)?;
             }
-            return Ok((recorder.finish(sim), true));
+            return Ok((None, true));
         }
         if let Err(e) = sim.step() {
-            return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false));
+            return Ok((Some(e), false));
         }
         let n = sim.steps();
         if n.is_multiple_of(every) || n == steps {
-            recorder.sample(sim)?;
+            sample(recorder, sim, frames)?;
             sampled = n;
         }
     }
     if let Watch::Interrupts(progress) = watch {
         progress.set_position(start + steps);
     }
-    Ok((recorder.finish(sim), false))
+    Ok((None, false))
+}
+
+/// Samples `sim` into `recorder` and offers its positions to `frames`.
+fn sample<S: System, K: Sink>(
+    recorder: &mut Recorder<'_, K>,
+    sim: &mut Stepper<S>,
+    frames: &mut Frames,
+) -> Result<(), K::Error> {
+    recorder.sample(sim)?;
+    frames.push(sim.t(), sim.q());
+    Ok(())
 }
