@@ -5,6 +5,7 @@ mod alloc_count;
 mod bench;
 mod compare;
 mod frames;
+mod gif;
 mod heatmap;
 mod interrupt;
 mod output;
@@ -223,6 +224,7 @@ fn run(cli: Cli) -> Result<Ended> {
             parsed.refuse_sweep(&scenario, "run")?;
             let case = parsed.case(&scenario)?;
             case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
+            viewer.check(std::slice::from_ref(&case))?;
             runner::Estimate::of(std::slice::from_ref(&case)).check(
                 &scenario.display().to_string(),
                 case.every,
@@ -286,6 +288,7 @@ fn run(cli: Cli) -> Result<Ended> {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
             let cases = compare::cases(&parsed, &scenario)?;
+            viewer.check(&cases)?;
             let every = cases.first().map_or(1, |c| c.every);
             runner::Estimate::of(&cases).check(&scenario.display().to_string(), every, force)?;
             output_dir(&out)?;

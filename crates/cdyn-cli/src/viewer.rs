@@ -21,10 +21,26 @@ pub struct ViewerArgs {
 }
 
 impl ViewerArgs {
+    /// Refuses `--gif` for a model without a drawing, before anything runs.
+    pub fn check(self, cases: &[Case]) -> Result<()> {
+        if self.gif && cases.iter().all(|c| c.drawing.is_none()) {
+            anyhow::bail!(
+                "--gif: this model has no drawing (only mechanisms given by [[bodies]] and their elements have one)"
+            );
+        }
+        Ok(())
+    }
+
     /// Writes what was asked for into `dir`, after its `summary.json`.
     pub fn write(self, dir: &Path, title: &str, cases: &[Case], results: &[CaseResult]) -> Result<()> {
         if self.html {
             write_html(dir, title, cases, results)?;
+        }
+        if self.gif {
+            let drawn = cases.iter().zip(results).find_map(|(c, r)| Some((c.drawing.as_ref()?, &r.frames)));
+            if let Some((drawing, frames)) = drawn.filter(|(_, f)| !f.is_empty()) {
+                crate::gif::write(&dir.join(GIF), drawing, frames)?;
+            }
         }
         Ok(())
     }

@@ -95,6 +95,18 @@ impl Mechanism {
     }
 }
 
+impl Drawing {
+    /// Where `anchor` is, world axes, when the coordinates are `q`:
+    /// `x + R(θ) p` for a body's point, `p` itself for the ground's.
+    pub fn place(&self, anchor: Anchor, q: &[f64]) -> [f64; 2] {
+        let Some(b) = anchor.body.and_then(|i| self.bodies.get(i)) else { return anchor.point };
+        let angle = b.angle.map_or(0.0, |i| q[i]);
+        let (s, c) = angle.sin_cos();
+        let [px, py] = anchor.point;
+        [q[b.x] + c * px - s * py, q[b.x + 1] + s * px + c * py]
+    }
+}
+
 /// The body points an element acts at, and a prismatic joint's axis. An
 /// element on an angle is drawn at the centres of its bodies other than the ground.
 fn ends(e: &Element) -> (Vec<(BodyId, [f64; 2])>, Option<[f64; 2]>) {
@@ -141,5 +153,11 @@ mod tests {
         assert_eq!(d.links[0].ends[0], Anchor { body: None, point: [0.0, 0.0] });
         assert_eq!(d.links[1].ends, vec![Anchor { body: Some(0), point: [0.0, 0.0] }]);
         assert_eq!(d.links[2].ends[1], Anchor { body: Some(1), point: [0.0, 0.0] });
+        // The crank's free end at a quarter turn, the bob where its coordinates say, the ground fixed.
+        let q = [0.0, 0.5, std::f64::consts::FRAC_PI_2, 3.0, -1.0];
+        let end = d.place(Anchor { body: Some(0), point: [0.5, 0.0] }, &q);
+        assert!((end[0] - 0.0).abs() < 1e-15 && (end[1] - 1.0).abs() < 1e-15, "{end:?}");
+        assert_eq!(d.place(Anchor { body: Some(1), point: [0.0, 0.0] }, &q), [3.0, -1.0]);
+        assert_eq!(d.place(Anchor { body: None, point: [2.0, 7.0] }, &q), [2.0, 7.0]);
     }
 }
