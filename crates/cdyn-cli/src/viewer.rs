@@ -116,7 +116,9 @@ fn run(case: &Case, result: &CaseResult) -> Result<Value> {
 /// logarithmic plots a spike stays visible however many samples are merged.
 fn envelope(y: &[f64], group: usize) -> Vec<f64> {
     y.chunks(group.max(1))
-        .map(|c| c.iter().copied().filter(|v| !v.is_nan()).fold(f64::NAN, |m, v| if m.abs() >= v.abs() { m } else { v }))
+        .map(|c| {
+            c.iter().copied().filter(|v| !v.is_nan()).fold(f64::NAN, |m, v| if m.abs() >= v.abs() { m } else { v })
+        })
         .collect()
 }
 

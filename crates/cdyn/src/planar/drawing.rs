@@ -73,11 +73,11 @@ impl Mechanism {
             let (ends, axis) = ends(e);
             let ends: Option<Vec<Anchor>> = ends
                 .into_iter()
-                .filter_map(|(id, point)| match id {
-                    BodyId::Ground => Some(Some(Anchor { body: None, point })),
-                    BodyId::Body(i) if i < bodies.len() => Some(Some(Anchor { body: Some(i), point })),
+                .map(|(id, point)| match id {
+                    BodyId::Ground => Some(Anchor { body: None, point }),
+                    BodyId::Body(i) if i < bodies.len() => Some(Anchor { body: Some(i), point }),
                     // An element on a body that does not exist: not drawn.
-                    BodyId::Body(_) => Some(None),
+                    BodyId::Body(_) => None,
                 })
                 .collect();
             let Some(ends) = ends else { continue };
@@ -107,9 +107,12 @@ impl Drawing {
     }
 }
 
+/// A point of a body (or the ground), as an element gives it.
+type BodyPoint = (BodyId, [f64; 2]);
+
 /// The body points an element acts at, and a prismatic joint's axis. An
 /// element on an angle is drawn at the centres of its bodies other than the ground.
-fn ends(e: &Element) -> (Vec<(BodyId, [f64; 2])>, Option<[f64; 2]>) {
+fn ends(e: &Element) -> (Vec<BodyPoint>, Option<[f64; 2]>) {
     let centres = |ids: &[BodyId]| ids.iter().filter(|id| **id != BodyId::Ground).map(|&id| (id, [0.0, 0.0])).collect();
     match *e {
         Element::Revolute { a, pa, b, pb, .. }
