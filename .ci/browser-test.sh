@@ -3,7 +3,8 @@
 # (examples/four_bar.toml) with `cdyn run --html`, loads it in headless
 # Chromium at two slider positions and checks (tests/browser/check_viewer.py):
 # no console message, no network request, the mechanism moved, every body
-# drawn at t = 0. Installs Debian's chromium when missing; skips (exit 0,
+# drawn at t = 0; a compare's page and a page without a drawing load without
+# error or request too. Installs Debian's chromium when missing; skips (exit 0,
 # one line) where that cannot work: not root, no apt-get or no package registry.
 # `.ci/browser-test.sh --screenshot docs/viewer.png` also remakes the README's picture.
 set -euo pipefail
@@ -25,5 +26,9 @@ cdyn="$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_directory
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 "$cdyn" run examples/four_bar.toml --out "$work/run" --html >/dev/null
-python3 tests/browser/check_viewer.py "$work/run/report.html" "$@"
+# Also a compare's page (nine cases, one picked) and one without a drawing.
+"$cdyn" compare examples/slider_crank.toml --out "$work/compare" --html >/dev/null
+"$cdyn" run examples/double_pendulum.toml --out "$work/plots" --html >/dev/null
+python3 tests/browser/check_viewer.py "$work/run/report.html" \
+  --also "$work/compare/report.html#pos=0.4&case=2" --also "$work/plots/report.html" "$@"
 echo "browser-test: passed in $((SECONDS - start)) s"

@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Checks a `report.html` written by `cdyn run --html` in headless Chromium.
 
-Usage: check_viewer.py REPORT_HTML [--screenshot OUT_PNG]
+Usage: check_viewer.py REPORT_HTML [--also REPORT_HTML[#fragment]]... [--screenshot OUT_PNG]
+
+REPORT_HTML is a planar mechanism's page; pages given with --also (a
+compare's, a model without a drawing) get the first two checks below.
 
 Standard library only; Chromium is driven from its command line:
   * the page at two slider positions (`#pos=0`, `#pos=0.5`), each loaded
@@ -151,6 +154,7 @@ def main():
         sys.exit(__doc__)
     report = args[0]
     screenshot_out = args[args.index("--screenshot") + 1] if "--screenshot" in args else None
+    also = [args[i + 1] for i, a in enumerate(args) if a == "--also"]
 
     with tempfile.TemporaryDirectory() as tmp:
         # The checks can fail: a page that logs an error and fetches an image is caught.
@@ -167,6 +171,12 @@ def main():
             check("data-errors" not in attrs, f"pos={pos}: no script error {attrs.get('data-errors', '')}")
             check(not console, f"pos={pos}: no console message {console}")
             check(not requests, f"pos={pos}: no network request {requests}")
+        for page in also:
+            path, _, fragment = page.partition("#")
+            dom, err, log = chromium("file://" + os.path.abspath(path) + "#" + fragment, "--dump-dom")
+            attrs, console, requests = body_attributes(dom), console_lines(err), page_requests(log)
+            check(attrs.get("data-ready") == "1" and "data-errors" not in attrs, f"{page}: the page ran to its end without error {attrs.get('data-errors', '')}")
+            check(not console and not requests, f"{page}: no console message {console}, no network request {requests}")
         (a0, _, _, shot0), (a1, _, _, shot1) = loads[0], loads[0.5]
         bodies0, bodies1 = json.loads(a0.get("data-bodies", "[]")), json.loads(a1.get("data-bodies", "[]"))
         check(len(bodies0) > 0 and len(bodies0) == len(bodies1), f"{len(bodies0)} bodies drawn")

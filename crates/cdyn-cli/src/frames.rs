@@ -4,9 +4,9 @@
 //! dropped and later samples are taken half as often; the last sample
 //! (the end state) is always kept.
 
-/// Most frames kept, and most numbers (`frames × coordinates`) kept.
+/// Most frames kept, and most numbers (`frames × coordinates`, 8 MB) kept.
 const MAX_FRAMES: usize = 2000;
-const MAX_NUMBERS: usize = 4_000_000;
+const MAX_NUMBERS: usize = 1_000_000;
 
 /// Positions at evenly spaced samples of a run (every `stride`-th one).
 #[derive(Debug, Clone, Default)]
@@ -113,6 +113,12 @@ mod tests {
             assert_eq!(f.q(i), [f.t[i], -f.t[i]]);
         }
         assert_eq!(*f.t.last().unwrap(), (samples - 1) as f64);
+    }
+
+    #[test]
+    fn large_systems_keep_fewer_frames() {
+        assert_eq!(Frames::of(9).limit, MAX_FRAMES);
+        assert_eq!(Frames::of(10_000).limit, 100);
     }
 
     #[test]

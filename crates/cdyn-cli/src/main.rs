@@ -222,9 +222,9 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Run { scenario, out, force, viewer } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "run")?;
-            let case = parsed.case(&scenario)?;
+            let mut case = parsed.case(&scenario)?;
             case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
-            viewer.check(std::slice::from_ref(&case))?;
+            viewer.prepare(std::slice::from_mut(&mut case))?;
             runner::Estimate::of(std::slice::from_ref(&case)).check(
                 &scenario.display().to_string(),
                 case.every,
@@ -287,8 +287,8 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Compare { scenario, out, force, viewer } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
-            let cases = compare::cases(&parsed, &scenario)?;
-            viewer.check(&cases)?;
+            let mut cases = compare::cases(&parsed, &scenario)?;
+            viewer.prepare(&mut cases)?;
             let every = cases.first().map_or(1, |c| c.every);
             runner::Estimate::of(&cases).check(&scenario.display().to_string(), every, force)?;
             output_dir(&out)?;

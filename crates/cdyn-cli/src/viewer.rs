@@ -21,12 +21,19 @@ pub struct ViewerArgs {
 }
 
 impl ViewerArgs {
-    /// Refuses `--gif` for a model without a drawing, before anything runs.
-    pub fn check(self, cases: &[Case]) -> Result<()> {
+    /// Before anything runs: refuses `--gif` for a model without a drawing,
+    /// and drops the drawings when neither option is given, so that no
+    /// frames are kept for nothing.
+    pub fn prepare(self, cases: &mut [Case]) -> Result<()> {
         if self.gif && cases.iter().all(|c| c.drawing.is_none()) {
             anyhow::bail!(
                 "--gif: this model has no drawing (only mechanisms given by [[bodies]] and their elements have one)"
             );
+        }
+        if !self.html && !self.gif {
+            for case in cases {
+                case.drawing = None;
+            }
         }
         Ok(())
     }

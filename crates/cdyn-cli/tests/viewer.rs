@@ -55,6 +55,11 @@ fn run_html_and_gif_of_a_mechanism() {
     let (first, middle) = (frames[0].buffer(), frames[frames.len() / 2].buffer());
     let changed = first.pixels().zip(middle.pixels()).filter(|(a, b)| a != b).count();
     assert!(changed > 1000, "the mechanism did not move: {changed} pixels differ");
+
+    // A run without the options into the same directory leaves no page or GIF of the earlier one.
+    let r = cdyn(&["run", path_str(&four_bar), "--out", path_str(out.path())]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(!out.path().join("report.html").exists() && !out.path().join("animation.gif").exists());
 }
 
 #[test]
