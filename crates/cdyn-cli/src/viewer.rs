@@ -89,10 +89,16 @@ pub fn page(title: &str, cases: &[Case], results: &[CaseResult], info: &Value) -
         "cases": runs,
         "info": info,
     });
-    // Inside <script>, "</" could end the element early; "<\/" reads the same in JSON.
-    let text = serde_json::to_string(&data)?.replace("</", "<\\/");
     debug_assert!(TEMPLATE.contains(DATA_SLOT));
-    Ok(TEMPLATE.replacen(DATA_SLOT, &text, 1))
+    Ok(TEMPLATE.replacen(DATA_SLOT, &inline_json(&data)?, 1))
+}
+
+/// `value` as JSON that can stand inside a `<script>` element: no `<` at
+/// all (`</script>` or `<!--` in a name or path would end or change the
+/// element), `\u003c` instead, which JSON reads as the same string. A `<`
+/// can only be inside a string, where the escape is valid.
+fn inline_json(value: &Value) -> Result<String> {
+    Ok(serde_json::to_string(value)?.replace('<', "\\u003c"))
 }
 
 /// One case's data: its summary entry, frames and plotted series, and how they were sampled.
@@ -132,6 +138,14 @@ fn envelope(y: &[f64], group: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn inline_json_has_no_tag_and_reads_back() {
+        let value = json!({ "scenario": "a</script><!--b.toml", "x": [1.5, -2e-300] });
+        let text = inline_json(&value).unwrap();
+        assert!(!text.contains('<'), "{text}");
+        assert_eq!(serde_json::from_str::<Value>(&text).unwrap(), value);
+    }
 
     #[test]
     fn envelope_keeps_the_largest_magnitude_of_each_group() {
