@@ -132,6 +132,12 @@ fn draw_frame<DB: DrawingBackend>(
     t: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     area.fill(&WHITE)?;
+    let label = ("sans-serif", 14).into_font().color(&BLACK);
+    if q.iter().any(|x| !x.is_finite()) {
+        // A run that blew up: nothing sensible to draw.
+        area.draw(&Text::new(format!("t = {t:.3}: positions not finite"), (8, 6), label))?;
+        return area.present();
+    }
     let grey = RGBColor(0x99, 0x99, 0x99);
     let at = |e: &Anchor| view.px(d.place(*e, q));
     for end in d.links.iter().flat_map(|l| &l.ends).filter(|e| e.body.is_none()) {
@@ -164,7 +170,7 @@ fn draw_frame<DB: DrawingBackend>(
         area.draw(&Circle::new(c, 6, COLOURS[i % COLOURS.len()].filled()))?;
         area.draw(&Circle::new(c, 6, BLACK.stroke_width(1)))?;
     }
-    area.draw(&Text::new(format!("t = {t:.3}"), (8, 6), ("sans-serif", 14).into_font().color(&BLACK)))?;
+    area.draw(&Text::new(format!("t = {t:.3}"), (8, 6), label))?;
     area.present()
 }
 
