@@ -65,11 +65,7 @@ impl ModelBuilder {
     /// Adds `R` nonholonomic rows `A(q, t) v + b(q, t) = 0` reading the
     /// coordinates `at` (see [`crate::nonholonomic`] for how every part of
     /// the library treats them).
-    pub fn nonholonomic<C: Nonholonomic<K, R>, const K: usize, const R: usize>(
-        mut self,
-        c: C,
-        at: [usize; K],
-    ) -> Self {
+    pub fn nonholonomic<C: Nonholonomic<K, R>, const K: usize, const R: usize>(mut self, c: C, at: [usize; K]) -> Self {
         if self.check_indices("a nonholonomic constraint", &at) {
             let item = (c, at);
             match self.constraints.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<NonholonomicGroup<C, K, R>>())

@@ -88,7 +88,14 @@ fn tractor_trailer() -> Example {
     m.add(Element::KnifeEdge { body: tractor, point: [0.3, 0.0], blade: [1.0, 0.0] });
     m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0] });
     m.add(Element::KnifeEdge { body: trailer, point: [-0.4, 0.0], blade: [1.0, 0.0] });
-    m.add(Element::Spring { a: BodyId::Ground, pa: [3.0, 2.0], b: tractor, pb: [0.5, 0.0], stiffness: 4.0, rest_length: 0.0 });
+    m.add(Element::Spring {
+        a: BodyId::Ground,
+        pa: [3.0, 2.0],
+        b: tractor,
+        pb: [0.5, 0.0],
+        stiffness: 4.0,
+        rest_length: 0.0,
+    });
     Example::from_mechanism(m.build().unwrap(), None)
 }
 

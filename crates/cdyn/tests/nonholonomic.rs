@@ -1,13 +1,15 @@
-//! Nonholonomic constraints: the knife edge's derivatives against finite
-//! differences, a sled on an incline and the Chaplygin sleigh against their
-//! closed forms, with and without stabilization, and bad knife edges named.
+//! Nonholonomic constraints: the knife edge's and a rheonomic row's
+//! derivatives against finite differences, the work of a rheonomic row in
+//! the energy balance, a sled on an incline, the Chaplygin sleigh and a
+//! bicycle with fixed steering against their closed forms, with and
+//! without stabilization, and bad knife edges named.
 
 use cdyn::control::{Control, Geometric, Rate, Velocity};
 use cdyn::dynamics::Dynamics;
 use cdyn::integrate::Application;
 use cdyn::methods;
 use cdyn::planar::{BodyId, Element, Mechanism};
-use cdyn::{Scheme, Settings, Simulation};
+use cdyn::{Model, Nonholonomic, Potential, Scalar, Scheme, Settings, Simulation};
 
 /// Gravity along the incline: 9.81 sin 30°.
 const G_INCLINE: f64 = 4.905;
@@ -22,7 +24,14 @@ fn trailer() -> Mechanism {
     m.add(Element::KnifeEdge { body: tractor, point: [0.3, 0.1], blade: [1.0, 0.1] });
     m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0] });
     m.add(Element::KnifeEdge { body: trailer, point: [-0.4, 0.0], blade: [2.0, -0.3] });
-    m.add(Element::Spring { a: BodyId::Ground, pa: [3.0, 1.0], b: tractor, pb: [0.0, 0.0], stiffness: 4.0, rest_length: 1.0 });
+    m.add(Element::Spring {
+        a: BodyId::Ground,
+        pa: [3.0, 1.0],
+        b: tractor,
+        pb: [0.0, 0.0],
+        stiffness: 4.0,
+        rest_length: 1.0,
+    });
     m
 }
 
@@ -83,6 +92,75 @@ fn knife_edge_rows_are_affine_and_their_derivatives_match_finite_differences() {
     }
 }
 
+/// A rheonomic, non-ideal constraint with a configuration-dependent `A` on
+/// a point `(x, y)`: `(1 + y²) ẋ + sin t ẏ + x cos t + t y = 0`.
+struct Rheonomic;
+
+impl Nonholonomic<2, 1> for Rheonomic {
+    fn eval<D: Scalar>(&self, [x, y]: [D; 2], [vx, vy]: [D; 2], t: D) -> [D; 1] {
+        [(y * y + 1.0) * vx + t.sin() * vy + x * t.cos() + t * y]
+    }
+}
+
+/// Weight: `V = y`.
+struct Weight;
+
+impl Potential<1> for Weight {
+    fn energy<D: Scalar>(&self, [y]: [D; 1]) -> D {
+        y
+    }
+}
+
+fn rheonomic_model() -> Model {
+    Model::builder(vec![1.0, 2.0]).nonholonomic(Rheonomic, [0, 1]).potential(Weight, [1]).build().unwrap()
+}
+
+#[test]
+fn rheonomic_rows_have_a_b_and_gamma_of_their_finite_differences() {
+    let model = rheonomic_model();
+    let (q, v, t) = ([0.4, -0.7], [1.3, 0.6], 0.8);
+    let g = |q: [f64; 2], v: [f64; 2], t: f64| Rheonomic.eval(q, v, t)[0];
+    let mut d = Dynamics::new(&model);
+    d.evaluate(&model, &q, &v, t).unwrap();
+    let eps = 1e-6;
+    let a = [0, 1].map(|j| {
+        let (mut vp, mut vm) = (v, v);
+        vp[j] += eps;
+        vm[j] -= eps;
+        (g(q, vp, t) - g(q, vm, t)) / (2.0 * eps)
+    });
+    for j in 0..2 {
+        assert!((d.jac()[j] - a[j]).abs() < 1e-9, "A[{j}]: {} vs {}", d.jac()[j], a[j]);
+    }
+    assert!((d.phi_t()[0] - g(q, [0.0; 2], t)).abs() < 1e-15, "b");
+    assert!((d.phi_dot()[0] - g(q, v, t)).abs() < 1e-15, "A v + b");
+    assert_eq!(d.phi()[0], 0.0);
+    let along = |s: f64| g([q[0] + s * v[0], q[1] + s * v[1]], v, t + s);
+    let dg = (along(eps) - along(-eps)) / (2.0 * eps);
+    assert!((d.gamma()[0] + dg).abs() < 1e-8, "γ {} vs {}", d.gamma()[0], -dg);
+}
+
+/// The constraint force of a rheonomic row does work `λ b`; the energy
+/// balance `Ψ = T + V − E₀ − ∫Ė` counts it, so `Ψ` stays at the scheme's
+/// error while the energy itself changes.
+#[test]
+fn the_energy_balance_counts_the_work_of_a_rheonomic_row() {
+    let model = rheonomic_model();
+    let (q0, v0) = ([0.5, 0.2], [-0.5 / 1.04, 0.7]);
+    let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, 1e-3, Control::none()), &q0, &v0).unwrap();
+    let (mut psi, mut violation, mut work) = (0.0_f64, 0.0_f64, 0.0_f64);
+    for _ in 0..3000 {
+        sim.step().unwrap();
+        let m = sim.measure();
+        psi = psi.max(m.psi.abs());
+        violation = violation.max(m.phi_dot);
+        work = work.max(sim.energy_input().abs());
+    }
+    println!("rheonomic: max |Ψ| {psi:.3e}, max |∫Ė| {work:.3e}, max |Av + b| {violation:.3e}");
+    assert!(work > 0.1, "the row does work: {work:.3e}");
+    assert!(psi < 1e-9 && violation < 1e-9, "{psi:.3e} {violation:.3e}");
+}
+
 /// A sled with its edge at its centre of mass on an incline (gravity `−g'`
 /// along y in the incline's plane). Its heading turns at the constant rate
 /// `ω` (no torque about the contact), and the speed `u` along the blade
@@ -132,7 +210,14 @@ struct Outcome {
     energy: f64,
 }
 
-fn run(m: &Mechanism, scheme: Scheme, h: f64, t_end: f64, control: Control, exact: impl Fn(f64) -> ([f64; 3], [f64; 3])) -> Outcome {
+fn run(
+    m: &Mechanism,
+    scheme: Scheme,
+    h: f64,
+    t_end: f64,
+    control: Control,
+    exact: impl Fn(f64) -> ([f64; 3], [f64; 3]),
+) -> Outcome {
     let b = m.build().unwrap();
     let mut sim = Simulation::new(&b.model, Settings::new(scheme, h, control), &b.q0, &b.v0).unwrap();
     let mut out = Outcome { error: 0.0, violation: 0.0, energy: 0.0 };
@@ -209,7 +294,8 @@ fn velocity_level_controls_keep_the_knife_edge_at_round_off() {
             assert!(o.error < drift.error, "{name}: error {:.3e} vs {:.3e} uncontrolled", o.error, drift.error);
         }
     }
-    let o = run(&m, Scheme::AdamsBashforth3, 1e-2, 50.0, velocity_feedback(Application::ForwardEuler), |t| sled.exact(t));
+    let o =
+        run(&m, Scheme::AdamsBashforth3, 1e-2, 50.0, velocity_feedback(Application::ForwardEuler), |t| sled.exact(t));
     println!("velocity (forward euler) max |Aq̇+b| {:.3e}  error {:.3e}", o.violation, o.error);
     assert!(o.violation < drift.violation / 50.0, "{:.3e} vs {:.3e} uncontrolled", o.violation, drift.violation);
 }
@@ -260,7 +346,9 @@ fn chaplygin_sleigh_speeds_follow_tanh_and_sech() {
             assert!((-v[0] * s + v[1] * c + d * v[2]).abs() < 1e-9, "{name}");
         }
         let (u_end, w_end, _) = exact(20.0);
-        println!("{name:8} max error u {err_u:.3e}  w {err_w:.3e}  θ {err_theta:.3e}  (u → {u_end:.6}, w → {w_end:.3e})");
+        println!(
+            "{name:8} max error u {err_u:.3e}  w {err_w:.3e}  θ {err_theta:.3e}  (u → {u_end:.6}, w → {w_end:.3e})"
+        );
         assert!(err_u < 1e-9 && err_w < 1e-9 && err_theta < 1e-9, "{name}: {err_u:.3e} {err_w:.3e} {err_theta:.3e}");
         // The motion is the tanh/sech one and not a trivial one: it has spun down.
         assert!((u_end - big_u).abs() < 1e-3 * big_u && w_end.abs() < 1e-2 * w0);
@@ -295,3 +383,43 @@ fn bad_knife_edges_name_the_element() {
     assert!(err.contains("element 0 (knife_edge)") && err.contains("point"), "{err}");
 }
 
+/// The kinematic bicycle with its steering held: a frame on a rear knife
+/// edge, a front wheel pinned to it at the fixed steering angle `δ` on a
+/// knife edge of its own (holonomic and nonholonomic rows together). The
+/// rear contact runs on a circle of radius `L / tan δ` at constant speed.
+#[test]
+fn a_bicycle_with_fixed_steering_drives_in_a_circle() {
+    let (l, delta, u): (f64, f64, f64) = (1.2, 0.3, 2.0);
+    let omega = u * delta.tan() / l;
+    let radius = l / delta.tan();
+    let mut m = Mechanism::new([0.0, 0.0]);
+    let frame = m.rigid("frame", 1.0, 0.1, [0.0, 0.0], 0.0);
+    let wheel = m.rigid("wheel", 0.5, 0.01, [l / 2.0, 0.0], delta);
+    m.bodies[0].velocity = [u, omega * l / 2.0];
+    m.bodies[0].angular_velocity = omega;
+    m.bodies[1].velocity = [u, omega * l];
+    m.bodies[1].angular_velocity = omega;
+    m.add(Element::KnifeEdge { body: frame, point: [-l / 2.0, 0.0], blade: [1.0, 0.0] });
+    m.add(Element::Revolute { a: frame, pa: [l / 2.0, 0.0], b: wheel, pb: [0.0, 0.0] });
+    m.add(Element::FixedAngle { a: frame, b: wheel, angle: delta });
+    m.add(Element::KnifeEdge { body: wheel, point: [0.0, 0.0], blade: [1.0, 0.0] });
+    let b = m.build().unwrap();
+    let centre = [-l / 2.0, radius];
+    let lap = 2.0 * std::f64::consts::PI / omega;
+    for (name, control) in [("none", Control::none()), ("robust", methods::robust())] {
+        let mut sim =
+            Simulation::new(&b.model, Settings::new(Scheme::RungeKutta4, 1e-3, control), &b.q0, &b.v0).unwrap();
+        let (mut err_r, mut err_w, mut worst) = (0.0_f64, 0.0_f64, 0.0_f64);
+        while sim.t() < lap {
+            sim.step().unwrap();
+            let (q, v) = (sim.q(), sim.v());
+            let rear = [q[0] - l / 2.0 * q[2].cos(), q[1] - l / 2.0 * q[2].sin()];
+            err_r = err_r.max(((rear[0] - centre[0]).hypot(rear[1] - centre[1]) - radius).abs());
+            err_w = err_w.max((v[2] - omega).abs());
+            let m = sim.measure();
+            worst = worst.max(m.phi.abs().max(m.phi_dot));
+        }
+        println!("bicycle {name:8} radius error {err_r:.3e}  turning rate error {err_w:.3e}  max |Φ|, |Φ̇| {worst:.3e}");
+        assert!(err_r < 1e-9 && err_w < 1e-9 && worst < 1e-9, "{name}: {err_r:.3e} {err_w:.3e} {worst:.3e}");
+    }
+}

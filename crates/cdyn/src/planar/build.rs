@@ -195,7 +195,13 @@ impl Layout<'_> {
 
     /// A knife edge on a rigid body: its blocked direction is the blade's
     /// normal, of unit length so that `|Φ̇|` is a speed.
-    fn knife_edge(&self, builder: ModelBuilder, body: BodyId, point: [f64; 2], blade: [f64; 2]) -> Result<ModelBuilder> {
+    fn knife_edge(
+        &self,
+        builder: ModelBuilder,
+        body: BodyId,
+        point: [f64; 2],
+        blade: [f64; 2],
+    ) -> Result<ModelBuilder> {
         if body == BodyId::Ground {
             return Err(Problem::OnGround("given a knife edge").into());
         }
