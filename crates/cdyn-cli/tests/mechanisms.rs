@@ -152,7 +152,7 @@ fn scenario_format_mistakes_fail_cleanly() {
 
 #[test]
 fn knife_edge_examples_run() {
-    for name in ["knife_edge_incline", "chaplygin_sleigh"] {
+    for name in ["knife_edge_incline", "chaplygin_sleigh", "bicycle"] {
         let dir = tempfile::tempdir().unwrap();
         let out = cdyn(&["run"], &examples().join(format!("{name}.toml")), dir.path());
         assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
