@@ -157,6 +157,9 @@ fn knife_edge_examples_run() {
         let out = cdyn(&["run"], &examples().join(format!("{name}.toml")), dir.path());
         assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
         assert!(dir.path().join(format!("{name}.csv")).exists(), "{name}");
+        // The edges' side speeds |A q̇ + b| are reported, at round-off under these methods.
+        let phi_dot = summary(dir.path())["cases"][0]["max_abs_phi_dot"].as_f64().unwrap();
+        assert!(phi_dot < 1e-13, "{name}: max |Φ̇| = {phi_dot:e}");
     }
 }
 
