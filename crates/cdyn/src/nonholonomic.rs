@@ -21,7 +21,7 @@
 //!   constraint force `−Aᵀλ` on a motion with `A v = −b`. An ideal
 //!   constraint (`b = 0`) does no work, and its `Φ_t` is exactly zero;
 //! * Baumgarte's `α Φ̇ + β Φ` acts on `A v + b` through `α` alone;
-//!   the velocity feedback ([`Velocity::Gradient`](crate::Velocity)) is the
+//!   the velocity feedback ([`Velocity::Gradient`](crate::control::Velocity::Gradient)) is the
 //!   gradient of `½ (Av + b)ᵀ Z_v (Av + b)` with respect to `v`;
 //! * position-level controls (CVSGF, its coupled form) see `Φ = 0`: there is
 //!   nothing to correct in `q`, and since `A` is a row of the Jacobian their
@@ -46,6 +46,31 @@ use std::any::Any;
 /// `eval` must be affine in `v` (no products of velocities, no functions of
 /// them other than linear ones): the library reads `A` as the derivative
 /// with respect to `v` and `b` as the value at `v = 0`.
+///
+/// A point mass on a plane that may only move along a heading turning with
+/// time, `−sin(t) ẋ + cos(t) ẏ = 0`:
+///
+/// ```
+/// use cdyn::{Control, Model, Nonholonomic, Scalar, Scheme, Settings, Simulation};
+///
+/// struct Heading;
+/// impl Nonholonomic<2, 1> for Heading {
+///     fn eval<D: Scalar>(&self, _q: [D; 2], [vx, vy]: [D; 2], t: D) -> [D; 1] {
+///         [-t.sin() * vx + t.cos() * vy]
+///     }
+/// }
+///
+/// let model = Model::builder(vec![1.0, 1.0]).nonholonomic(Heading, [0, 1]).build()?;
+/// let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::none());
+/// let mut sim = Simulation::new(&model, settings, &[0.0, 0.0], &[1.0, 0.0])?;
+/// for _ in 0..1000 {
+///     sim.step()?;
+/// }
+/// // The constraint force turns the velocity with the heading, at constant speed.
+/// let (v, t) = (sim.v(), sim.t());
+/// assert!((v[0] - t.cos()).abs() < 1e-9 && (v[1] - t.sin()).abs() < 1e-9);
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 pub trait Nonholonomic<const K: usize, const R: usize>: Send + Sync + 'static {
     /// `A(q, t) v + b(q, t)`; written once for every scalar type.
     fn eval<D: Scalar>(&self, q: [D; K], v: [D; K], t: D) -> [D; R];

@@ -263,6 +263,24 @@ fn sled_on_an_incline_follows_its_closed_form_with_and_without_control() {
     }
 }
 
+/// The observed order of convergence on the sled: each scheme's own, so
+/// the nonholonomic rows' `γ` is right (a wrong one leaves an error that
+/// does not shrink with `h`).
+#[test]
+fn sled_errors_converge_at_each_schemes_order() {
+    let sled = Sled { theta0: 0.3, omega: 2.0, u0: 1.0 };
+    let m = sled.mechanism();
+    for (scheme, h, order) in
+        [(Scheme::AdamsBashforth2, 4e-3, 2.0), (Scheme::AdamsBashforth3, 4e-3, 3.0), (Scheme::RungeKutta4, 2e-2, 4.0)]
+    {
+        let coarse = run(&m, scheme, h, 4.0, Control::none(), |t| sled.exact(t)).error;
+        let fine = run(&m, scheme, h / 2.0, 4.0, Control::none(), |t| sled.exact(t)).error;
+        let observed = (coarse / fine).log2();
+        println!("{scheme:?}: errors {coarse:.3e}, {fine:.3e}, order {observed:.2}");
+        assert!((observed - order).abs() < 0.25, "{scheme:?}: order {observed:.2}, expected {order}");
+    }
+}
+
 /// Over a long run with a coarse step: without control `A q̇ + b` drifts
 /// by the scheme's error; the velocity-level controls measured after the
 /// step (post-step, and the projection) keep it at round-off. Applied by a
