@@ -194,7 +194,7 @@ impl Model {
         }
     }
 
-    /// `Φ(q, t)` alone.
+    /// `Φ(q, t)` alone (zero on nonholonomic rows, which have no position-level value).
     pub fn constraint_values(&self, q: &[f64], t: f64, phi: &mut [f64]) {
         for (b, &(r0, _)) in self.constraints.iter().zip(&self.offsets) {
             b.values(q, t, &mut phi[r0..r0 + b.rows()]);
