@@ -110,7 +110,8 @@ impl Drawing {
 /// A point of a body (or the ground), as an element gives it.
 type BodyPoint = (BodyId, [f64; 2]);
 
-/// The body points an element acts at, and a prismatic joint's axis. An
+/// The body points an element acts at, and a prismatic joint's axis or a
+/// knife edge's blade (in the frame of the element's first body). An
 /// element on an angle is drawn at the centres of its bodies other than the ground.
 fn ends(e: &Element) -> (Vec<BodyPoint>, Option<[f64; 2]>) {
     let centres = |ids: &[BodyId]| ids.iter().filter(|id| **id != BodyId::Ground).map(|&id| (id, [0.0, 0.0])).collect();
@@ -120,6 +121,7 @@ fn ends(e: &Element) -> (Vec<BodyPoint>, Option<[f64; 2]>) {
         | Element::Spring { a, pa, b, pb, .. }
         | Element::Damper { a, pa, b, pb, .. } => (vec![(a, pa), (b, pb)], None),
         Element::Prismatic { a, pa, b, pb, axis } => (vec![(a, pa), (b, pb)], Some(axis)),
+        Element::KnifeEdge { body, point, blade } => (vec![(body, point)], Some(blade)),
         Element::FixedAngle { a, b, .. }
         | Element::DriveAngle { a, b, .. }
         | Element::TorsionSpring { a, b, .. }
