@@ -6,6 +6,8 @@
 pub mod alloc_count;
 pub mod bench;
 pub mod compare;
+pub mod frames;
+pub mod gif;
 pub mod heatmap;
 pub mod interrupt;
 pub mod output;
@@ -19,3 +21,4 @@ pub mod suite;
 pub mod suite_plot;
 pub mod sweep;
 pub mod terminal;
+pub mod viewer;

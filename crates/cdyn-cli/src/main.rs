@@ -4,7 +4,7 @@
 use anyhow::{Context, Result, bail};
 use cdyn_cli::terminal::print;
 use cdyn_cli::{
-    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal,
+    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal, viewer,
 };
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -42,6 +42,8 @@ enum Command {
         /// Run even if the CSV output would exceed 2 GB.
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        viewer: viewer::ViewerArgs,
     },
     /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
     Bench {
@@ -101,6 +103,8 @@ enum Command {
         /// Run even if the CSV output would exceed 2 GB.
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        viewer: viewer::ViewerArgs,
     },
 }
 
@@ -198,11 +202,12 @@ fn run(cli: Cli) -> Result<Ended> {
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)
         }
-        Command::Run { scenario, out, force } => {
+        Command::Run { scenario, out, force, viewer } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "run")?;
-            let case = parsed.case(&scenario)?;
+            let mut case = parsed.case(&scenario)?;
             case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
+            viewer.prepare(std::slice::from_mut(&mut case))?;
             runner::Estimate::of(std::slice::from_ref(&case)).check(
                 &scenario.display().to_string(),
                 case.every,
@@ -221,6 +226,7 @@ fn run(cli: Cli) -> Result<Ended> {
             });
             report::write_summary(&out, &results, extra)?;
             report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
+            viewer.write(&out, &results[0].name, std::slice::from_ref(&case), &results)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)
@@ -261,16 +267,19 @@ fn run(cli: Cli) -> Result<Ended> {
                 .collect::<Result<Vec<_>>>()?;
             write_sweep(&sweep::merge(parts)?, &out, listing.listing()).map(|()| Ended::Done)
         }
-        Command::Compare { scenario, out, force } => {
+        Command::Compare { scenario, out, force, viewer } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
-            let cases = compare::cases(&parsed, &scenario)?;
+            let mut cases = compare::cases(&parsed, &scenario)?;
+            viewer.prepare(&mut cases)?;
             let every = cases.first().map_or(1, |c| c.every);
             runner::Estimate::of(&cases).check(&scenario.display().to_string(), every, force)?;
             output_dir(&out)?;
             output::clear(&out, &report::file_names(&cases, report::RUN_FIGURES))?;
             interrupt::install();
             let results = compare::run(&cases, &scenario, &out)?;
+            let stem = scenario.file_stem().map_or("compare".into(), |s| s.to_string_lossy().into_owned());
+            viewer.write(&out, &stem, &cases, &results)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)

@@ -29,7 +29,9 @@ pub fn run_cases(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
 pub fn file_names(cases: &[Case], stems: Stems) -> Vec<String> {
     let csv = cases.iter().map(|c| format!("{}.csv", c.name));
     let figures = stems.iter().flat_map(|s| ["png", "svg"].map(|ext| format!("{s}.{ext}")));
-    csv.chain(figures).chain(["summary.json".to_string()]).collect()
+    // The viewer's files too: a run without --html leaves no page of an earlier run.
+    let viewer = ["summary.json", crate::viewer::FILE, crate::viewer::GIF].map(String::from);
+    csv.chain(figures).chain(viewer).collect()
 }
 
 /// Writes `dir/summary.json` with every case; `interrupted` says whether a

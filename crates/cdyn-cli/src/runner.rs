@@ -2,6 +2,7 @@
 //! per sample, written as the run goes so that a run which fails keeps what
 //! it wrote, plus the series and statistics the summary and figures need.
 
+use crate::frames::Frames;
 use crate::interrupt;
 use crate::output::AtomicFile;
 use crate::progress;
@@ -29,6 +30,8 @@ pub struct Case {
     /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
     /// where the model comes from entries; errors name it instead of the row.
     pub row_entries: Vec<String>,
+    /// What the mechanism looks like, for the viewer; `None` for models without a drawing.
+    pub drawing: Option<cdyn::planar::Drawing>,
 }
 
 impl Case {
@@ -125,6 +128,9 @@ pub struct CaseResult {
     pub error: Option<String>,
     /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
     pub interrupted: bool,
+    /// Positions at some samples, for the viewer (kept when the case has a drawing).
+    #[serde(skip)]
+    pub frames: Frames,
 }
 
 /// What a run reports of its method besides the record.
@@ -134,6 +140,7 @@ struct Method {
     control: Option<cdyn::Control>,
     tuning: Option<cdyn::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
+    frames: Frames,
 }
 
 /// The series of a run that kept none (sweeps).
@@ -156,6 +163,7 @@ impl CaseResult {
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
             interrupted: method.interrupted,
+            frames: method.frames,
         }
     }
 
@@ -295,9 +303,13 @@ fn simulate<K: Sink>(
     states: Option<&mut States>,
 ) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
+    let mut frames = match watch {
+        Watch::Interrupts(_) if case.drawing.is_some() => Frames::of(ex.model.n()),
+        _ => Frames::none(),
+    };
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
-            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch, states)?;
+            let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch, &mut frames, states)?;
             let method = Method {
                 interrupted,
                 control: Some(sim.settings().control),
@@ -308,6 +320,7 @@ fn simulate<K: Sink>(
                     .projection
                     .is_some()
                     .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
+                frames,
             };
             Ok((record, method))
         }
@@ -317,27 +330,39 @@ fn simulate<K: Sink>(
 
 /// [`Recorder::run`], step by step so that an interrupt stops the run
 /// between two steps: the state it stopped at is sampled too (a complete
-/// CSV row), and the record says it was interrupted.
+/// CSV row), and the record says it was interrupted. `frames` is offered
+/// every sample, and the state it ends at.
 fn drive<S: System, K: Sink>(
     sim: &mut Stepper<S>,
     mut recorder: Recorder<'_, K>,
     t_end: f64,
     every: u64,
     watch: Watch<'_>,
+    frames: &mut Frames,
     mut states: Option<&mut States>,
 ) -> Result<(Record, bool), K::Error> {
-    // A sample of the recorder, and of `q` and `v` where they are kept.
-    let mut sample = |recorder: &mut Recorder<'_, K>, sim: &mut Stepper<S>| {
-        if let Some(s) = states.as_deref_mut() {
-            s.t.push(sim.t());
-            s.q.extend_from_slice(sim.q());
-            s.v.extend_from_slice(sim.v());
-        }
-        recorder.sample(sim)
-    };
+    let (error, interrupted) = drive_frames(sim, &mut recorder, t_end, every, watch, frames, &mut states)?;
+    frames.end(sim.t(), sim.q());
+    let mut record = recorder.finish(sim);
+    if error.is_some() {
+        record.error = error;
+    }
+    Ok((record, interrupted))
+}
+
+/// [`drive`] until the run ends; returns the simulation's error, if any, and whether it was interrupted.
+fn drive_frames<S: System, K: Sink>(
+    sim: &mut Stepper<S>,
+    recorder: &mut Recorder<'_, K>,
+    t_end: f64,
+    every: u64,
+    watch: Watch<'_>,
+    frames: &mut Frames,
+    states: &mut Option<&mut States>,
+) -> Result<(Option<cdyn::Error>, bool), K::Error> {
     let steps = match steps_to(t_end, sim.settings().h) {
         Ok(n) => n,
-        Err(e) => return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false)),
+        Err(e) => return Ok((Some(e), false)),
     };
     let every = every.max(1);
     // Where this case's steps start on a bar shared by several cases.
@@ -345,7 +370,7 @@ fn drive<S: System, K: Sink>(
         Watch::Interrupts(progress) => progress.position(),
         Watch::Nothing | Watch::Asking(_) => 0,
     };
-    sample(&mut recorder, sim)?;
+    sample(recorder, sim, frames, states)?;
     let mut sampled = sim.steps();
     while sim.steps() < steps {
         if let Watch::Interrupts(progress) = watch
@@ -360,21 +385,39 @@ fn drive<S: System, K: Sink>(
         };
         if stop {
             if sampled != sim.steps() {
-                sample(&mut recorder, sim)?;
+                sample(recorder, sim, frames, states)?;
             }
-            return Ok((recorder.finish(sim), true));
+            return Ok((None, true));
         }
         if let Err(e) = sim.step() {
-            return Ok((Record { error: Some(e), ..recorder.finish(sim) }, false));
+            return Ok((Some(e), false));
         }
         let n = sim.steps();
         if n.is_multiple_of(every) || n == steps {
-            sample(&mut recorder, sim)?;
+            sample(recorder, sim, frames, states)?;
             sampled = n;
         }
     }
     if let Watch::Interrupts(progress) = watch {
         progress.set_position(start + steps);
     }
-    Ok((recorder.finish(sim), false))
+    Ok((None, false))
+}
+
+/// Samples `sim` into `recorder`, offers its positions to `frames`, and
+/// keeps its time, `q` and `v` in `states` where they are kept.
+fn sample<S: System, K: Sink>(
+    recorder: &mut Recorder<'_, K>,
+    sim: &mut Stepper<S>,
+    frames: &mut Frames,
+    states: &mut Option<&mut States>,
+) -> Result<(), K::Error> {
+    recorder.sample(sim)?;
+    frames.push(sim.t(), sim.q());
+    if let Some(s) = states.as_deref_mut() {
+        s.t.push(sim.t());
+        s.q.extend_from_slice(sim.q());
+        s.v.extend_from_slice(sim.v());
+    }
+    Ok(())
 }

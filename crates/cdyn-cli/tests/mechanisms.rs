@@ -149,3 +149,46 @@ fn scenario_format_mistakes_fail_cleanly() {
         }
     }
 }
+
+#[test]
+fn knife_edge_examples_run() {
+    for name in ["knife_edge_incline", "chaplygin_sleigh", "bicycle"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = cdyn(&["run"], &examples().join(format!("{name}.toml")), dir.path());
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(dir.path().join(format!("{name}.csv")).exists(), "{name}");
+        // The edges' side speeds |A q̇ + b| are reported, at round-off under these methods.
+        let phi_dot = summary(dir.path())["cases"][0]["max_abs_phi_dot"].as_f64().unwrap();
+        assert!(phi_dot < 1e-13, "{name}: max |Φ̇| = {phi_dot:e}");
+    }
+}
+
+#[test]
+fn knife_edge_mistakes_name_the_entry() {
+    let edge = |body: &str, rest: &str| {
+        format!("{CRANK}[[joints]]\nkind = \"knife_edge\"\nbody = \"{body}\"\nblade = [1.0, 0.0]\n{rest}")
+    };
+    let cases: Vec<(String, &[&str])> = vec![
+        (edge("crank", "").replace("blade = [1.0, 0.0]", "blade = [0.0, 0.0]"), &["joints[1] (knife_edge)", "|blade|"]),
+        (edge("crank", "").replace("blade = [1.0, 0.0]\n", ""), &["joints[1]", "blade"]),
+        (edge("crank", "point = [nan, 0.0]\n"), &["joints[1] (knife_edge)", "point"]),
+        (edge("ground", ""), &["joints[1] (knife_edge)", "ground"]),
+        (edge("crank", "normal = [0.0, 1.0]\n"), &["joints[1]", "normal"]),
+        (
+            format!("{CRANK}[[drives]]\nkind = \"knife_edge\"\nbody = \"crank\"\nblade = [1.0, 0.0]\n"),
+            &["drives[0] (knife_edge)", "[[joints]]"],
+        ),
+        (
+            format!(
+                "{CRANK}[[bodies]]\nname = \"bob\"\nmass = 1.0\nposition = [2.0, 0.0]\n[[joints]]\nkind = \"knife_edge\"\nbody = \"bob\"\nblade = [1.0, 0.0]\n"
+            ),
+            &["joints[1] (knife_edge)", "point mass"],
+        ),
+    ];
+    for (text, needles) in cases {
+        let line = error_of(&text);
+        for n in needles {
+            assert!(line.contains(n), "{line:?} should mention {n:?} for:\n{text}");
+        }
+    }
+}

@@ -90,34 +90,11 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
     }
 
     fn columns(&self, out: &mut Vec<u32>) {
-        for (_, idx) in &self.items {
-            for _ in 0..R {
-                out.extend(idx.iter().map(|&i| i as u32));
-            }
-        }
+        columns_of::<_, K, R>(&self.items, out);
     }
 
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
-        // Per element: its rows of every output, as fixed-size chunks (no
-        // bounds checks inside the loop).
-        let rows = out
-            .rhs
-            .chunks_exact_mut(R)
-            .zip(out.phi.chunks_exact_mut(R))
-            .zip(out.phi_dot.chunks_exact_mut(R))
-            .zip(out.phi_t.chunks_exact_mut(R))
-            .zip(out.gamma.chunks_exact_mut(R))
-            .zip(out.jac.chunks_exact_mut(R * K));
-        for ((c, idx), (((((rhs, phi), phi_dot), phi_t), gamma), jac)) in self.items.iter().zip(rows) {
-            let gather = |s: &[f64]| std::array::from_fn(|j| s[idx[j]]);
-            let l = local(c, gather(q), gather(v), gather(out.free_acc), t);
-            rhs.copy_from_slice(&l.rhs);
-            phi.copy_from_slice(&l.phi);
-            phi_dot.copy_from_slice(&l.phi_dot);
-            phi_t.copy_from_slice(&l.phi_t);
-            gamma.copy_from_slice(&l.gamma);
-            jac.copy_from_slice(l.jac.as_flattened());
-        }
+        evaluate_items(&self.items, q, v, t, out, local);
     }
 
     fn values(&self, q: &[f64], t: f64, phi: &mut [f64]) {
@@ -129,6 +106,48 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
+    }
+}
+
+/// Appends the coordinate index of every Jacobian entry of `items`, `R`
+/// rows per element (any kind of element: holonomic or nonholonomic).
+pub(crate) fn columns_of<C, const K: usize, const R: usize>(items: &[(C, [usize; K])], out: &mut Vec<u32>) {
+    for (_, idx) in items {
+        for _ in 0..R {
+            out.extend(idx.iter().map(|&i| i as u32));
+        }
+    }
+}
+
+/// Writes every element's rows, as `local` differentiates them, into `out`.
+#[inline(always)]
+pub(crate) fn evaluate_items<C, const K: usize, const R: usize>(
+    items: &[(C, [usize; K])],
+    q: &[f64],
+    v: &[f64],
+    t: f64,
+    out: ConstraintValues<'_>,
+    local: impl Fn(&C, [f64; K], [f64; K], [f64; K], f64) -> Local<K, R>,
+) {
+    // Per element: its rows of every output, as fixed-size chunks (no
+    // bounds checks inside the loop).
+    let rows = out
+        .rhs
+        .chunks_exact_mut(R)
+        .zip(out.phi.chunks_exact_mut(R))
+        .zip(out.phi_dot.chunks_exact_mut(R))
+        .zip(out.phi_t.chunks_exact_mut(R))
+        .zip(out.gamma.chunks_exact_mut(R))
+        .zip(out.jac.chunks_exact_mut(R * K));
+    for ((c, idx), (((((rhs, phi), phi_dot), phi_t), gamma), jac)) in items.iter().zip(rows) {
+        let gather = |s: &[f64]| std::array::from_fn(|j| s[idx[j]]);
+        let l = local(c, gather(q), gather(v), gather(out.free_acc), t);
+        rhs.copy_from_slice(&l.rhs);
+        phi.copy_from_slice(&l.phi);
+        phi_dot.copy_from_slice(&l.phi_dot);
+        phi_t.copy_from_slice(&l.phi_t);
+        gamma.copy_from_slice(&l.gamma);
+        jac.copy_from_slice(l.jac.as_flattened());
     }
 }
 

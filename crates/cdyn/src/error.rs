@@ -277,7 +277,7 @@ pub enum Problem {
         /// The point mass's name.
         body: String,
     },
-    /// A drive, force or torque on the ground, which does not move.
+    /// A drive, force, torque or knife edge on the ground, which does not move.
     #[error("the ground cannot be {0}")]
     OnGround(&'static str),
     /// A point mass given an angle or angular velocity.

@@ -6,6 +6,7 @@ use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, Constraint
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
 use crate::mass::{DiagonalMass, MassMatrix};
+use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
 pub use crate::sparse::Pattern;
@@ -56,6 +57,21 @@ impl ModelBuilder {
             match self.constraints.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<ConstraintGroup<C, K, R>>()) {
                 Some(g) => g.items.push(item),
                 None => self.constraints.push(Box::new(ConstraintGroup { items: vec![item] })),
+            }
+        }
+        self
+    }
+
+    /// Adds `R` nonholonomic rows `A(q, t) v + b(q, t) = 0` reading the
+    /// coordinates `at` (see [`crate::nonholonomic`] for how every part of
+    /// the library treats them).
+    pub fn nonholonomic<C: Nonholonomic<K, R>, const K: usize, const R: usize>(mut self, c: C, at: [usize; K]) -> Self {
+        if self.check_indices("a nonholonomic constraint", &at) {
+            let item = (c, at);
+            match self.constraints.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<NonholonomicGroup<C, K, R>>())
+            {
+                Some(g) => g.items.push(item),
+                None => self.constraints.push(Box::new(NonholonomicGroup { items: vec![item] })),
             }
         }
         self
@@ -178,7 +194,7 @@ impl Model {
         }
     }
 
-    /// `Φ(q, t)` alone.
+    /// `Φ(q, t)` alone (zero on nonholonomic rows, which have no position-level value).
     pub fn constraint_values(&self, q: &[f64], t: f64, phi: &mut [f64]) {
         for (b, &(r0, _)) in self.constraints.iter().zip(&self.offsets) {
             b.values(q, t, &mut phi[r0..r0 + b.rows()]);

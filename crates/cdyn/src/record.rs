@@ -271,6 +271,10 @@ pub struct Record {
     /// Largest `|Φ|` over the samples.
     #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub max_abs_phi: f64,
+    /// Largest `|Φ̇|` over the samples: the velocity-level violation, and
+    /// for nonholonomic rows (whose `Φ` is zero) the only one.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
+    pub max_abs_phi_dot: f64,
     /// Largest `|Ψ|` over the samples.
     #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
     pub max_abs_psi: f64,
@@ -356,6 +360,7 @@ impl<'a> Recorder<'a> {
 fn empty_record(has_reference: bool) -> Record {
     Record {
         max_abs_phi: 0.0,
+        max_abs_phi_dot: 0.0,
         max_abs_psi: 0.0,
         max_abs_coupling: 0.0,
         max_abs_error: has_reference.then_some(0.0),
@@ -424,6 +429,7 @@ impl<'a, K: Sink> Recorder<'a, K> {
         };
         let r = &mut self.record;
         r.max_abs_phi = r.max_abs_phi.max(measures.phi.abs());
+        r.max_abs_phi_dot = r.max_abs_phi_dot.max(measures.phi_dot);
         r.max_abs_psi = r.max_abs_psi.max(measures.psi.abs());
         r.max_abs_coupling = r.max_abs_coupling.max(measures.coupling);
         if let Some(e) = error {

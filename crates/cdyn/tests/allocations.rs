@@ -2,14 +2,15 @@
 //! steps after warm-up, for every scheme, control law and application, on
 //! Example 1 (as a general model and as a small system) and on a mechanism
 //! with every kind of element; the robust preset after its automatic gains
-//! are chosen, and the projection method (general models only).
+//! are chosen, and the projection method (general models only); and a
+//! tractor with a trailer on knife edges (nonholonomic rows).
 
 use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity};
 use cdyn::dynamics::LinearSolver;
 use cdyn::integrate::Application;
 use cdyn::methods;
 use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
-use cdyn::planar::{Coordinate, Element, Mechanism};
+use cdyn::planar::{BodyId, Coordinate, Element, Mechanism};
 use cdyn::projection::{OnFailure, Projection};
 use cdyn::simulate::Stepper;
 use cdyn::small::SmallSimulation;
@@ -74,6 +75,26 @@ fn hanging_chain(n: usize) -> Example {
         point: [0.0; 2],
         fx: TimeFn::linear(0.0, 1.0),
         fy: TimeFn::constant(0.0),
+    });
+    Example::from_mechanism(m.build().unwrap(), None)
+}
+
+/// A tractor pulled by a spring, with a trailer on a pin: two knife edges
+/// (nonholonomic rows) and a revolute joint, starting at rest.
+fn tractor_trailer() -> Example {
+    let mut m = Mechanism::new([0.0, 0.0]);
+    let tractor = m.rigid("tractor", 2.0, 0.4, [0.0, 0.0], 0.0);
+    let trailer = m.rigid("trailer", 1.0, 0.2, [-1.1, 0.0], 0.0);
+    m.add(Element::KnifeEdge { body: tractor, point: [0.3, 0.0], blade: [1.0, 0.0] });
+    m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0] });
+    m.add(Element::KnifeEdge { body: trailer, point: [-0.4, 0.0], blade: [1.0, 0.0] });
+    m.add(Element::Spring {
+        a: BodyId::Ground,
+        pa: [3.0, 2.0],
+        b: tractor,
+        pb: [0.5, 0.0],
+        stiffness: 4.0,
+        rest_length: 0.0,
     });
     Example::from_mechanism(m.build().unwrap(), None)
 }
@@ -157,6 +178,7 @@ fn steps_do_not_allocate() {
     let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
     let andrews = andrews().unwrap();
     let chain = hanging_chain(64);
+    let trailer = tractor_trailer();
     assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
@@ -164,6 +186,10 @@ fn steps_do_not_allocate() {
             assert_eq!(n, 0, "pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
             let n = small_allocations_per_run(Settings::new(scheme, 0.01, control), 5, 200);
             assert_eq!(n, 0, "small pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+        }
+        for control in controls().into_iter().chain(robust_controls()).chain(projections()) {
+            let n = allocations_per_run(&trailer, Settings::new(scheme, 0.01, control), 5, 200);
+            assert_eq!(n, 0, "tractor and trailer, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
         // Rates with hα = 0.4, as in the paper.
         let control = |h: f64| Control {

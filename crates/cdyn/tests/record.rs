@@ -83,6 +83,7 @@ fn statistics_are_the_largest_over_the_samples() {
     assert_eq!(samples.len(), 11); // 40 steps: 0, 4, …, 40
     // Each sample against the example's own (allocating) observe and error.
     let mut check = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+    let mut max_phi_dot = 0.0_f64;
     for s in &samples {
         while check.steps() < s.step {
             check.step().unwrap();
@@ -91,7 +92,10 @@ fn statistics_are_the_largest_over_the_samples() {
         assert_eq!(s.error, ex.error(check.q(), check.v(), s.t));
         let m = check.measure();
         assert_eq!((s.phi, s.psi, s.coupling), (m.phi, m.psi, m.coupling));
+        max_phi_dot = max_phi_dot.max(m.phi_dot);
     }
+    assert!(max_phi_dot > 0.0);
+    assert_eq!(record.max_abs_phi_dot, max_phi_dot);
     let max = |f: fn(&Seen) -> f64| samples.iter().map(f).fold(0.0, f64::max);
     assert_eq!(record.max_abs_phi, max(|s| s.phi.abs()));
     assert_eq!(record.max_abs_psi, max(|s| s.psi.abs()));

@@ -3,7 +3,7 @@
 //! of its kind on the coordinates of the bodies it connects.
 
 use super::body::{Body, BodyId};
-use super::constraints::{AnchoredRod, Distance, OnLine, PointRod, Prescribed, RelativeAngle, Revolute};
+use super::constraints::{AnchoredRod, Distance, KnifeEdge, OnLine, PointRod, Prescribed, RelativeAngle, Revolute};
 use super::element::{Coordinate, Element};
 use super::ends::{End, idx_array, with_k};
 use super::loads::{Damper, Gravity, PointLoad, RotaryDamper, Spring, Torque, Torsion};
@@ -88,6 +88,7 @@ impl Layout<'_> {
                 finite("angle", angle)?;
                 self.relative_angle(builder, a, b, TimeFn::constant(angle))
             }
+            Element::KnifeEdge { body, point, blade } => self.knife_edge(builder, body, point, blade),
             Element::DriveCoordinate { body, coordinate, ref f } => self.coordinate(builder, body, coordinate, f),
             Element::DriveAngle { a, b, ref f } => {
                 finite_fn(f)?;
@@ -190,6 +191,28 @@ impl Layout<'_> {
         } else {
             Ok(builder)
         }
+    }
+
+    /// A knife edge on a rigid body: its blocked direction is the blade's
+    /// normal, of unit length so that `|Φ̇|` is a speed.
+    fn knife_edge(
+        &self,
+        builder: ModelBuilder,
+        body: BodyId,
+        point: [f64; 2],
+        blade: [f64; 2],
+    ) -> Result<ModelBuilder> {
+        if body == BodyId::Ground {
+            return Err(Problem::OnGround("given a knife edge").into());
+        }
+        let norm = positive("|blade|", blade[0].hypot(blade[1]))?;
+        let normal = [-blade[1] / norm, blade[0] / norm];
+        // The angle first: a point mass is refused for having none.
+        let mut angle = Vec::new();
+        self.attach_angle(body, &mut angle)?;
+        let mut idx = Vec::new();
+        let edge = self.attach(body, point, &mut idx)?;
+        Ok(builder.nonholonomic(KnifeEdge { edge, normal }, idx_array(&idx)))
     }
 
     /// `φ_b − φ_a = f(t)`: fixed angles, angle drives and prismatic guides.

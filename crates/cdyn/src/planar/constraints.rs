@@ -3,6 +3,7 @@
 
 use super::ends::{End, angle_of};
 use crate::Constraint;
+use crate::nonholonomic::Nonholonomic;
 use crate::scalar::Scalar;
 use crate::timefn::TimeFn;
 
@@ -107,6 +108,24 @@ impl Constraint<1, 1> for Prescribed {
     #[inline(always)]
     fn eval<D: Scalar>(&self, [x]: [D; 1], t: D) -> [D; 1] {
         [x - self.f.eval(t)]
+    }
+}
+
+/// A knife edge on a rigid body `(x, y, φ)`: the velocity of the point
+/// `edge` has no component along `normal` (both in the body's frame,
+/// `normal` of unit length), `ṗ · R(φ) n = 0`. Ideal: `b = 0`.
+pub(super) struct KnifeEdge {
+    pub(super) edge: End,
+    pub(super) normal: [f64; 2],
+}
+
+impl Nonholonomic<3, 1> for KnifeEdge {
+    #[inline(always)]
+    fn eval<D: Scalar>(&self, q: [D; 3], v: [D; 3], _t: D) -> [D; 1] {
+        let [vx, vy] = self.edge.velocity(&q, &v);
+        let (s, c) = (q[2].sin(), q[2].cos());
+        let [nx, ny] = self.normal;
+        [vx * (c * nx - s * ny) + vy * (s * nx + c * ny)]
     }
 }
 

@@ -87,6 +87,18 @@ pub enum Element<B = BodyId> {
         #[cfg_attr(feature = "serde", serde(default))]
         angle: f64,
     },
+    /// A knife edge or a wheel's contact: the point `point` of a rigid body
+    /// moves along `blade` (a direction fixed in the body) and not across
+    /// it — a nonholonomic constraint on the body's velocity.
+    KnifeEdge {
+        /// The rigid body carrying the edge.
+        body: B,
+        /// The contact point, on `body`.
+        #[cfg_attr(feature = "serde", serde(default))]
+        point: [f64; 2],
+        /// The direction the point may move along, in `body`'s frame; any non-zero length.
+        blade: [f64; 2],
+    },
     /// A coordinate of a body follows `f(t)`.
     #[cfg_attr(feature = "serde", serde(rename = "coordinate"))]
     DriveCoordinate {
@@ -192,7 +204,7 @@ pub enum Element<B = BodyId> {
 /// The list of a scenario file an element is written in; each takes its own kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Group {
-    /// `[[joints]]`: revolute, prismatic, distance, fixed_angle.
+    /// `[[joints]]`: revolute, prismatic, distance, fixed_angle, knife_edge.
     Joints,
     /// `[[drives]]`: relative_angle, coordinate.
     Drives,
@@ -219,6 +231,7 @@ impl<B> Element<B> {
             Element::Prismatic { .. } => "prismatic",
             Element::Distance { .. } => "distance",
             Element::FixedAngle { .. } => "fixed_angle",
+            Element::KnifeEdge { .. } => "knife_edge",
             Element::DriveCoordinate { .. } => "coordinate",
             Element::DriveAngle { .. } => "relative_angle",
             Element::Spring { .. } => "spring",
@@ -236,7 +249,8 @@ impl<B> Element<B> {
             Element::Revolute { .. }
             | Element::Prismatic { .. }
             | Element::Distance { .. }
-            | Element::FixedAngle { .. } => Group::Joints,
+            | Element::FixedAngle { .. }
+            | Element::KnifeEdge { .. } => Group::Joints,
             Element::DriveCoordinate { .. } | Element::DriveAngle { .. } => Group::Drives,
             Element::Spring { .. }
             | Element::TorsionSpring { .. }
@@ -259,6 +273,7 @@ impl<B> Element<B> {
                 Element::Distance { a: f("a", a)?, pa, b: f("b", b)?, pb, length }
             }
             Element::FixedAngle { a, b, angle } => Element::FixedAngle { a: f("a", a)?, b: f("b", b)?, angle },
+            Element::KnifeEdge { body, point, blade } => Element::KnifeEdge { body: f("body", body)?, point, blade },
             Element::DriveCoordinate { body, coordinate, f: g } => {
                 Element::DriveCoordinate { body: f("body", body)?, coordinate, f: g }
             }

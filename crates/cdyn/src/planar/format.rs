@@ -9,7 +9,7 @@ use super::element::{Element, Group};
 use serde::Deserialize;
 use serde::de::{self, DeserializeSeed, Deserializer, SeqAccess, Visitor};
 
-/// A `[[joints]]` list: revolute, prismatic, distance, fixed_angle.
+/// A `[[joints]]` list: revolute, prismatic, distance, fixed_angle, knife_edge.
 pub fn joints<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Element<String>>, D::Error> {
     Group::Joints.deserialize(deserializer)
 }
@@ -109,6 +109,10 @@ mod tests {
                 Element::FixedAngle { a: GROUND, b: CRANK, angle: 0.0 },
             ),
             (
+                "kind = 'knife_edge'\nbody = 'crank'\npoint = [0.5, 0.0]\nblade = [1.0, 0.2]",
+                Element::KnifeEdge { body: CRANK, point: [0.5, 0.0], blade: [1.0, 0.2] },
+            ),
+            (
                 "kind = 'coordinate'\nbody = 'bob'\ncoordinate = 'y'\nfunction = { sine = [[0.1, 2.0, 0.3]] }",
                 Element::DriveCoordinate {
                     body: BOB,
@@ -205,7 +209,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!((lists.joints.len(), lists.drives.len(), lists.forces.len()), (4, 2, 6));
+        assert_eq!((lists.joints.len(), lists.drives.len(), lists.forces.len()), (5, 2, 6));
     }
 
     #[test]

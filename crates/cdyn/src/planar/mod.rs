@@ -15,6 +15,7 @@
 mod body;
 mod build;
 mod constraints;
+mod drawing;
 mod element;
 mod ends;
 #[cfg(feature = "serde")]
@@ -24,5 +25,6 @@ mod mechanism;
 
 pub use body::{Body, BodyId, GROUND};
 pub use build::Built;
+pub use drawing::{Anchor, Drawing, Link, Shape};
 pub use element::{Coordinate, Element, Group};
 pub use mechanism::Mechanism;
