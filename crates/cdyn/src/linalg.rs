@@ -43,7 +43,35 @@ pub const SPARSE_FROM: usize = 48;
 
 /// Pivots below this fraction of the assembled diagonal mean the row
 /// depends on the rows before it.
+///
+/// `d_j / S_jj` is the squared sine of the angle (in the metric `M⁻¹`)
+/// between row `j` of `Φ_q` and the span of the rows eliminated before it,
+/// so the test does not depend on the units or scale of a row. An exactly
+/// dependent row leaves round-off, `d_j / S_jj` of order `ε ≈ 1e-16` times
+/// a small growth factor; 1e-12 flags it with a margin of 10⁴, and a row
+/// it flags is within 1e-6 rad of the others: dropping it changes the
+/// constraint directions enforced by at most that much.
 const PIVOT_TOLERANCE: f64 = 1e-12;
+
+/// What to do with a constraint row that depends on the rows eliminated
+/// before it (a pivot of `Φ_q M⁻¹ Φ_qᵀ` below [`PIVOT_TOLERANCE`] of its
+/// diagonal entry): redundant constraints, or a mechanism passing through
+/// a singular position.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum DependentRows {
+    /// Stop with an error naming the row. The default: a dependent row is
+    /// far more often a modelling mistake (a joint entered twice) than an
+    /// intended redundancy, and redundant constraints are opted into.
+    #[default]
+    Error,
+    /// Solve without the row: its multiplier is 0 and the rows before it
+    /// carry the whole reaction (a *basic* solution of the singular
+    /// system; see [`Schur`]). The accelerations are the unique ones
+    /// whenever the constraint equations are consistent.
+    Tolerate,
+}
 
 /// The pivot test of every `L D Lᵀ` of `S` (this module's and the small
 /// systems' one in `small.rs`): pivot `d` of the row `row()` whose assembled
@@ -57,6 +85,24 @@ pub(crate) fn check_pivot(d: f64, s_jj: f64, jac: &[f64], row: impl FnOnce() -> 
         return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(row()) });
     }
     Ok(())
+}
+
+/// `1/d` for a pivot that passes [`check_pivot`]; for a dependent row, 0
+/// when `dependent` tolerates it (which removes the row from the solve:
+/// its column of `L` becomes `S_ij · 0 = 0` and its entry of `D⁻¹` is 0).
+#[inline(always)]
+pub(crate) fn inverse_pivot(
+    d: f64,
+    s_jj: f64,
+    jac: &[f64],
+    dependent: DependentRows,
+    row: impl FnOnce() -> usize,
+) -> Result<f64, Breakdown> {
+    match check_pivot(d, s_jj, jac, row) {
+        Ok(()) => Ok(1.0 / d),
+        Err(Breakdown::Singular(_)) if dependent == DependentRows::Tolerate => Ok(0.0),
+        Err(e) => Err(e),
+    }
 }
 
 /// For every pair of rows `(a ≥ b)` sharing a coordinate, the products
@@ -87,6 +133,19 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
 /// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the
 /// elimination order of its [`Structure`].
 ///
+/// Rank-revealing: a row whose pivot fails [`check_pivot`] is either an
+/// error or, with [`DependentRows::Tolerate`], dropped — `D⁻¹` and its
+/// column of `L` are 0 — so that `S x = b` is solved on the other rows and
+/// the dropped rows' `x` is 0. For a consistent `b` (in the range of `S`,
+/// as `Φ_q M⁻¹ G − γ` is when the constraints are compatible) this is an
+/// exact solution, the *basic* one, and `Φ_qᵀ x` — hence the acceleration —
+/// is the same for every solution. Not the minimum-norm multipliers: that
+/// needs a second solve on the dependent set, and the basic solution is
+/// what the rows' order already defines, costs nothing per step and keeps
+/// a dependent row's multiplier exactly 0. For an inconsistent `b` (a
+/// control law's `Φ` off the manifold) the dropped rows' equations are
+/// simply not enforced; nothing is divided by a vanishing pivot.
+///
 /// Everything the numeric passes read per row is addressed by original row
 /// number (`order` maps elimination positions to rows), so a right-hand side
 /// is solved in place, without a permuted copy. Indices are `u32`: the
@@ -116,6 +175,10 @@ pub(crate) struct Schur {
     work: Vec<f64>,
     /// Length of the Jacobian the terms index.
     nnz: usize,
+    /// Whether a dependent row is an error or dropped.
+    dependent: DependentRows,
+    /// Rows dropped by the last factorization.
+    dropped: usize,
 }
 
 /// Entries `slot` of `col_ptr`, `row_ptr` or `sum_ptr` to the next, as a
@@ -207,6 +270,8 @@ impl Schur {
             inv_d: vec![0.0; m],
             work: vec![0.0; m],
             nnz: pattern.nnz(),
+            dependent: DependentRows::Error,
+            dropped: 0,
         };
         schur.check();
         schur
@@ -237,6 +302,16 @@ impl Schur {
         assert!(squares, "a constraint row reads a coordinate twice");
     }
 
+    /// Sets what a dependent row does in the next factorizations.
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.dependent = dependent;
+    }
+
+    /// Rows the last factorization dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        self.dropped
+    }
+
     /// Assembles `S` from the Jacobian values, factors it and solves
     /// `S x = b` in place. The forward substitution and the diagonal
     /// scaling join the factorization (column `j` of `L` is final when it is
@@ -260,8 +335,23 @@ impl Schur {
     /// `jac.len() == self.nnz` and `b.len() == self.m`.
     unsafe fn factor(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
         let m = self.m;
-        let Self { order, col_ptr, row_idx, row_ptr, row_entries, sum_ptr, terms, lower, scaled, inv_d, work, .. } =
-            self;
+        let Self {
+            order,
+            col_ptr,
+            row_idx,
+            row_ptr,
+            row_entries,
+            sum_ptr,
+            terms,
+            lower,
+            scaled,
+            inv_d,
+            work,
+            dependent,
+            dropped,
+            ..
+        } = self;
+        *dropped = 0;
         // Entry `slot` of `S` (see `sum_ptr`), summed in a register.
         let entry = |slot: usize| -> f64 {
             // SAFETY (here and below): indices from the checked structure.
@@ -302,8 +392,8 @@ impl Schur {
                     }
                 }
             }
-            check_pivot(d, s_jj, jac, || order[j] as usize)?;
-            let inv = 1.0 / d;
+            let inv = inverse_pivot(d, s_jj, jac, *dependent, || order[j] as usize)?;
+            *dropped += usize::from(inv == 0.0);
             unsafe {
                 *inv_d.get_unchecked_mut(j) = inv;
                 let row = *order.get_unchecked(j) as usize;
