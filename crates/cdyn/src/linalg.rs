@@ -654,6 +654,75 @@ mod tests {
             let mut bad = values(pattern.nnz(), 0.7);
             bad[3] = f64::INFINITY;
             assert_eq!(s.factor_and_solve(&bad, &mut vec![1.0; m]), Err(Breakdown::NonFinite), "{solver:?}");
+            // Tolerated, the blown-up Jacobian is still not called singular.
+            s.set_dependent_rows(DependentRows::Tolerate);
+            assert_eq!(s.factor_and_solve(&bad, &mut vec![1.0; m]), Err(Breakdown::NonFinite), "{solver:?}");
+        }
+    }
+
+    /// The repeated-row system of the test above, and a consistent
+    /// right-hand side `b = S y`.
+    fn repeated_row() -> (Pattern, usize, Vec<f64>) {
+        let (mut pattern, n) = star(3, 4);
+        let last = pattern.row(pattern.start.len() - 2);
+        let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
+        pattern.cols.extend(&repeated);
+        pattern.start.push(pattern.cols.len() as u32);
+        let mut jac = values(pattern.nnz(), 0.7);
+        let k = repeated.len();
+        let tail = jac.len() - k;
+        let copy = jac[tail - k..tail].to_vec();
+        // Twice the row before: dependent, and not of the same scale.
+        jac[tail..].iter_mut().zip(&copy).for_each(|(j, c)| *j = 2.0 * c);
+        (pattern, n, jac)
+    }
+
+    /// `M⁻¹ Φ_qᵀ x`.
+    fn weighted_jt(pattern: &Pattern, jac: &[f64], inv_mass: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; inv_mass.len()];
+        for (r, &xr) in x.iter().enumerate() {
+            for j in pattern.row(r) {
+                let c = pattern.cols[j] as usize;
+                out[c] += inv_mass[c] * jac[j] * xr;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_tolerated_dependent_row_is_dropped_with_a_zero_multiplier_and_the_same_response() {
+        let (pattern, n, jac) = repeated_row();
+        let m = pattern.start.len() - 1;
+        let mass: DiagonalMass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+        let inv_mass = mass.inverse();
+        // b = S y = Φ_q M⁻¹ Φ_qᵀ y: in the range of S.
+        let y = values(m, 4.0);
+        let w = weighted_jt(&pattern, &jac, inv_mass, &y);
+        let b: Vec<f64> = (0..m).map(|r| pattern.row(r).map(|j| jac[j] * w[pattern.cols[j] as usize]).sum()).collect();
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &mass, solver);
+            s.set_dependent_rows(DependentRows::Tolerate);
+            let mut x = b.clone();
+            s.factor_and_solve(&jac, &mut x).unwrap();
+            assert_eq!(s.dependent_rows(), 1, "{solver:?}");
+            let dropped: Vec<usize> = (0..m).filter(|&r| x[r] == 0.0).collect();
+            assert!(dropped == [m - 1] || dropped == [m - 2], "{solver:?}: zero multipliers {dropped:?}");
+            let r = residual(&pattern, &jac, inv_mass, &x, &b);
+            assert!(r < 1e-12, "{solver:?}: relative residual {r:e}");
+            // The response M⁻¹ Φ_qᵀ x is the unique one, though x is not y.
+            let (got, want) = (weighted_jt(&pattern, &jac, inv_mass, &x), &w);
+            let err = got.iter().zip(want).fold(0.0_f64, |a, (g, w)| a.max((g - w).abs()));
+            assert!(err < 1e-12, "{solver:?}: response off by {err:e}");
+            // Further solves with the factorization drop the same row.
+            let mut again = b.clone();
+            s.solve(&mut again);
+            assert_eq!(again, x, "{solver:?}");
+            // An independent system afterwards counts no dropped row.
+            let (indep, _) = star(3, 4);
+            let mut t = Schur::new(&indep, &mass, solver);
+            t.set_dependent_rows(DependentRows::Tolerate);
+            t.factor_and_solve(&values(indep.nnz(), 0.7), &mut vec![1.0; m - 1]).unwrap();
+            assert_eq!(t.dependent_rows(), 0, "{solver:?}");
         }
     }
 }
