@@ -338,6 +338,7 @@ impl Error {
     pub fn row(&self) -> Option<usize> {
         match self {
             Error::SingularConstraints { row, .. } => Some(*row),
+            Error::InvalidModel { problem: Problem::SingularAssembly { row, .. }, .. } => Some(*row),
             Error::ProjectionFailed { row, .. } => *row,
             _ => None,
         }

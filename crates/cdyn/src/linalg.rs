@@ -57,8 +57,10 @@ const PIVOT_TOLERANCE: f64 = 1e-12;
 /// before it (a pivot of `Φ_q M⁻¹ Φ_qᵀ` below [`PIVOT_TOLERANCE`] of its
 /// diagonal entry): redundant constraints, or a mechanism passing through
 /// a singular position.
+///
+/// In scenario files: `[integrator] dependent_rows = "error"` or `"tolerate"`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum DependentRows {
     /// Stop with an error naming the row. The default: a dependent row is

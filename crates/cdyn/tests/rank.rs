@@ -46,7 +46,8 @@ fn a_parallelogram_with_a_redundant_crank_moves_as_the_plain_four_bar() {
     // Released below the horizontal, it swings without reaching the flat
     // position (where the plain four-bar loses rank as well: see A02).
     let theta0 = -0.6;
-    let (plain, redundant) = (parallelogram(theta0, 0.0, false).build().unwrap(), parallelogram(theta0, 0.0, true).build().unwrap());
+    let (plain, redundant) =
+        (parallelogram(theta0, 0.0, false).build().unwrap(), parallelogram(theta0, 0.0, true).build().unwrap());
     assert_eq!((plain.model.m(), redundant.model.m()), (8, 9));
     let (h, t_end) = (1e-3, 5.0);
     for control in [Control::none(), Control { geometric: Geometric::Newton(Rate::Given(50.0)), ..Control::none() }] {
