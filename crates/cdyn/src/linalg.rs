@@ -42,21 +42,36 @@ pub enum LinearSolver {
 pub const SPARSE_FROM: usize = 48;
 
 /// Pivots below this fraction of the assembled diagonal mean the row
-/// depends on the rows before it.
+/// depends on the rows before it: an error (the strict default).
 ///
 /// `d_j / S_jj` is the squared sine of the angle (in the metric `M⁻¹`)
 /// between row `j` of `Φ_q` and the span of the rows eliminated before it,
 /// so the test does not depend on the units or scale of a row. An exactly
 /// dependent row leaves round-off, `d_j / S_jj` of order `ε ≈ 1e-16` times
-/// a small growth factor; 1e-12 flags it with a margin of 10⁴, and a row
-/// it flags is within 1e-6 rad of the others: dropping it changes the
-/// constraint directions enforced by at most that much.
+/// a small growth factor; 1e-12 flags it with a margin of 10⁴.
 const PIVOT_TOLERANCE: f64 = 1e-12;
 
+/// Pivots below this fraction of the assembled diagonal are dropped with
+/// [`DependentRows::Tolerate`]: rows within 1e-4 rad of the span of the
+/// others.
+///
+/// Larger than [`PIVOT_TOLERANCE`] because redundant constraints are
+/// dependent only *on* the constraint manifold: at a drift `|Φ| ~ δ` their
+/// rows differ by `O(δ)`, so `d_j / S_jj ~ δ²`, and a row kept with such a
+/// pivot enforces a second, slightly different constraint — its multiplier
+/// grows like the right-hand side's `O(δ)` inconsistency over `δ²`. Measured
+/// on the parallelogram with a redundant crank under energy-only control:
+/// at 1e-12 the row came back once `|Φ|` drifted past 1e-7 and the run
+/// diverged within 0.5 s; at 1e-8 drifts to about 1e-5 are absorbed. A
+/// legitimately near-singular row (a mechanism within 1e-4 rad of a flat
+/// position) is dropped instead of solved with a pivot 1e-8 of its scale,
+/// where its equation is nearly implied by the others.
+const DROP_TOLERANCE: f64 = 1e-8;
+
 /// What to do with a constraint row that depends on the rows eliminated
-/// before it (a pivot of `Φ_q M⁻¹ Φ_qᵀ` below [`PIVOT_TOLERANCE`] of its
-/// diagonal entry): redundant constraints, or a mechanism passing through
-/// a singular position.
+/// before it (a pivot of `Φ_q M⁻¹ Φ_qᵀ` small relative to its diagonal
+/// entry): redundant constraints, or a mechanism passing through a
+/// singular position.
 ///
 /// In scenario files: `[integrator] dependent_rows = "error"` or `"tolerate"`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -82,16 +97,23 @@ pub enum DependentRows {
 /// has blown up, which is told apart so that it is not reported as singular.
 #[inline(always)]
 pub(crate) fn check_pivot(d: f64, s_jj: f64, jac: &[f64], row: impl FnOnce() -> usize) -> Result<(), Breakdown> {
-    if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
+    pivot_test(d, s_jj, PIVOT_TOLERANCE, jac, row)
+}
+
+/// [`check_pivot`] with the tolerance `tolerance`.
+#[inline(always)]
+fn pivot_test(d: f64, s_jj: f64, tolerance: f64, jac: &[f64], row: impl FnOnce() -> usize) -> Result<(), Breakdown> {
+    if d.is_nan() || d <= tolerance * s_jj {
         let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
         return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(row()) });
     }
     Ok(())
 }
 
-/// `1/d` for a pivot that passes [`check_pivot`]; for a dependent row, 0
-/// when `dependent` tolerates it (which removes the row from the solve:
-/// its column of `L` becomes `S_ij · 0 = 0` and its entry of `D⁻¹` is 0).
+/// `1/d` for a pivot that passes [`check_pivot`] (`Error`) or the test
+/// with [`DROP_TOLERANCE`] (`Tolerate`); 0 for a row `Tolerate` drops
+/// (which removes it from the solve: its column of `L` becomes
+/// `S_ij · 0 = 0` and its entry of `D⁻¹` is 0).
 #[inline(always)]
 pub(crate) fn inverse_pivot(
     d: f64,
@@ -100,10 +122,13 @@ pub(crate) fn inverse_pivot(
     dependent: DependentRows,
     row: impl FnOnce() -> usize,
 ) -> Result<f64, Breakdown> {
-    match check_pivot(d, s_jj, jac, row) {
-        Ok(()) => Ok(1.0 / d),
-        Err(Breakdown::Singular(_)) if dependent == DependentRows::Tolerate => Ok(0.0),
-        Err(e) => Err(e),
+    match dependent {
+        DependentRows::Error => check_pivot(d, s_jj, jac, row).map(|()| 1.0 / d),
+        DependentRows::Tolerate => match pivot_test(d, s_jj, DROP_TOLERANCE, jac, row) {
+            Ok(()) => Ok(1.0 / d),
+            Err(Breakdown::Singular(_)) => Ok(0.0),
+            Err(e) => Err(e),
+        },
     }
 }
 
@@ -135,8 +160,9 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
 /// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the
 /// elimination order of its [`Structure`].
 ///
-/// Rank-revealing: a row whose pivot fails [`check_pivot`] is either an
-/// error or, with [`DependentRows::Tolerate`], dropped — `D⁻¹` and its
+/// Rank-revealing: a row whose pivot fails [`check_pivot`] is an error,
+/// or, with [`DependentRows::Tolerate`], a row whose pivot is below
+/// [`DROP_TOLERANCE`] of its diagonal entry is dropped — `D⁻¹` and its
 /// column of `L` are 0 — so that `S x = b` is solved on the other rows and
 /// the dropped rows' `x` is 0. For a consistent `b` (in the range of `S`,
 /// as `Φ_q M⁻¹ G − γ` is when the constraints are compatible) this is an
