@@ -1,11 +1,12 @@
 //! No allocation inside a step: a counting global allocator watches 200
 //! steps after warm-up, for every scheme, control law and application, on
 //! Example 1 (as a general model and as a small system) and on a mechanism
-//! with every kind of element; the robust preset after its automatic gains
-//! are chosen, and the projection method (general models only).
+//! with every kind of element (also with a redundant row, tolerated); the
+//! robust preset after its automatic gains are chosen, and the projection
+//! method (general models only).
 
 use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity};
-use cdyn::dynamics::LinearSolver;
+use cdyn::dynamics::{DependentRows, LinearSolver};
 use cdyn::integrate::Application;
 use cdyn::methods;
 use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
@@ -50,6 +51,20 @@ static GLOBAL: Counting = Counting;
 /// A chain of point masses on rods with a damper and a driven support: every
 /// kind of element on the sparse path.
 fn hanging_chain(n: usize) -> Example {
+    Example::from_mechanism(chain_mechanism(n).build().unwrap(), None)
+}
+
+/// The hanging chain with its first rod entered twice: a dependent row at
+/// every step, dropped with `dependent_rows = Tolerate`.
+fn redundant_chain(n: usize) -> Example {
+    let mut m = chain_mechanism(n);
+    let (support, first) = (m.find("support").unwrap(), m.find("m0").unwrap());
+    m.add(Element::Distance { a: support, pa: [0.0; 2], b: first, pb: [0.0; 2], length: 0.1 });
+    Example::from_mechanism(m.build().unwrap(), None)
+}
+
+/// The mechanism of [`hanging_chain`].
+fn chain_mechanism(n: usize) -> Mechanism {
     let mut m = Mechanism::new([0.0, -9.81]);
     let support = m.rigid("support", 1.0, 0.1, [0.0, 0.0], 0.0);
     // Everything starts moving with the support: ẋ = 0.3 at t = 0.
@@ -75,7 +90,7 @@ fn hanging_chain(n: usize) -> Example {
         fx: TimeFn::linear(0.0, 1.0),
         fy: TimeFn::constant(0.0),
     });
-    Example::from_mechanism(m.build().unwrap(), None)
+    m
 }
 
 fn controls() -> Vec<Control> {
@@ -157,6 +172,7 @@ fn steps_do_not_allocate() {
     let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
     let andrews = andrews().unwrap();
     let chain = hanging_chain(64);
+    let redundant = redundant_chain(64);
     assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
@@ -200,6 +216,10 @@ fn steps_do_not_allocate() {
                 let settings = Settings { solver, ..Settings::new(scheme, 1e-3, control) };
                 let n = allocations_per_run(&chain, settings, 5, 200);
                 assert_eq!(n, 0, "chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
+                // A dependent row dropped at every step allocates nothing either.
+                let settings = Settings { dependent_rows: DependentRows::Tolerate, ..settings };
+                let n = allocations_per_run(&redundant, settings, 5, 200);
+                assert_eq!(n, 0, "redundant chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
             }
         }
     }
