@@ -90,45 +90,63 @@ pub enum DependentRows {
     Tolerate,
 }
 
+impl DependentRows {
+    /// The fraction of its diagonal entry a pivot must exceed for its row
+    /// to count as independent.
+    #[inline(always)]
+    pub(crate) fn tolerance(self) -> f64 {
+        match self {
+            DependentRows::Error => PIVOT_TOLERANCE,
+            DependentRows::Tolerate => DROP_TOLERANCE,
+        }
+    }
+}
+
 /// The pivot test of every `L D Lᵀ` of `S` (this module's and the small
 /// systems' one in `small.rs`): pivot `d` of the row `row()` whose assembled
-/// diagonal entry is `s_jj`, for the Jacobian values `jac`. A pivot that is
-/// not positive beyond round-off means a dependent row — unless the state
-/// has blown up, which is told apart so that it is not reported as singular.
-#[inline(always)]
-pub(crate) fn check_pivot(d: f64, s_jj: f64, jac: &[f64], row: impl FnOnce() -> usize) -> Result<(), Breakdown> {
-    pivot_test(d, s_jj, PIVOT_TOLERANCE, jac, row)
-}
-
-/// [`check_pivot`] with the tolerance `tolerance`.
-#[inline(always)]
-fn pivot_test(d: f64, s_jj: f64, tolerance: f64, jac: &[f64], row: impl FnOnce() -> usize) -> Result<(), Breakdown> {
-    if d.is_nan() || d <= tolerance * s_jj {
-        let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
-        return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(row()) });
-    }
-    Ok(())
-}
-
-/// `1/d` for a pivot that passes [`check_pivot`] (`Error`) or the test
-/// with [`DROP_TOLERANCE`] (`Tolerate`); 0 for a row `Tolerate` drops
-/// (which removes it from the solve: its column of `L` becomes
-/// `S_ij · 0 = 0` and its entry of `D⁻¹` is 0).
+/// diagonal entry is `s_jj`, for the Jacobian values `jac`. Returns `1/d`
+/// for a pivot above `tolerance · s_jj` (`dependent.tolerance()`, chosen
+/// once per factorization). One below means a dependent row — unless the
+/// state has blown up, which is told apart so that it is not reported as
+/// singular: the [`Breakdown`], or 0 and one more `dropped` row when
+/// `dependent` tolerates it — which removes the row from the solve: its
+/// column of `L` becomes `S_ij · 0 = 0` and its entry of `D⁻¹` is 0. A
+/// passing pivot costs what the strict test alone did.
 #[inline(always)]
 pub(crate) fn inverse_pivot(
     d: f64,
     s_jj: f64,
+    tolerance: f64,
     jac: &[f64],
     dependent: DependentRows,
+    dropped: &mut usize,
     row: impl FnOnce() -> usize,
 ) -> Result<f64, Breakdown> {
+    if d.is_nan() || d <= tolerance * s_jj {
+        return dependent_pivot(d, jac, dependent, dropped, row);
+    }
+    Ok(1.0 / d)
+}
+
+/// The failing branch of [`inverse_pivot`], out of the factorization's loop.
+#[cold]
+#[inline(never)]
+fn dependent_pivot(
+    d: f64,
+    jac: &[f64],
+    dependent: DependentRows,
+    dropped: &mut usize,
+    row: impl FnOnce() -> usize,
+) -> Result<f64, Breakdown> {
+    if !d.is_finite() || jac.iter().any(|x| !x.is_finite()) {
+        return Err(Breakdown::NonFinite);
+    }
     match dependent {
-        DependentRows::Error => check_pivot(d, s_jj, jac, row).map(|()| 1.0 / d),
-        DependentRows::Tolerate => match pivot_test(d, s_jj, DROP_TOLERANCE, jac, row) {
-            Ok(()) => Ok(1.0 / d),
-            Err(Breakdown::Singular(_)) => Ok(0.0),
-            Err(e) => Err(e),
-        },
+        DependentRows::Error => Err(Breakdown::Singular(row())),
+        DependentRows::Tolerate => {
+            *dropped += 1;
+            Ok(0.0)
+        }
     }
 }
 
@@ -160,7 +178,7 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
 /// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the
 /// elimination order of its [`Structure`].
 ///
-/// Rank-revealing: a row whose pivot fails [`check_pivot`] is an error,
+/// Rank-revealing: a row whose pivot fails [`inverse_pivot`] is an error,
 /// or, with [`DependentRows::Tolerate`], a row whose pivot is below
 /// [`DROP_TOLERANCE`] of its diagonal entry is dropped — `D⁻¹` and its
 /// column of `L` are 0 — so that `S x = b` is solved on the other rows and
@@ -379,6 +397,9 @@ impl Schur {
             dropped,
             ..
         } = self;
+        let (dependent, tolerance) = (*dependent, dependent.tolerance());
+        // Counted in a local, which stays in a register; stored once at the end.
+        let mut count = 0;
         *dropped = 0;
         // Entry `slot` of `S` (see `sum_ptr`), summed in a register.
         let entry = |slot: usize| -> f64 {
@@ -420,8 +441,7 @@ impl Schur {
                     }
                 }
             }
-            let inv = inverse_pivot(d, s_jj, jac, *dependent, || order[j] as usize)?;
-            *dropped += usize::from(inv == 0.0);
+            let inv = inverse_pivot(d, s_jj, tolerance, jac, dependent, &mut count, || order[j] as usize)?;
             unsafe {
                 *inv_d.get_unchecked_mut(j) = inv;
                 let row = *order.get_unchecked(j) as usize;
@@ -437,6 +457,7 @@ impl Schur {
                 *b.get_unchecked_mut(row) = y * inv;
             }
         }
+        *dropped = count;
         Ok(())
     }
 

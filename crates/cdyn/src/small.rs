@@ -252,13 +252,14 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     /// both must agree on, the pivot test, is shared.
     #[inline(always)]
     fn factor(&mut self) -> Result<(), Breakdown> {
+        let (dependent, tolerance) = (self.dependent, self.dependent.tolerance());
+        let mut count = 0;
         self.dropped = 0;
         for j in 0..M {
             let s_jj = self.s(j, j);
             let d = s_jj - (0..j).map(|k| self.lower[j][k] * self.lower[j][k] * self.d[k]).sum::<f64>();
-            let inv = inverse_pivot(d, s_jj, self.jac.as_flattened(), self.dependent, || j)?;
-            // A dropped row's column of L is `· 0 = 0` below: no later row subtracts it.
-            self.dropped += usize::from(inv == 0.0);
+            // A dropped row's 1/d is 0, so its column of L is too: no later row subtracts it.
+            let inv = inverse_pivot(d, s_jj, tolerance, self.jac.as_flattened(), dependent, &mut count, || j)?;
             self.d[j] = d;
             self.inv_d[j] = inv;
             for i in j + 1..M {
@@ -266,6 +267,7 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
                 self.lower[i][j] = (self.s(i, j) - update) * self.inv_d[j];
             }
         }
+        self.dropped = count;
         Ok(())
     }
 
