@@ -225,6 +225,8 @@ pub(crate) struct Schur {
     dependent: DependentRows,
     /// Rows dropped by the last factorization.
     dropped: usize,
+    /// `dependent.tolerance()`.
+    tolerance: f64,
 }
 
 /// Entries `slot` of `col_ptr`, `row_ptr` or `sum_ptr` to the next, as a
@@ -318,6 +320,7 @@ impl Schur {
             nnz: pattern.nnz(),
             dependent: DependentRows::Error,
             dropped: 0,
+            tolerance: DependentRows::Error.tolerance(),
         };
         schur.check();
         schur
@@ -350,7 +353,7 @@ impl Schur {
 
     /// Sets what a dependent row does in the next factorizations.
     pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
-        self.dependent = dependent;
+        (self.dependent, self.tolerance) = (dependent, dependent.tolerance());
     }
 
     /// Rows the last factorization dropped as dependent (0 unless tolerated).
@@ -395,9 +398,10 @@ impl Schur {
             work,
             dependent,
             dropped,
+            tolerance,
             ..
         } = self;
-        let (dependent, tolerance) = (*dependent, dependent.tolerance());
+        let (dependent, tolerance) = (*dependent, *tolerance);
         // Counted in a local, which stays in a register; stored once at the end.
         let mut count = 0;
         *dropped = 0;

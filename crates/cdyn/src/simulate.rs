@@ -237,7 +237,10 @@ impl<S: System> Stepper<S> {
         let h = self.settings.h;
         self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
         self.step += 1;
-        let dropped = self.system.take_dependent_rows();
+        let dropped = match self.settings.dependent_rows {
+            DependentRows::Error => 0,
+            DependentRows::Tolerate => self.system.take_dependent_rows(),
+        };
         if dropped > 0 {
             let r = self.rank_loss.get_or_insert(RankLoss { max: 0, steps: 0, first_time: t, last_time: t });
             (r.max, r.steps, r.last_time) = (r.max.max(dropped), r.steps + 1, t);

@@ -104,7 +104,6 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
             control: settings.control,
             e0,
             evaluations: 0,
-            dependent: 0,
             d: SmallDynamics::new(mass, settings.dependent_rows),
             rows: [[0.0; M]; 5],
             w: [0.0; N],
@@ -149,9 +148,6 @@ pub struct SmallControlled<S, const N: usize, const M: usize> {
     control: Control,
     e0: f64,
     evaluations: u64,
-    /// Most rows dropped as dependent by an evaluation since the last
-    /// [`System::take_dependent_rows`].
-    dependent: usize,
     d: SmallDynamics<N, M>,
     /// Work space of the control laws, kept so no evaluation initializes it.
     rows: [[f64; M]; 5],
@@ -174,10 +170,14 @@ struct SmallDynamics<const N: usize, const M: usize> {
     lower: [[f64; M]; M],
     d: [f64; M],
     inv_d: [f64; M],
-    /// Whether a dependent row is an error or dropped, and the rows the
-    /// last factorization dropped (as in `linalg::Schur`).
+    /// Whether a dependent row is an error or dropped, and the most rows a
+    /// factorization dropped since the last [`System::take_dependent_rows`]
+    /// (kept here, and written only when a row was dropped: a step of a
+    /// small system is some tens of instructions).
     dependent: DependentRows,
     dropped: usize,
+    /// `dependent.tolerance()`, read once per factorization.
+    tolerance: f64,
 }
 
 impl<const N: usize, const M: usize> SmallDynamics<N, M> {
@@ -209,6 +209,7 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
             inv_d: [0.0; M],
             dependent,
             dropped: 0,
+            tolerance: dependent.tolerance(),
         }
     }
 
@@ -252,9 +253,8 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     /// both must agree on, the pivot test, is shared.
     #[inline(always)]
     fn factor(&mut self) -> Result<(), Breakdown> {
-        let (dependent, tolerance) = (self.dependent, self.dependent.tolerance());
+        let (dependent, tolerance) = (self.dependent, self.tolerance);
         let mut count = 0;
-        self.dropped = 0;
         for j in 0..M {
             let s_jj = self.s(j, j);
             let d = s_jj - (0..j).map(|k| self.lower[j][k] * self.lower[j][k] * self.d[k]).sum::<f64>();
@@ -267,7 +267,9 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
                 self.lower[i][j] = (self.s(i, j) - update) * self.inv_d[j];
             }
         }
-        self.dropped = count;
+        if count > 0 {
+            self.dropped = self.dropped.max(count);
+        }
         Ok(())
     }
 
@@ -368,7 +370,6 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
         self.evaluations += 1;
         let d = &mut self.d;
         d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        self.dependent = self.dependent.max(d.dropped);
         let e_dot = energy::power(d.force_power, &d.lambda, &d.phi_t);
         f[..N].copy_from_slice(&v);
         f[N..2 * N].copy_from_slice(&d.acc);
@@ -401,7 +402,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         self.evaluations
     }
     fn take_dependent_rows(&mut self) -> usize {
-        std::mem::take(&mut self.dependent)
+        std::mem::take(&mut self.d.dropped)
     }
     fn last_violation(&self) -> f64 {
         self.d.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
