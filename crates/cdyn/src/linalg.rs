@@ -85,8 +85,11 @@ pub enum DependentRows {
     Error,
     /// Solve without the row: its multiplier is 0 and the rows before it
     /// carry the whole reaction (a *basic* solution of the singular
-    /// system; see [`Schur`]). The accelerations are the unique ones
-    /// whenever the constraint equations are consistent.
+    /// system, not the minimum-norm one). The accelerations are the unique
+    /// ones whenever the constraint equations are consistent. Rows are
+    /// dropped below 1e-8 of their diagonal entry (not 1e-12: redundant
+    /// rows are dependent only on the constraint manifold, and a drift
+    /// makes them independent by its square).
     Tolerate,
 }
 

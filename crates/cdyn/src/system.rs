@@ -50,7 +50,7 @@ pub trait System: Rhs<Error = EvalError> {
     /// Right-hand-side evaluations so far.
     fn evaluations(&self) -> u64;
     /// The most constraint rows an evaluation dropped as dependent since
-    /// the last call (0 unless [`DependentRows::Tolerate`](crate::linalg::DependentRows)), and resets it.
+    /// the last call (0 unless [`DependentRows::Tolerate`](crate::dynamics::DependentRows)), and resets it.
     fn take_dependent_rows(&mut self) -> usize;
     /// `max |Φ|` at the state of the latest evaluation.
     fn last_violation(&self) -> f64;
