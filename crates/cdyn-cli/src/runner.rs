@@ -9,7 +9,7 @@ use crate::progress;
 use anyhow::{Context, Result};
 use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sample, Series, Sink};
-use cdyn::simulate::{Stepper, steps_to};
+use cdyn::simulate::{RankLoss, Stepper, steps_to};
 use cdyn::system::System;
 use cdyn::{Settings, Simulation};
 use indicatif::ProgressBar;
@@ -124,6 +124,10 @@ pub struct CaseResult {
     pub tuning: Option<cdyn::gains::Tuning>,
     /// Mean Newton iterations per step of the `projection` method.
     pub projection_iterations_per_step: Option<f64>,
+    /// Steps in which constraint rows were dropped as dependent
+    /// (`dependent_rows = "tolerate"`): the most rows at once, how many
+    /// steps, the first and last; `null` if none were.
+    pub dependent_rows: Option<RankLoss>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
     /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
@@ -141,6 +145,7 @@ struct Method {
     tuning: Option<cdyn::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
     frames: Frames,
+    rank_loss: Option<RankLoss>,
 }
 
 /// The series of a run that kept none (sweeps).
@@ -162,6 +167,7 @@ impl CaseResult {
             control: method.control,
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
+            dependent_rows: method.rank_loss,
             interrupted: method.interrupted,
             frames: method.frames,
         }
@@ -321,6 +327,7 @@ fn simulate<K: Sink>(
                     .is_some()
                     .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
                 frames,
+                rank_loss: sim.rank_loss().copied(),
             };
             Ok((record, method))
         }

@@ -4,7 +4,8 @@
 
 use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
-use cdyn::assemble::assemble;
+use cdyn::assemble::assemble_with;
+use cdyn::dynamics::DependentRows;
 use cdyn::error::{Part, positive};
 use cdyn::methods::{MethodKeys, Preset};
 use cdyn::models::{Example, Kind};
@@ -95,6 +96,10 @@ pub struct IntegratorSpec {
     pub scheme: Scheme,
     pub h: f64,
     pub t_end: f64,
+    /// A constraint row that depends on the others: `"error"` (default) or
+    /// `"tolerate"` (solved without it; redundant constraints).
+    #[serde(default)]
+    pub dependent_rows: DependentRows,
 }
 
 #[derive(Debug, Deserialize, Default, Clone)]
@@ -269,7 +274,7 @@ impl Scenario {
             ),
             other => integrator(other),
         })?;
-        let mut settings = Settings::new(i.scheme, h, control);
+        let mut settings = Settings { dependent_rows: i.dependent_rows, ..Settings::new(i.scheme, h, control) };
         let init = &self.initial;
         if let Some(tol) = init.tolerance {
             settings.consistency_tolerance =
@@ -297,10 +302,11 @@ impl Scenario {
         let assembly = if init.assemble.unwrap_or(self.model.kind == Kind::Mechanism) {
             let tolerance = settings.consistency_tolerance.unwrap_or(1e-9).min(1e-10);
             let Example { model, q0, v0, .. } = &mut example;
-            Some(
-                assemble(model, q0, v0, 0.0, tolerance)
-                    .map_err(|e| anyhow!("{file}: [initial]: {e}{}", worst_entry(&example, &rows)))?,
-            )
+            Some(assemble_with(model, q0, v0, 0.0, tolerance, settings.dependent_rows).map_err(|e| {
+                // A dependent row is named; otherwise the worst violated one.
+                let entry = e.row().and_then(|r| rows.get(r)).map(|e| format!(" ({e})"));
+                anyhow!("{file}: [initial]: {e}{}", entry.unwrap_or_else(|| worst_entry(&example, &rows)))
+            })?)
         } else {
             None
         };

@@ -66,6 +66,11 @@ fn bad_scenarios_get_one_line_naming_the_problem() {
         (GOOD.replace("geometric = \"cvsgf\"", "geometric = \"magic\""), &["bad.toml", "magic"]),
         (GOOD.replace("scheme = \"ab3\"", "scheme = \"rk45\""), &["bad.toml", "rk45"]),
         (
+            GOOD.replace("t_end = 1.0", "t_end = 1.0\ndependent_rows = \"ignore\""),
+            &["bad.toml", "dependent_rows", "ignore", "tolerate"],
+        ),
+        (GOOD.replace("t_end = 1.0", "t_end = 1.0\ndependent_rows = 1"), &["bad.toml", "dependent_rows"]),
+        (
             GOOD.replace("[model]\nkind = \"pendulum\"", "[model]\nkind = \"pendulum\"\nlength = -2"),
             &["bad.toml", "length", "-2"],
         ),

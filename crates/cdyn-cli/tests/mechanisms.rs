@@ -192,3 +192,48 @@ fn knife_edge_mistakes_name_the_entry() {
         }
     }
 }
+
+#[test]
+fn a_redundant_crank_is_tolerated_and_reported_or_named_when_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = examples().join("parallelogram_redundant.toml");
+    let out = cdyn(&["run"], &path, dir.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let case = &summary(dir.path())["cases"][0];
+    assert!(case["error"].is_null(), "{case}");
+    let rows = &case["dependent_rows"];
+    assert_eq!((rows["max"].as_u64(), rows["steps"].as_u64()), (Some(1), case["steps"].as_u64()), "{rows}");
+    assert_eq!(rows["first_time"].as_f64(), Some(0.0), "{rows}");
+    assert!((rows["last_time"].as_f64().unwrap() - 4.999).abs() < 1e-9, "{rows}");
+
+    // Strict (the default): one line naming the redundant entry, at
+    // assembly or, without it, at the first step.
+    let text = std::fs::read_to_string(&path).unwrap();
+    for (strict, at) in [
+        (text.replace("\ndependent_rows = \"tolerate\"\n", "\n"), "assembly"),
+        (
+            text.replace(
+                "\ndependent_rows = \"tolerate\"\n",
+                "\ndependent_rows = \"error\"\n[initial]\nassemble = false\n",
+            ),
+            "step 0",
+        ),
+    ] {
+        let file = dir.path().join("strict.toml");
+        std::fs::write(&file, strict).unwrap();
+        let out = cdyn(&["run"], &file, &dir.path().join("strict"));
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert!(!out.status.success() && stderr.trim_end().lines().count() == 1, "{stderr}");
+        for part in [at, "joints[4] (distance)", "dependent_rows = \"tolerate\""] {
+            assert!(stderr.contains(part), "{part}: {stderr}");
+        }
+    }
+}
+
+#[test]
+fn a_run_without_dependent_rows_reports_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = cdyn(&["run"], &examples().join("four_bar.toml"), dir.path());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(summary(dir.path())["cases"][0]["dependent_rows"].is_null());
+}

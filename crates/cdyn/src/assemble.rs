@@ -7,7 +7,7 @@
 //! units mixed in `q` (lengths and angles) and reuses the factorization
 //! the dynamics already need.
 
-use crate::dynamics::{Breakdown, Dynamics};
+use crate::dynamics::{Breakdown, DependentRows, Dynamics};
 use crate::error::{Part, Problem, Result};
 use crate::model::Model;
 use crate::projection::{Failure, Work, positions, velocities};
@@ -35,10 +35,26 @@ fn max_abs(x: &[f64]) -> f64 {
     x.iter().fold(0.0, |a, x| a.max(x.abs()))
 }
 
-/// Projects `(q, v)` at time `t` onto the constraints, to `|Φ| ≤ tolerance`.
+/// Projects `(q, v)` at time `t` onto the constraints, to `|Φ| ≤ tolerance`;
+/// a dependent constraint row is an error.
 pub fn assemble(model: &Model, q: &mut [f64], v: &mut [f64], t: f64, tolerance: f64) -> Result<Assembly> {
+    assemble_with(model, q, v, t, tolerance, DependentRows::Error)
+}
+
+/// As [`assemble`], with dependent constraint rows handled as `dependent`
+/// says: tolerated, the Newton steps and the velocity correction are the
+/// basic solutions (see `DependentRows::Tolerate`).
+pub fn assemble_with(
+    model: &Model,
+    q: &mut [f64],
+    v: &mut [f64],
+    t: f64,
+    tolerance: f64,
+    dependent: DependentRows,
+) -> Result<Assembly> {
     const MAX_ITERATIONS: u32 = 50;
     let mut d = Dynamics::new(model);
+    d.set_dependent_rows(dependent);
     let (q_start, v_start) = (q.to_vec(), v.to_vec());
     let mut out = Assembly::default();
     let mut work = Work::new(model);

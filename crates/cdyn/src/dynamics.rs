@@ -4,7 +4,7 @@
 use crate::constraint::ConstraintBuffers;
 use crate::energy;
 use crate::linalg::Schur;
-pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
+pub use crate::linalg::{Breakdown, DependentRows, LinearSolver, SPARSE_FROM};
 use crate::mass::MassMatrix;
 use crate::model::Model;
 
@@ -42,6 +42,17 @@ impl Dynamics {
             acc: vec![0.0; n],
             schur: Schur::new(model.pattern(), model.mass(), solver),
         }
+    }
+
+    /// Sets what a dependent constraint row does in the next evaluations
+    /// (default: [`DependentRows::Error`]).
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.schur.set_dependent_rows(dependent);
+    }
+
+    /// Constraint rows the last evaluation dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        self.schur.dependent_rows()
     }
 
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the

@@ -39,7 +39,7 @@ pub enum Error {
     },
     /// `Φ_q M⁻¹ Φ_qᵀ` is singular: the constraints are redundant or degenerate here.
     #[error(
-        "singular constraint matrix at step {step}, t = {}: constraint row {row} is linearly dependent on the others", Time(*t)
+        "singular constraint matrix at step {step}, t = {}: constraint row {row} is linearly dependent on the others (if the constraints are redundant, set dependent_rows = \"tolerate\")", Time(*t)
     )]
     SingularConstraints {
         /// Steps taken before the failure.
@@ -302,7 +302,9 @@ pub enum Problem {
         value: f64,
     },
     /// The constraints are singular where the state is to be projected.
-    #[error("the constraints are singular at the given positions (row {row}, iteration {iteration})")]
+    #[error(
+        "the constraints are singular at the given positions (row {row}, iteration {iteration}; if they are redundant, set dependent_rows = \"tolerate\")"
+    )]
     SingularAssembly {
         /// The dependent row.
         row: usize,
@@ -336,6 +338,7 @@ impl Error {
     pub fn row(&self) -> Option<usize> {
         match self {
             Error::SingularConstraints { row, .. } => Some(*row),
+            Error::InvalidModel { problem: Problem::SingularAssembly { row, .. }, .. } => Some(*row),
             Error::ProjectionFailed { row, .. } => *row,
             _ => None,
         }

@@ -42,21 +42,115 @@ pub enum LinearSolver {
 pub const SPARSE_FROM: usize = 48;
 
 /// Pivots below this fraction of the assembled diagonal mean the row
-/// depends on the rows before it.
+/// depends on the rows before it: an error (the strict default).
+///
+/// `d_j / S_jj` is the squared sine of the angle (in the metric `M⁻¹`)
+/// between row `j` of `Φ_q` and the span of the rows eliminated before it,
+/// so the test does not depend on the units or scale of a row. An exactly
+/// dependent row leaves round-off, `d_j / S_jj` of order `ε ≈ 1e-16` times
+/// a small growth factor; 1e-12 flags it with a margin of 10⁴.
 const PIVOT_TOLERANCE: f64 = 1e-12;
+
+/// Pivots below this fraction of the assembled diagonal are dropped with
+/// [`DependentRows::Tolerate`]: rows within 1e-4 rad of the span of the
+/// others.
+///
+/// Larger than [`PIVOT_TOLERANCE`] because redundant constraints are
+/// dependent only *on* the constraint manifold: at a drift `|Φ| ~ δ` their
+/// rows differ by `O(δ)`, so `d_j / S_jj ~ δ²`, and a row kept with such a
+/// pivot enforces a second, slightly different constraint — its multiplier
+/// grows like the right-hand side's `O(δ)` inconsistency over `δ²`. Measured
+/// on the parallelogram with a redundant crank under energy-only control:
+/// at 1e-12 the row came back once `|Φ|` drifted past 1e-7 and the run
+/// diverged within 0.5 s; at 1e-8 drifts to about 1e-5 are absorbed. A
+/// legitimately near-singular row (a mechanism within 1e-4 rad of a flat
+/// position) is dropped instead of solved with a pivot 1e-8 of its scale,
+/// where its equation is nearly implied by the others.
+const DROP_TOLERANCE: f64 = 1e-8;
+
+/// What to do with a constraint row that depends on the rows eliminated
+/// before it (a pivot of `Φ_q M⁻¹ Φ_qᵀ` small relative to its diagonal
+/// entry): redundant constraints, or a mechanism passing through a
+/// singular position.
+///
+/// In scenario files: `[integrator] dependent_rows = "error"` or `"tolerate"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum DependentRows {
+    /// Stop with an error naming the row. The default: a dependent row is
+    /// far more often a modelling mistake (a joint entered twice) than an
+    /// intended redundancy, and redundant constraints are opted into.
+    #[default]
+    Error,
+    /// Solve without the row: its multiplier is 0 and the rows before it
+    /// carry the whole reaction (a *basic* solution of the singular
+    /// system, not the minimum-norm one). The accelerations are the unique
+    /// ones whenever the constraint equations are consistent. Rows are
+    /// dropped below 1e-8 of their diagonal entry (not 1e-12: redundant
+    /// rows are dependent only on the constraint manifold, and a drift
+    /// makes them independent by its square).
+    Tolerate,
+}
+
+impl DependentRows {
+    /// The fraction of its diagonal entry a pivot must exceed for its row
+    /// to count as independent.
+    #[inline(always)]
+    pub(crate) fn tolerance(self) -> f64 {
+        match self {
+            DependentRows::Error => PIVOT_TOLERANCE,
+            DependentRows::Tolerate => DROP_TOLERANCE,
+        }
+    }
+}
 
 /// The pivot test of every `L D Lᵀ` of `S` (this module's and the small
 /// systems' one in `small.rs`): pivot `d` of the row `row()` whose assembled
-/// diagonal entry is `s_jj`, for the Jacobian values `jac`. A pivot that is
-/// not positive beyond round-off means a dependent row — unless the state
-/// has blown up, which is told apart so that it is not reported as singular.
+/// diagonal entry is `s_jj`, for the Jacobian values `jac`. Returns `1/d`
+/// for a pivot above `tolerance · s_jj` (`dependent.tolerance()`, chosen
+/// once per factorization). One below means a dependent row — unless the
+/// state has blown up, which is told apart so that it is not reported as
+/// singular: the [`Breakdown`], or 0 and one more `dropped` row when
+/// `dependent` tolerates it — which removes the row from the solve: its
+/// column of `L` becomes `S_ij · 0 = 0` and its entry of `D⁻¹` is 0. A
+/// passing pivot costs what the strict test alone did.
 #[inline(always)]
-pub(crate) fn check_pivot(d: f64, s_jj: f64, jac: &[f64], row: impl FnOnce() -> usize) -> Result<(), Breakdown> {
-    if d.is_nan() || d <= PIVOT_TOLERANCE * s_jj {
-        let blown_up = !d.is_finite() || jac.iter().any(|x| !x.is_finite());
-        return Err(if blown_up { Breakdown::NonFinite } else { Breakdown::Singular(row()) });
+pub(crate) fn inverse_pivot(
+    d: f64,
+    s_jj: f64,
+    tolerance: f64,
+    jac: &[f64],
+    dependent: DependentRows,
+    dropped: &mut usize,
+    row: impl FnOnce() -> usize,
+) -> Result<f64, Breakdown> {
+    if d.is_nan() || d <= tolerance * s_jj {
+        return dependent_pivot(d, jac, dependent, dropped, row);
     }
-    Ok(())
+    Ok(1.0 / d)
+}
+
+/// The failing branch of [`inverse_pivot`], out of the factorization's loop.
+#[cold]
+#[inline(never)]
+fn dependent_pivot(
+    d: f64,
+    jac: &[f64],
+    dependent: DependentRows,
+    dropped: &mut usize,
+    row: impl FnOnce() -> usize,
+) -> Result<f64, Breakdown> {
+    if !d.is_finite() || jac.iter().any(|x| !x.is_finite()) {
+        return Err(Breakdown::NonFinite);
+    }
+    match dependent {
+        DependentRows::Error => Err(Breakdown::Singular(row())),
+        DependentRows::Tolerate => {
+            *dropped += 1;
+            Ok(0.0)
+        }
+    }
 }
 
 /// For every pair of rows `(a ≥ b)` sharing a coordinate, the products
@@ -87,6 +181,20 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
 /// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the
 /// elimination order of its [`Structure`].
 ///
+/// Rank-revealing: a row whose pivot fails [`inverse_pivot`] is an error,
+/// or, with [`DependentRows::Tolerate`], a row whose pivot is below
+/// [`DROP_TOLERANCE`] of its diagonal entry is dropped — `D⁻¹` and its
+/// column of `L` are 0 — so that `S x = b` is solved on the other rows and
+/// the dropped rows' `x` is 0. For a consistent `b` (in the range of `S`,
+/// as `Φ_q M⁻¹ G − γ` is when the constraints are compatible) this is an
+/// exact solution, the *basic* one, and `Φ_qᵀ x` — hence the acceleration —
+/// is the same for every solution. Not the minimum-norm multipliers: that
+/// needs a second solve on the dependent set, and the basic solution is
+/// what the rows' order already defines, costs nothing per step and keeps
+/// a dependent row's multiplier exactly 0. For an inconsistent `b` (a
+/// control law's `Φ` off the manifold) the dropped rows' equations are
+/// simply not enforced; nothing is divided by a vanishing pivot.
+///
 /// Everything the numeric passes read per row is addressed by original row
 /// number (`order` maps elimination positions to rows), so a right-hand side
 /// is solved in place, without a permuted copy. Indices are `u32`: the
@@ -116,6 +224,12 @@ pub(crate) struct Schur {
     work: Vec<f64>,
     /// Length of the Jacobian the terms index.
     nnz: usize,
+    /// Whether a dependent row is an error or dropped.
+    dependent: DependentRows,
+    /// Rows dropped by the last factorization.
+    dropped: usize,
+    /// `dependent.tolerance()`.
+    tolerance: f64,
 }
 
 /// Entries `slot` of `col_ptr`, `row_ptr` or `sum_ptr` to the next, as a
@@ -207,6 +321,9 @@ impl Schur {
             inv_d: vec![0.0; m],
             work: vec![0.0; m],
             nnz: pattern.nnz(),
+            dependent: DependentRows::Error,
+            dropped: 0,
+            tolerance: DependentRows::Error.tolerance(),
         };
         schur.check();
         schur
@@ -237,6 +354,16 @@ impl Schur {
         assert!(squares, "a constraint row reads a coordinate twice");
     }
 
+    /// Sets what a dependent row does in the next factorizations.
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        (self.dependent, self.tolerance) = (dependent, dependent.tolerance());
+    }
+
+    /// Rows the last factorization dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        self.dropped
+    }
+
     /// Assembles `S` from the Jacobian values, factors it and solves
     /// `S x = b` in place. The forward substitution and the diagonal
     /// scaling join the factorization (column `j` of `L` is final when it is
@@ -260,8 +387,27 @@ impl Schur {
     /// `jac.len() == self.nnz` and `b.len() == self.m`.
     unsafe fn factor(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
         let m = self.m;
-        let Self { order, col_ptr, row_idx, row_ptr, row_entries, sum_ptr, terms, lower, scaled, inv_d, work, .. } =
-            self;
+        let Self {
+            order,
+            col_ptr,
+            row_idx,
+            row_ptr,
+            row_entries,
+            sum_ptr,
+            terms,
+            lower,
+            scaled,
+            inv_d,
+            work,
+            dependent,
+            dropped,
+            tolerance,
+            ..
+        } = self;
+        let (dependent, tolerance) = (*dependent, *tolerance);
+        // Counted in a local, which stays in a register; stored once at the end.
+        let mut count = 0;
+        *dropped = 0;
         // Entry `slot` of `S` (see `sum_ptr`), summed in a register.
         let entry = |slot: usize| -> f64 {
             // SAFETY (here and below): indices from the checked structure.
@@ -302,8 +448,7 @@ impl Schur {
                     }
                 }
             }
-            check_pivot(d, s_jj, jac, || order[j] as usize)?;
-            let inv = 1.0 / d;
+            let inv = inverse_pivot(d, s_jj, tolerance, jac, dependent, &mut count, || order[j] as usize)?;
             unsafe {
                 *inv_d.get_unchecked_mut(j) = inv;
                 let row = *order.get_unchecked(j) as usize;
@@ -319,6 +464,7 @@ impl Schur {
                 *b.get_unchecked_mut(row) = y * inv;
             }
         }
+        *dropped = count;
         Ok(())
     }
 
@@ -564,6 +710,75 @@ mod tests {
             let mut bad = values(pattern.nnz(), 0.7);
             bad[3] = f64::INFINITY;
             assert_eq!(s.factor_and_solve(&bad, &mut vec![1.0; m]), Err(Breakdown::NonFinite), "{solver:?}");
+            // Tolerated, the blown-up Jacobian is still not called singular.
+            s.set_dependent_rows(DependentRows::Tolerate);
+            assert_eq!(s.factor_and_solve(&bad, &mut vec![1.0; m]), Err(Breakdown::NonFinite), "{solver:?}");
+        }
+    }
+
+    /// The repeated-row system of the test above, and a consistent
+    /// right-hand side `b = S y`.
+    fn repeated_row() -> (Pattern, usize, Vec<f64>) {
+        let (mut pattern, n) = star(3, 4);
+        let last = pattern.row(pattern.start.len() - 2);
+        let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
+        pattern.cols.extend(&repeated);
+        pattern.start.push(pattern.cols.len() as u32);
+        let mut jac = values(pattern.nnz(), 0.7);
+        let k = repeated.len();
+        let tail = jac.len() - k;
+        let copy = jac[tail - k..tail].to_vec();
+        // Twice the row before: dependent, and not of the same scale.
+        jac[tail..].iter_mut().zip(&copy).for_each(|(j, c)| *j = 2.0 * c);
+        (pattern, n, jac)
+    }
+
+    /// `M⁻¹ Φ_qᵀ x`.
+    fn weighted_jt(pattern: &Pattern, jac: &[f64], inv_mass: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; inv_mass.len()];
+        for (r, &xr) in x.iter().enumerate() {
+            for j in pattern.row(r) {
+                let c = pattern.cols[j] as usize;
+                out[c] += inv_mass[c] * jac[j] * xr;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_tolerated_dependent_row_is_dropped_with_a_zero_multiplier_and_the_same_response() {
+        let (pattern, n, jac) = repeated_row();
+        let m = pattern.start.len() - 1;
+        let mass: DiagonalMass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+        let inv_mass = mass.inverse();
+        // b = S y = Φ_q M⁻¹ Φ_qᵀ y: in the range of S.
+        let y = values(m, 4.0);
+        let w = weighted_jt(&pattern, &jac, inv_mass, &y);
+        let b: Vec<f64> = (0..m).map(|r| pattern.row(r).map(|j| jac[j] * w[pattern.cols[j] as usize]).sum()).collect();
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &mass, solver);
+            s.set_dependent_rows(DependentRows::Tolerate);
+            let mut x = b.clone();
+            s.factor_and_solve(&jac, &mut x).unwrap();
+            assert_eq!(s.dependent_rows(), 1, "{solver:?}");
+            let dropped: Vec<usize> = (0..m).filter(|&r| x[r] == 0.0).collect();
+            assert!(dropped == [m - 1] || dropped == [m - 2], "{solver:?}: zero multipliers {dropped:?}");
+            let r = residual(&pattern, &jac, inv_mass, &x, &b);
+            assert!(r < 1e-12, "{solver:?}: relative residual {r:e}");
+            // The response M⁻¹ Φ_qᵀ x is the unique one, though x is not y.
+            let (got, want) = (weighted_jt(&pattern, &jac, inv_mass, &x), &w);
+            let err = got.iter().zip(want).fold(0.0_f64, |a, (g, w)| a.max((g - w).abs()));
+            assert!(err < 1e-12, "{solver:?}: response off by {err:e}");
+            // Further solves with the factorization drop the same row.
+            let mut again = b.clone();
+            s.solve(&mut again);
+            assert_eq!(again, x, "{solver:?}");
+            // An independent system afterwards counts no dropped row.
+            let (indep, _) = star(3, 4);
+            let mut t = Schur::new(&indep, &mass, solver);
+            t.set_dependent_rows(DependentRows::Tolerate);
+            t.factor_and_solve(&values(indep.nnz(), 0.7), &mut vec![1.0; m - 1]).unwrap();
+            assert_eq!(t.dependent_rows(), 0, "{solver:?}");
         }
     }
 }

@@ -6,7 +6,7 @@
 
 use crate::control::Control;
 use crate::diagnostics::Measures;
-use crate::dynamics::LinearSolver;
+use crate::dynamics::{DependentRows, LinearSolver};
 use crate::error::{Error, Part, Problem, Result, positive};
 use crate::gains::{Tuning, resolve};
 use crate::integrate::{Buffer, Integrator, Scheme};
@@ -29,6 +29,9 @@ pub struct Settings {
     pub violation_limit: f64,
     /// Dense or sparse factorization of `Φ_q M⁻¹ Φ_qᵀ` (default: by size).
     pub solver: LinearSolver,
+    /// Whether a dependent constraint row stops the run (the default) or
+    /// is solved around (redundant constraints, singular positions).
+    pub dependent_rows: DependentRows,
 }
 
 impl Settings {
@@ -42,6 +45,7 @@ impl Settings {
             consistency_tolerance: Some(1e-9),
             violation_limit: f64::INFINITY,
             solver: LinearSolver::Auto,
+            dependent_rows: DependentRows::Error,
         }
     }
 
@@ -75,6 +79,24 @@ pub struct Stepper<S: System> {
     /// Newton iterations of the projection so far, and steps it failed.
     projection_iterations: u64,
     projection_failures: u64,
+    /// Steps with dependent constraint rows, if any.
+    rank_loss: Option<RankLoss>,
+}
+
+/// When the constraints lost rank during a run with
+/// [`DependentRows::Tolerate`]: steps in which an evaluation of the
+/// right-hand side dropped dependent rows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct RankLoss {
+    /// The most rows one evaluation dropped.
+    pub max: usize,
+    /// Steps with at least one dropped row.
+    pub steps: u64,
+    /// Start time of the first such step.
+    pub first_time: f64,
+    /// Start time of the last such step.
+    pub last_time: f64,
 }
 
 /// A running simulation of a [`Model`].
@@ -87,7 +109,9 @@ impl<'m> Simulation<'m> {
         settings.validate()?;
         check_initial_state(model.n(), q0, v0)?;
         let e0 = model.kinetic(v0) + model.potential(q0, None);
-        Self::start(ControlledSystem::with_solver(model, settings.control, e0, settings.solver), settings, q0, v0)
+        let mut system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
+        system.set_dependent_rows(settings.dependent_rows);
+        Self::start(system, settings, q0, v0)
     }
 
     /// The model simulated.
@@ -133,7 +157,19 @@ impl<S: System> Stepper<S> {
         system.set_control(control);
         let settings = Settings { control, ..settings };
         let integrator = Integrator::with_zero(settings.scheme, settings.control.application, system.zero_state());
-        Ok(Self { system, integrator, settings, tuning, x, step: 0, projection_iterations: 0, projection_failures: 0 })
+        // The gains' evaluation is not a step.
+        system.take_dependent_rows();
+        Ok(Self {
+            system,
+            integrator,
+            settings,
+            tuning,
+            x,
+            step: 0,
+            projection_iterations: 0,
+            projection_failures: 0,
+            rank_loss: None,
+        })
     }
 
     /// What the automatic gains were chosen from, and the largest rate × h
@@ -148,6 +184,10 @@ impl<S: System> Stepper<S> {
     /// Steps whose projection did not converge (with `on_failure = continue`).
     pub fn projection_failures(&self) -> u64 {
         self.projection_failures
+    }
+    /// Steps in which the constraints lost rank so far; `None` if none did.
+    pub fn rank_loss(&self) -> Option<&RankLoss> {
+        self.rank_loss.as_ref()
     }
 
     /// The settings it runs with, its control with the automatic gains chosen.
@@ -197,6 +237,14 @@ impl<S: System> Stepper<S> {
         let h = self.settings.h;
         self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
         self.step += 1;
+        let dropped = match self.settings.dependent_rows {
+            DependentRows::Error => 0,
+            DependentRows::Tolerate => self.system.take_dependent_rows(),
+        };
+        if dropped > 0 {
+            let r = self.rank_loss.get_or_insert(RankLoss { max: 0, steps: 0, first_time: t, last_time: t });
+            (r.max, r.steps, r.last_time) = (r.max.max(dropped), r.steps + 1, t);
+        }
         if !all_finite(self.x.as_slice()) {
             return Err(Error::Diverged { step: self.step, t: self.t() });
         }

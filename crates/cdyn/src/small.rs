@@ -18,7 +18,7 @@ use crate::energy;
 use crate::error::{Error, Result};
 use crate::force::{Force, Potential, energy_and_gradient};
 use crate::integrate::{Buffer, Rhs};
-use crate::linalg::{Breakdown, check_pivot};
+use crate::linalg::{Breakdown, DependentRows, inverse_pivot};
 use crate::mass::{DiagonalMass, MassMatrix};
 use crate::model::{Model, check_rows};
 use crate::projection::{Failure, Projection};
@@ -104,7 +104,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
             control: settings.control,
             e0,
             evaluations: 0,
-            d: SmallDynamics::new(mass),
+            d: SmallDynamics::new(mass, settings.dependent_rows),
             rows: [[0.0; M]; 5],
             w: [0.0; N],
         };
@@ -170,6 +170,14 @@ struct SmallDynamics<const N: usize, const M: usize> {
     lower: [[f64; M]; M],
     d: [f64; M],
     inv_d: [f64; M],
+    /// Whether a dependent row is an error or dropped, and the most rows a
+    /// factorization dropped since the last [`System::take_dependent_rows`]
+    /// (kept here, and written only when a row was dropped: a step of a
+    /// small system is some tens of instructions).
+    dependent: DependentRows,
+    dropped: usize,
+    /// `dependent.tolerance()`, read once per factorization.
+    tolerance: f64,
 }
 
 impl<const N: usize, const M: usize> SmallDynamics<N, M> {
@@ -184,7 +192,7 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
         all
     };
 
-    fn new(mass: DiagonalMass<[f64; N]>) -> Self {
+    fn new(mass: DiagonalMass<[f64; N]>, dependent: DependentRows) -> Self {
         Self {
             mass,
             phi: [0.0; M],
@@ -199,6 +207,9 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
             lower: [[0.0; M]; M],
             d: [0.0; M],
             inv_d: [0.0; M],
+            dependent,
+            dropped: 0,
+            tolerance: dependent.tolerance(),
         }
     }
 
@@ -231,7 +242,8 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
         Ok(())
     }
 
-    /// Factors `S = Φ_q M⁻¹ Φ_qᵀ` as `L D Lᵀ`, with the pivot test of the general kernel.
+    /// Factors `S = Φ_q M⁻¹ Φ_qᵀ` as `L D Lᵀ`, with the pivot test and the
+    /// dropping of dependent rows of the general kernel.
     ///
     /// A second copy of the factorization on purpose: `linalg::Schur` reads
     /// every entry through index arrays, and stepping a small system through
@@ -241,16 +253,22 @@ impl<const N: usize, const M: usize> SmallDynamics<N, M> {
     /// both must agree on, the pivot test, is shared.
     #[inline(always)]
     fn factor(&mut self) -> Result<(), Breakdown> {
+        let (dependent, tolerance) = (self.dependent, self.tolerance);
+        let mut count = 0;
         for j in 0..M {
             let s_jj = self.s(j, j);
             let d = s_jj - (0..j).map(|k| self.lower[j][k] * self.lower[j][k] * self.d[k]).sum::<f64>();
-            check_pivot(d, s_jj, self.jac.as_flattened(), || j)?;
+            // A dropped row's 1/d is 0, so its column of L is too: no later row subtracts it.
+            let inv = inverse_pivot(d, s_jj, tolerance, self.jac.as_flattened(), dependent, &mut count, || j)?;
             self.d[j] = d;
-            self.inv_d[j] = 1.0 / d;
+            self.inv_d[j] = inv;
             for i in j + 1..M {
                 let update: f64 = (0..j).map(|k| self.lower[i][k] * self.lower[j][k] * self.d[k]).sum();
                 self.lower[i][j] = (self.s(i, j) - update) * self.inv_d[j];
             }
+        }
+        if count > 0 {
+            self.dropped = self.dropped.max(count);
         }
         Ok(())
     }
@@ -382,6 +400,9 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
     }
     fn evaluations(&self) -> u64 {
         self.evaluations
+    }
+    fn take_dependent_rows(&mut self) -> usize {
+        std::mem::take(&mut self.d.dropped)
     }
     fn last_violation(&self) -> f64 {
         self.d.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))

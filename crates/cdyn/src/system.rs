@@ -3,7 +3,7 @@
 
 use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::{Measures, Probe};
-use crate::dynamics::{Breakdown, Dynamics, LinearSolver};
+use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::{Buffer, Rhs};
 use crate::mass::DiagonalMass;
@@ -49,6 +49,9 @@ pub trait System: Rhs<Error = EvalError> {
     fn e0(&self) -> f64;
     /// Right-hand-side evaluations so far.
     fn evaluations(&self) -> u64;
+    /// The most constraint rows an evaluation dropped as dependent since
+    /// the last call (0 unless [`DependentRows::Tolerate`](crate::dynamics::DependentRows)), and resets it.
+    fn take_dependent_rows(&mut self) -> usize;
     /// `max |Φ|` at the state of the latest evaluation.
     fn last_violation(&self) -> f64;
     /// Violations at the state `x`, time `t`.
@@ -84,6 +87,9 @@ pub struct ControlledSystem<'m> {
     projection: projection::Work,
     /// Right-hand-side evaluations so far.
     evaluations: u64,
+    /// Most rows dropped as dependent by an evaluation since the last
+    /// [`System::take_dependent_rows`].
+    dependent: usize,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -104,7 +110,13 @@ impl<'m> ControlledSystem<'m> {
             probe: Probe::new(model),
             projection: projection::Work::new(model),
             evaluations: 0,
+            dependent: 0,
         }
+    }
+
+    /// Sets what a dependent constraint row does (default: an error).
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.dynamics.set_dependent_rows(dependent);
     }
 
     /// The model it evaluates.
@@ -140,6 +152,7 @@ impl Rhs for ControlledSystem<'_> {
         let (q, v, e) = split_state(x, n);
         self.evaluations += 1;
         self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
+        self.dependent = self.dependent.max(self.dynamics.dependent_rows());
         let e_dot = self.dynamics.energy_input();
         f[..n].copy_from_slice(v);
         f[n..2 * n].copy_from_slice(self.dynamics.acc());
@@ -171,6 +184,9 @@ impl System for ControlledSystem<'_> {
     }
     fn evaluations(&self) -> u64 {
         self.evaluations
+    }
+    fn take_dependent_rows(&mut self) -> usize {
+        std::mem::take(&mut self.dependent)
     }
     fn last_violation(&self) -> f64 {
         self.dynamics.phi().iter().fold(0.0_f64, |a, p| a.max(p.abs()))

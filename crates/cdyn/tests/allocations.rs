@@ -1,12 +1,13 @@
 //! No allocation inside a step: a counting global allocator watches 200
 //! steps after warm-up, for every scheme, control law and application, on
 //! Example 1 (as a general model and as a small system) and on a mechanism
-//! with every kind of element; the robust preset after its automatic gains
-//! are chosen, and the projection method (general models only); and a
-//! tractor with a trailer on knife edges (nonholonomic rows).
+//! with every kind of element (also with a redundant row, tolerated); the
+//! robust preset after its automatic gains are chosen, and the projection
+//! method (general models only); and a tractor with a trailer on knife
+//! edges (nonholonomic rows).
 
 use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity};
-use cdyn::dynamics::LinearSolver;
+use cdyn::dynamics::{DependentRows, LinearSolver};
 use cdyn::integrate::Application;
 use cdyn::methods;
 use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
@@ -51,6 +52,20 @@ static GLOBAL: Counting = Counting;
 /// A chain of point masses on rods with a damper and a driven support: every
 /// kind of element on the sparse path.
 fn hanging_chain(n: usize) -> Example {
+    Example::from_mechanism(chain_mechanism(n).build().unwrap(), None)
+}
+
+/// The hanging chain with its first rod entered twice: a dependent row at
+/// every step, dropped with `dependent_rows = Tolerate`.
+fn redundant_chain(n: usize) -> Example {
+    let mut m = chain_mechanism(n);
+    let (support, first) = (m.find("support").unwrap(), m.find("m0").unwrap());
+    m.add(Element::Distance { a: support, pa: [0.0; 2], b: first, pb: [0.0; 2], length: 0.1 });
+    Example::from_mechanism(m.build().unwrap(), None)
+}
+
+/// The mechanism of [`hanging_chain`].
+fn chain_mechanism(n: usize) -> Mechanism {
     let mut m = Mechanism::new([0.0, -9.81]);
     let support = m.rigid("support", 1.0, 0.1, [0.0, 0.0], 0.0);
     // Everything starts moving with the support: ẋ = 0.3 at t = 0.
@@ -76,7 +91,7 @@ fn hanging_chain(n: usize) -> Example {
         fx: TimeFn::linear(0.0, 1.0),
         fy: TimeFn::constant(0.0),
     });
-    Example::from_mechanism(m.build().unwrap(), None)
+    m
 }
 
 /// A tractor pulled by a spring, with a trailer on a pin: two knife edges
@@ -179,6 +194,7 @@ fn steps_do_not_allocate() {
     let andrews = andrews().unwrap();
     let chain = hanging_chain(64);
     let trailer = tractor_trailer();
+    let redundant = redundant_chain(64);
     assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
@@ -226,6 +242,10 @@ fn steps_do_not_allocate() {
                 let settings = Settings { solver, ..Settings::new(scheme, 1e-3, control) };
                 let n = allocations_per_run(&chain, settings, 5, 200);
                 assert_eq!(n, 0, "chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
+                // A dependent row dropped at every step allocates nothing either.
+                let settings = Settings { dependent_rows: DependentRows::Tolerate, ..settings };
+                let n = allocations_per_run(&redundant, settings, 5, 200);
+                assert_eq!(n, 0, "redundant chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
             }
         }
     }

@@ -2,7 +2,8 @@
 //! the general path (`Simulation` of the same system as a `Model`): the
 //! same trajectories, measures and errors, for every scheme and control.
 
-use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
+use cdyn::dynamics::DependentRows;
 use cdyn::integrate::Application;
 use cdyn::models::{PendulumParams, small_pendulum};
 use cdyn::small::{SmallSimulation, SmallSystem, to_model};
@@ -190,6 +191,36 @@ fn an_unconstrained_particle_moves_uniformly() {
         sim.step().unwrap();
     }
     assert_eq!((sim.q()[0], sim.v()[0], sim.t()), (7.0, 3.0, 2.0));
+}
+
+#[test]
+fn a_tolerated_doubled_row_is_the_circle_on_both_paths() {
+    // The doubled constraint, tolerated: uniform motion on the unit circle
+    // under every control law, the same on both paths, the row reported.
+    let mut all = controls();
+    all.push(Control { geometric: Geometric::Newton(Rate::Given(40.0)), ..Control::none() });
+    all.push(Control { velocity: Velocity::Gradient(Rate::Given(40.0)), ..Control::none() });
+    all.push(Control {
+        energy: Energy::Projected { alpha_e: Rate::Given(40.0), position_weight: 16.0 },
+        ..Control::none()
+    });
+    all.push(cdyn::methods::robust());
+    for control in all {
+        let settings =
+            Settings { dependent_rows: DependentRows::Tolerate, ..Settings::new(Scheme::RungeKutta4, 0.01, control) };
+        let d = divergence(DoubledRod, settings, [1.0, 0.0], [0.0, 1.0], 300);
+        assert!(d.is_some_and(|d| d < 1e-12), "{control:?}: {d:?}");
+        let mut sim = SmallSimulation::new(DoubledRod, settings, [1.0, 0.0], [0.0, 1.0]).unwrap();
+        for _ in 0..300 {
+            sim.step().unwrap();
+        }
+        let (q, t) = (sim.q(), sim.t());
+        let off = (q[0] - t.cos()).abs().max((q[1] - t.sin()).abs());
+        // RK-4 alone is 1e-9 off here; the energy laws add their own error (4e-8).
+        assert!(off < 1e-6, "{control:?}: off the circle's motion by {off:e}");
+        let loss = sim.rank_loss().copied().unwrap();
+        assert_eq!((loss.max, loss.steps), (1, 300), "{control:?}");
+    }
 }
 
 #[test]
