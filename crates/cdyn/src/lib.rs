@@ -15,6 +15,7 @@ pub mod gains;
 pub mod integrate;
 #[cfg(feature = "serde")]
 pub mod json_float;
+pub mod kinetic;
 mod linalg;
 pub mod mass;
 pub mod methods;
@@ -35,6 +36,7 @@ pub use constraint::Constraint;
 pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
 pub use error::{Error, Result};
 pub use force::{Force, Potential};
+pub use kinetic::Kinetic;
 pub use integrate::{Application, Scheme};
 pub use model::Model;
 pub use scalar::Scalar;
