@@ -6,8 +6,8 @@
 
 #[cfg(feature = "serde")]
 use super::{
-    Example, andrews, cartesian_pendulum, chain, damped_pendulum, double_pendulum, four_bar, moving_support_pendulum,
-    slider_crank, theta_pendulum,
+    Example, andrews, cartesian_pendulum, chain, damped_pendulum, double_pendulum, double_pendulum_angles, four_bar,
+    moving_support_pendulum, slider_crank, theta_pendulum,
 };
 
 /// A built-in model, by the name scenario files give it (`kind = "chain"`,
@@ -31,6 +31,10 @@ pub enum Kind {
     Andrews,
     /// [`double_pendulum`](super::double_pendulum), [`DoublePendulumParams`](super::DoublePendulumParams).
     DoublePendulum,
+    /// The same double pendulum in its two angles, its mass matrix `M(θ)`
+    /// from the kinetic energy: [`double_pendulum_angles`](super::double_pendulum_angles),
+    /// [`DoublePendulumParams`](super::DoublePendulumParams).
+    DoublePendulumAngles,
     /// [`chain`](super::chain), [`ChainParams`](super::ChainParams).
     Chain,
     /// [`slider_crank`](super::slider_crank), [`SliderCrankParams`](super::SliderCrankParams).
@@ -46,12 +50,13 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in declaration order.
-    pub const ALL: [Kind; 10] = [
+    pub const ALL: [Kind; 11] = [
         Kind::Pendulum,
         Kind::PendulumTheta,
         Kind::Mechanism,
         Kind::Andrews,
         Kind::DoublePendulum,
+        Kind::DoublePendulumAngles,
         Kind::Chain,
         Kind::SliderCrank,
         Kind::FourBar,
@@ -78,6 +83,7 @@ impl Kind {
             )),
             Kind::Andrews => build(parameters, |NoParameters {}| andrews()),
             Kind::DoublePendulum => build(parameters, double_pendulum),
+            Kind::DoublePendulumAngles => build(parameters, double_pendulum_angles),
             Kind::Chain => build(parameters, chain),
             Kind::SliderCrank => build(parameters, slider_crank),
             Kind::FourBar => build(parameters, four_bar),

@@ -8,6 +8,7 @@
 //! | model | free motion | reference |
 //! |---|---|---|
 //! | [`double_pendulum`] | 2 DOF | none (chaotic in general) |
+//! | [`double_pendulum_angles`] | 2 DOF, `M(θ)` from `T` | none; the same motion as [`double_pendulum`] |
 //! | [`chain`] | N DOF | rigid rotation when `g = 0`; the exact pendulum when `N = 1` |
 //! | [`slider_crank`] | none (driven); 1 DOF with a load | exact kinematics; a load pendulum by a fine RK-4 |
 //! | [`four_bar`] | none (driven); 1 DOF with a load | exact kinematics (circle intersection); a load by a fine RK-4 |
@@ -41,7 +42,7 @@ mod slider_crank;
 pub use andrews::andrews;
 pub use chain::{ChainParams, chain};
 pub use damped_pendulum::{DampedPendulumParams, damped_pendulum};
-pub use double_pendulum::{DoublePendulumParams, double_pendulum};
+pub use double_pendulum::{DoublePendulumKinetic, DoublePendulumParams, double_pendulum, double_pendulum_angles};
 pub use four_bar::{FourBarBranch, FourBarParams, four_bar};
 pub use kind::Kind;
 pub use moving_support::{MovingSupportParams, moving_support_pendulum};
