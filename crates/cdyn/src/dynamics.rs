@@ -3,8 +3,8 @@
 
 use crate::constraint::ConstraintBuffers;
 use crate::energy;
-use crate::linalg::{DenseLdl, Schur};
 pub use crate::linalg::{Breakdown, LinearSolver, SPARSE_FROM};
+use crate::linalg::{DenseLdl, Schur};
 use crate::mass::{DenseMass, MassAt, MassMatrix};
 use crate::model::Model;
 
@@ -60,7 +60,8 @@ impl General {
         let s = self.schur.matrix_mut();
         for a in 0..m {
             for c in 0..=a {
-                s[a * m + c] = self.jac[a * n..(a + 1) * n].iter().zip(&self.weighted[c * n..]).map(|(x, y)| x * y).sum();
+                s[a * m + c] =
+                    self.jac[a * n..(a + 1) * n].iter().zip(&self.weighted[c * n..]).map(|(x, y)| x * y).sum();
             }
         }
         self.schur.factor(jac)?;
@@ -129,7 +130,9 @@ impl Dynamics {
                 g.mdot_v.fill(0.0);
                 model.mass_at(q, v, &mut g.mass, &mut g.psi_q, &mut g.mdot_v).map_err(Breakdown::Mass)?;
                 // Lagrange's velocity terms join G: M q̈ = G + ∂T/∂q − Ṁ q̇ (see `kinetic.rs`).
-                for (((f, dt), mv), gv) in self.force.iter_mut().zip(&mut g.psi_q).zip(&g.mdot_v).zip(&self.grad_potential) {
+                for (((f, dt), mv), gv) in
+                    self.force.iter_mut().zip(&mut g.psi_q).zip(&g.mdot_v).zip(&self.grad_potential)
+                {
                     *f += *dt - mv;
                     *dt += gv;
                 }

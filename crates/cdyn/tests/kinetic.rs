@@ -5,16 +5,29 @@
 //! coordinates (trajectory, observed order of RK-4, the energy constraint).
 
 use cdyn::control::{Control, Energy, POSITION_WEIGHT, Rate};
+use cdyn::integrate::Rhs;
 use cdyn::kinetic::local;
 use cdyn::mass::DenseMass;
-use cdyn::models::{DoublePendulumKinetic, DoublePendulumParams, Example, double_pendulum, double_pendulum_angles};
-use cdyn::integrate::Rhs;
+use cdyn::models::{
+    DoublePendulumKinetic, DoublePendulumParams, Example, FourBarParams, LoadPendulum, double_pendulum,
+    double_pendulum_angles, four_bar, four_bar_angles,
+};
 use cdyn::system::ControlledSystem;
 use cdyn::{Error, Model, Scheme, Settings, Simulation};
 use proptest::prelude::*;
 
 fn params(theta1: f64, theta2: f64) -> DoublePendulumParams {
-    DoublePendulumParams { m1: 1.3, m2: 0.7, l1: 1.1, l2: 0.8, theta1, theta2, omega1: 0.4, omega2: -0.9, ..Default::default() }
+    DoublePendulumParams {
+        m1: 1.3,
+        m2: 0.7,
+        l1: 1.1,
+        l2: 0.8,
+        theta1,
+        theta2,
+        omega1: 0.4,
+        omega2: -0.9,
+        ..Default::default()
+    }
 }
 
 fn element(p: &DoublePendulumParams) -> DoublePendulumKinetic {
@@ -207,5 +220,55 @@ fn uncontrolled_energy_drift_is_the_integration_error_of_each() {
         println!("n = {}: max |Ψ| over t ≤ 4 at h = 0.02, 0.01: {coarse:e}, {fine:e}", ex.model.n());
         // At least 4 (the angles' energy error is still partly O(h⁵) at these steps: 4.7 observed).
         assert!(order > 3.8, "n = {}: max |Ψ| {coarse:e}, {fine:e}: order {order:.2}", ex.model.n());
+    }
+}
+
+/// Max |observable − reference| over a run for the first `k` observables,
+/// and the observables at every `SAMPLE`.
+fn against_reference(ex: &Example, h: f64, t_end: f64, k: usize) -> (f64, Vec<Vec<f64>>) {
+    let settings = Settings::new(Scheme::RungeKutta4, h, Control::none());
+    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+    let (mut worst, mut samples) = (0.0_f64, Vec::new());
+    let every = (SAMPLE / h).round() as u64;
+    let n = ex.model.n();
+    let (mut qr, mut vr) = (vec![0.0; n], vec![0.0; n]);
+    sim.run::<Error>(t_end, every, |s| {
+        let reference = ex.reference.as_ref().unwrap();
+        reference(s.t(), &mut qr, &mut vr);
+        let (at, exact) = (ex.observe(s.q(), s.v()), ex.observe(&qr, &vr));
+        worst = (0..k).map(|j| (at[j] - exact[j]).abs()).fold(worst, f64::max);
+        samples.push(at);
+        Ok(())
+    })
+    .unwrap();
+    (worst, samples)
+}
+
+#[test]
+fn four_bar_in_angles_follows_the_exact_kinematics_and_the_cartesian_model() {
+    for load in [None, Some(LoadPendulum::default())] {
+        let p = FourBarParams { load, ..Default::default() };
+        let (angles, cartesian) = (four_bar_angles(p).unwrap(), four_bar(p).unwrap());
+        assert_eq!((angles.model.n(), angles.model.m()), (3 + load.is_some() as usize, 3));
+        let t_end = 3.0;
+        let k = 3 + load.is_some() as usize;
+        let mut finest = Vec::new();
+        for (name, ex) in [("angles", &angles), ("cartesian", &cartesian)] {
+            let runs: Vec<_> = [0.02, 0.01, 0.005].iter().map(|&h| against_reference(ex, h, t_end, k)).collect();
+            let e: Vec<f64> = runs.iter().map(|r| r.0).collect();
+            println!("four-bar {name}, load {}: max observable error at h = 0.02, 0.01, 0.005: {e:?}", load.is_some());
+            // Order 4 against the exact kinematics and the load's fine reference.
+            for w in e.windows(2) {
+                let order = (w[0] / w[1]).log2();
+                assert!(order > 3.75 || w[1] < 1e-11, "{name}: errors {e:?}, observed order {order:.2}");
+            }
+            finest.push((runs[2].1.clone(), e[2]));
+        }
+        // The observables of both (rocker angle, coupler angle, rocker rate,
+        // load angle) agree within the sum of their errors at the finest step.
+        let (a, c) = (&finest[0], &finest[1]);
+        let gap = a.0.iter().zip(&c.0).flat_map(|(x, y)| (0..k).map(|j| (x[j] - y[j]).abs())).fold(0.0, f64::max);
+        println!("four-bar, load {}: max observable gap {gap:e} (errors {:e}, {:e})", load.is_some(), a.1, c.1);
+        assert!(gap <= a.1 + c.1, "gap {gap:e}, errors {:e} and {:e}", a.1, c.1);
     }
 }

@@ -7,7 +7,7 @@
 #[cfg(feature = "serde")]
 use super::{
     Example, andrews, cartesian_pendulum, chain, damped_pendulum, double_pendulum, double_pendulum_angles, four_bar,
-    moving_support_pendulum, slider_crank, theta_pendulum,
+    four_bar_angles, moving_support_pendulum, slider_crank, theta_pendulum,
 };
 
 /// A built-in model, by the name scenario files give it (`kind = "chain"`,
@@ -41,6 +41,9 @@ pub enum Kind {
     SliderCrank,
     /// [`four_bar`](super::four_bar), [`FourBarParams`](super::FourBarParams).
     FourBar,
+    /// The same four-bar in its three joint angles, `M(q)` from the kinetic
+    /// energy: [`four_bar_angles`](super::four_bar_angles), [`FourBarParams`](super::FourBarParams).
+    FourBarAngles,
     /// [`moving_support_pendulum`](super::moving_support_pendulum),
     /// [`MovingSupportParams`](super::MovingSupportParams).
     MovingSupportPendulum,
@@ -50,7 +53,7 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in declaration order.
-    pub const ALL: [Kind; 11] = [
+    pub const ALL: [Kind; 12] = [
         Kind::Pendulum,
         Kind::PendulumTheta,
         Kind::Mechanism,
@@ -60,6 +63,7 @@ impl Kind {
         Kind::Chain,
         Kind::SliderCrank,
         Kind::FourBar,
+        Kind::FourBarAngles,
         Kind::MovingSupportPendulum,
         Kind::DampedPendulum,
     ];
@@ -87,6 +91,7 @@ impl Kind {
             Kind::Chain => build(parameters, chain),
             Kind::SliderCrank => build(parameters, slider_crank),
             Kind::FourBar => build(parameters, four_bar),
+            Kind::FourBarAngles => build(parameters, four_bar_angles),
             Kind::MovingSupportPendulum => build(parameters, moving_support_pendulum),
             Kind::DampedPendulum => build(parameters, damped_pendulum),
         }
