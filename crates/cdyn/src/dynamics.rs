@@ -24,6 +24,9 @@ pub struct Dynamics {
 }
 
 /// How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied: decided by the model's mass.
+// The constant path's structure stays inline (no indirection in the hot
+// loops); there is one workspace per model, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
 enum Solver {
     /// Constant diagonal `M`: `S` assembled on the Jacobian's pattern.
     Constant(Schur),

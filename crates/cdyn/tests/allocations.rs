@@ -163,7 +163,8 @@ fn steps_do_not_allocate() {
     let andrews = andrews().unwrap();
     let chain = hanging_chain(64);
     let angles = double_pendulum_angles(DoublePendulumParams::default()).unwrap();
-    let four_bar = four_bar_angles(FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() }).unwrap();
+    let four_bar =
+        four_bar_angles(FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() }).unwrap();
     assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
