@@ -319,7 +319,7 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
         run.max_abs_phi = run.max_abs_phi.max(m.phi.abs());
         run.max_abs_phi_dot = run.max_abs_phi_dot.max(m.phi_dot);
         run.max_abs_psi = run.max_abs_psi.max(m.psi.abs());
-        let energy = ex.model.kinetic(sim.v()) + ex.model.potential(sim.q(), None).abs();
+        let energy = ex.model.kinetic(sim.q(), sim.v()) + ex.model.potential(sim.q(), None).abs();
         run.max_relative_psi = run.max_relative_psi.max(m.psi.abs() / energy.max(1.0));
         if sim.steps().is_multiple_of(every) {
             error = error.max(distance(sim.q(), &reference[(sim.steps() / every) as usize]));

@@ -13,6 +13,10 @@ const EVERY_PARAMETER: &[(&str, &str)] = &[
         "double_pendulum",
         "[model.parameters]\nm1 = 1.5\nm2 = 0.5\nl1 = 1.2\nl2 = 0.8\ngravity = 9.0\ntheta1 = 1.0\ntheta2 = 0.5\nomega1 = 0.1\nomega2 = -0.1\n",
     ),
+    (
+        "double_pendulum_angles",
+        "[model.parameters]\nm1 = 1.5\nm2 = 0.5\nl1 = 1.2\nl2 = 0.8\ngravity = 9.0\ntheta1 = 1.0\ntheta2 = 0.5\nomega1 = 0.1\nomega2 = -0.1\n",
+    ),
     ("chain", "[model.parameters]\nn = 3\nmass = 0.5\nlength = 0.7\ngravity = 9.0\ntheta0 = 1.0\nomega0 = 0.2\n"),
     (
         "slider_crank",
@@ -20,6 +24,10 @@ const EVERY_PARAMETER: &[(&str, &str)] = &[
     ),
     (
         "four_bar",
+        "[model.parameters]\ncrank_length = 1.0\ncoupler_length = 3.0\nrocker_length = 2.5\nground_length = 3.0\ncrank_mass = 1.1\ncrank_inertia = 0.09\ncoupler_mass = 3.1\ncoupler_inertia = 2.3\nrocker_mass = 2.4\nrocker_inertia = 1.3\nomega = 1.5\ntheta0 = 0.2\ngravity = 9.0\nbranch = \"right\"\n[model.parameters.load]\nmass = 0.3\nlength = 0.6\nangle = 0.1\nomega = 0.2\n",
+    ),
+    (
+        "four_bar_angles",
         "[model.parameters]\ncrank_length = 1.0\ncoupler_length = 3.0\nrocker_length = 2.5\nground_length = 3.0\ncrank_mass = 1.1\ncrank_inertia = 0.09\ncoupler_mass = 3.1\ncoupler_inertia = 2.3\nrocker_mass = 2.4\nrocker_inertia = 1.3\nomega = 1.5\ntheta0 = 0.2\ngravity = 9.0\nbranch = \"right\"\n[model.parameters.load]\nmass = 0.3\nlength = 0.6\nangle = 0.1\nomega = 0.2\n",
     ),
     (

@@ -1,7 +1,9 @@
 //! Cost of one step: Example 1 (cdyn as a small system and as a general
 //! model, against the hand-written baseline; then the general model under
 //! the `robust` preset and the `projection` method) and the N-link chain
-//! under `cvsgf_energy`, `robust` and `projection`, one group each.
+//! under `cvsgf_energy`, `robust` and `projection`, one group each; and the
+//! mechanisms whose `M(q)` comes from a kinetic energy (double pendulum,
+//! loaded four-bar) in angles against the same in Cartesian coordinates.
 //! `cargo bench -p cdyn` measures; `cargo test --benches`
 //! (CI) runs each benchmark once as a smoke test. Set `CDYN_BENCH_FULL=1`
 //! to add the 10 000-body chain. `cdyn bench` reports the same quantities
@@ -9,7 +11,10 @@
 
 use cdyn::baseline::HandWritten;
 use cdyn::methods::{self, MethodGains};
-use cdyn::models::{ChainParams, PendulumParams, cartesian_pendulum, chain, small_pendulum};
+use cdyn::models::{
+    ChainParams, DoublePendulumParams, Example, FourBarParams, LoadPendulum, PendulumParams, cartesian_pendulum, chain,
+    double_pendulum, double_pendulum_angles, four_bar, four_bar_angles, small_pendulum,
+};
 use cdyn::small::SmallSimulation;
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -123,5 +128,35 @@ fn chains(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, example1, example1_methods, chains);
+/// RK-4 steps, no control: what a configuration-dependent `M(q)` costs
+/// (its AD, dense factor and dense `S`) against the constant diagonal one
+/// of the same mechanism in more coordinates.
+fn angles(c: &mut Criterion) {
+    let mut group = c.benchmark_group("angles_vs_cartesian_rk4");
+    let loaded = FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() };
+    let dp = DoublePendulumParams { theta1: 1.0, theta2: 0.5, ..Default::default() };
+    let cases: [(&str, Example); 4] = [
+        ("double_pendulum_cartesian", double_pendulum(dp).unwrap()),
+        ("double_pendulum_angles", double_pendulum_angles(dp).unwrap()),
+        ("four_bar_load_cartesian", four_bar(loaded).unwrap()),
+        ("four_bar_load_angles", four_bar_angles(loaded).unwrap()),
+    ];
+    for (name, ex) in &cases {
+        const RUN: u64 = 10_000;
+        let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::none());
+        let fresh = || Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+        let mut sim = fresh();
+        group.bench_function(*name, |b| {
+            b.iter(|| {
+                if sim.steps() == RUN {
+                    sim = fresh();
+                }
+                sim.step().unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, example1, example1_methods, chains, angles);
 criterion_main!(benches);

@@ -84,5 +84,6 @@ fn singular(b: Breakdown, iteration: u32) -> crate::Error {
     match b {
         Breakdown::Singular(row) => Problem::SingularAssembly { row, iteration: iteration as usize }.at(Part::Assembly),
         Breakdown::NonFinite => Problem::NonFinitePositions.at(Part::Assembly),
+        Breakdown::Mass(coordinate) => Problem::MassNotPositive { coordinate }.at(Part::Assembly),
     }
 }

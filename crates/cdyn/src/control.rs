@@ -196,7 +196,9 @@ pub(crate) trait Evaluation {
     fn mass(&self) -> &Self::Mass;
     fn phi(&self) -> &[f64];
     fn phi_dot(&self) -> &[f64];
-    /// `∇V`, which is also `Ψ_q`.
+    /// `Ψ_q = ∇V + ∂T/∂q`: `∇V` when `M` is constant; with `M(q)` the
+    /// energy's position gradient takes `∂T/∂q` too (the laws below read
+    /// `Ψ_q` through this, never `∇V` alone).
     fn grad_potential(&self) -> &[f64];
     /// The uncontrolled acceleration `A`.
     fn acc(&self) -> &[f64];
@@ -361,7 +363,7 @@ impl Control {
                         (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
                     }
                 };
-                // U_q −= 2ρ_q Ψ Ψ_q,  U_v −= 2ρ_v Ψ Ψ_v,  Ψ_q = ∇V, Ψ_v = M v
+                // U_q −= 2ρ_q Ψ Ψ_q,  U_v −= 2ρ_v Ψ Ψ_v,  Ψ_q = ∇V + ∂T/∂q, Ψ_v = M v
                 if rho_q != 0.0 {
                     for (u, g) in u_q.iter_mut().zip(d.grad_potential()) {
                         *u -= 2.0 * rho_q * psi * g;

@@ -2,7 +2,6 @@
 //! measure `Y_c` (Eq. 47), computed without factorizing anything.
 
 use crate::constraint::ConstraintBuffers;
-use crate::energy;
 use crate::model::Model;
 
 /// Violations at one state.
@@ -20,7 +19,7 @@ pub struct Measures {
 
 impl Measures {
     /// The measures of one state, for general and small systems alike:
-    /// `psi` is `Ψ`, `grad_potential` is `∇V = Ψ_q`, and constraint row `i`
+    /// `psi` is `Ψ`, `grad_potential` is `Ψ_q` (`∇V + ∂T/∂q`), and constraint row `i`
     /// has `phi[i]`, `phi_dot[i]` and the entries of `Φ_q` that `row(i)`
     /// returns with their coordinates.
     pub(crate) fn of<'a>(
@@ -72,7 +71,9 @@ impl Probe {
         self.grad.fill(0.0);
         let potential = model.potential(q, Some(&mut self.grad));
         let pattern = model.pattern();
-        let psi = energy::psi(model.mass(), v, potential, e, e0);
+        // Ψ_q = ∇V + ∂T/∂q (nothing added for a constant M).
+        let kinetic = model.kinetic_and_gradient(q, v, Some(&mut self.grad));
+        let psi = kinetic + potential - e0 - e;
         let jac = &self.constraints.jac;
         Measures::of(psi, &self.grad, &self.constraints.phi, &self.constraints.phi_dot, |r| {
             let range = pattern.row(r);

@@ -3,9 +3,9 @@
 
 use crate::constraint::ConstraintBuffers;
 use crate::energy;
-use crate::linalg::Schur;
 pub use crate::linalg::{Breakdown, DependentRows, LinearSolver, SPARSE_FROM};
-use crate::mass::MassMatrix;
+use crate::linalg::{DenseLdl, Schur};
+use crate::mass::{DenseMass, MassAt, MassMatrix};
 use crate::model::Model;
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
@@ -20,7 +20,67 @@ pub struct Dynamics {
     force_power: f64,
     lambda: Vec<f64>,
     acc: Vec<f64>,
-    schur: Schur,
+    solver: Solver,
+}
+
+/// How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied: decided by the model's mass.
+// The constant path's structure stays inline (no indirection in the hot
+// loops); there is one workspace per model, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
+enum Solver {
+    /// Constant diagonal `M`: `S` assembled on the Jacobian's pattern.
+    Constant(Schur),
+    /// `M(q)`: evaluated, factored and used densely.
+    General(Box<General>),
+}
+
+/// The workspace of a configuration-dependent `M(q)`, allocated once.
+struct General {
+    mass: DenseMass,
+    /// `Ψ_q = ∇V + ∂T/∂q` (`∂T/∂q` first, while it is summed).
+    psi_q: Vec<f64>,
+    /// `Ṁ q̇`
+    mdot_v: Vec<f64>,
+    /// Row `r` of `Φ_q`, dense (`n` entries per row).
+    jac: Vec<f64>,
+    /// Row `r` of `(M⁻¹ Φ_qᵀ)ᵀ`: `M⁻¹` times row `r` of `Φ_q`.
+    weighted: Vec<f64>,
+    schur: DenseLdl,
+}
+
+impl General {
+    /// `S = Φ_q (M⁻¹ Φ_qᵀ)` from the pattern and values of `Φ_q`, factored, and `b` solved in place.
+    fn factor_and_solve(&mut self, model: &Model, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        let (n, m, pattern) = (model.n(), model.m(), model.pattern());
+        self.jac.fill(0.0);
+        for r in 0..m {
+            for j in pattern.row(r) {
+                self.jac[r * n + pattern.cols[j] as usize] = jac[j];
+            }
+            let (row, out) = (&self.jac[r * n..(r + 1) * n], &mut self.weighted[r * n..(r + 1) * n]);
+            self.mass.solve(row, out);
+        }
+        let s = self.schur.matrix_mut();
+        for a in 0..m {
+            for c in 0..=a {
+                s[a * m + c] =
+                    self.jac[a * n..(a + 1) * n].iter().zip(&self.weighted[c * n..]).map(|(x, y)| x * y).sum();
+            }
+        }
+        self.schur.factor(jac)?;
+        self.schur.solve(b);
+        Ok(())
+    }
+
+    /// `out += scale · M⁻¹ Φ_qᵀ y`
+    fn add_weighted_jt(&self, n: usize, y: &[f64], scale: f64, out: &mut [f64]) {
+        for (r, &yr) in y.iter().enumerate() {
+            let s = scale * yr;
+            for (o, w) in out.iter_mut().zip(&self.weighted[r * n..(r + 1) * n]) {
+                *o += s * w;
+            }
+        }
+    }
 }
 
 impl Dynamics {
@@ -29,9 +89,21 @@ impl Dynamics {
         Self::with_solver(model, LinearSolver::Auto)
     }
 
-    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ`.
+    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ` (for a constant `M`;
+    /// with `M(q)` it is dense).
     pub fn with_solver(model: &Model, solver: LinearSolver) -> Self {
         let (n, m) = (model.n(), model.m());
+        let solver = match model.mass() {
+            Some(mass) => Solver::Constant(Schur::new(model.pattern(), mass, solver)),
+            None => Solver::General(Box::new(General {
+                mass: DenseMass::new(n),
+                psi_q: vec![0.0; n],
+                mdot_v: vec![0.0; n],
+                jac: vec![0.0; m * n],
+                weighted: vec![0.0; m * n],
+                schur: DenseLdl::new(m),
+            })),
+        };
         Self {
             constraints: ConstraintBuffers::new(m, model.pattern().nnz()),
             force: vec![0.0; n],
@@ -40,19 +112,25 @@ impl Dynamics {
             force_power: 0.0,
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
-            schur: Schur::new(model.pattern(), model.mass(), solver),
+            solver,
         }
     }
 
     /// Sets what a dependent constraint row does in the next evaluations
     /// (default: [`DependentRows::Error`]).
     pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
-        self.schur.set_dependent_rows(dependent);
+        match &mut self.solver {
+            Solver::Constant(schur) => schur.set_dependent_rows(dependent),
+            Solver::General(g) => g.schur.set_dependent_rows(dependent),
+        }
     }
 
     /// Constraint rows the last evaluation dropped as dependent (0 unless tolerated).
     pub fn dependent_rows(&self) -> usize {
-        self.schur.dependent_rows()
+        match &self.solver {
+            Solver::Constant(schur) => schur.dependent_rows(),
+            Solver::General(g) => g.schur.dependent_rows(),
+        }
     }
 
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the
@@ -65,13 +143,32 @@ impl Dynamics {
         }
         self.force_power = model.add_forces(q, v, t, &mut self.force);
         // The unconstrained acceleration M⁻¹ G, which the constraint pass needs for `Φ_q M⁻¹ G − γ`.
-        model.mass().solve(&self.force, &mut self.acc);
+        match (&mut self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => mass.solve(&self.force, &mut self.acc),
+            (Solver::General(g), _) => {
+                g.psi_q.fill(0.0);
+                g.mdot_v.fill(0.0);
+                model.mass_at(q, v, &mut g.mass, &mut g.psi_q, &mut g.mdot_v).map_err(Breakdown::Mass)?;
+                // Lagrange's velocity terms join G: M q̈ = G + ∂T/∂q − Ṁ q̇ (see `kinetic.rs`).
+                for (((f, dt), mv), gv) in
+                    self.force.iter_mut().zip(&mut g.psi_q).zip(&g.mdot_v).zip(&self.grad_potential)
+                {
+                    *f += *dt - mv;
+                    *dt += gv;
+                }
+                g.mass.solve(&self.force, &mut self.acc);
+            }
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        }
         // λ starts as the right-hand side of (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
         model.constraints(q, v, t, self.constraints.pass(&self.acc, &mut self.lambda));
         if model.m() == 0 {
             return Ok(());
         }
-        self.schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
+        match &mut self.solver {
+            Solver::Constant(schur) => schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
+            Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
+        }
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
         let mut acc = std::mem::take(&mut self.acc);
         self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
@@ -84,8 +181,29 @@ impl Dynamics {
     /// `out`. `b` is overwritten with the multiplier change `S⁻¹ b`.
     /// Uses the factorization of the last [`evaluate`](Self::evaluate).
     pub fn add_constraint_response(&self, model: &Model, b: &mut [f64], out: &mut [f64]) {
-        self.schur.solve(b);
+        match &self.solver {
+            Solver::Constant(schur) => schur.solve(b),
+            Solver::General(g) => g.schur.solve(b),
+        }
         self.add_weighted_jt(model, b, -1.0, out);
+    }
+
+    /// The mass matrix at the state of the last [`evaluate`](Self::evaluate).
+    #[inline(always)]
+    pub fn mass<'a>(&'a self, model: &'a Model) -> MassAt<'a> {
+        match (&self.solver, model.mass()) {
+            (Solver::General(g), _) => MassAt::Dense(&g.mass),
+            (Solver::Constant(_), Some(mass)) => MassAt::Diagonal(mass),
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        }
+    }
+
+    /// `Ψ_q = ∇V + ∂T/∂q` of the last evaluation (`∇V` when `M` is constant).
+    pub fn psi_q(&self) -> &[f64] {
+        match &self.solver {
+            Solver::Constant(_) => &self.grad_potential,
+            Solver::General(g) => &g.psi_q,
+        }
     }
 
     /// `out += scale · M⁻¹ Φ_qᵀ y` with the Jacobian of the last
@@ -93,7 +211,12 @@ impl Dynamics {
     /// take up to three such products per evaluation, and the checks were
     /// half their cost on a chain of 1 000 bodies.
     pub fn add_weighted_jt(&self, model: &Model, y: &[f64], scale: f64, out: &mut [f64]) {
-        let (pattern, weight, jac) = (model.pattern(), model.mass().inverse(), &self.constraints.jac);
+        let weight = match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => mass.inverse(),
+            (Solver::General(g), _) => return g.add_weighted_jt(model.n(), y, scale, out),
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        };
+        let (pattern, jac) = (model.pattern(), &self.constraints.jac);
         assert!(y.len() == model.m() && out.len() == model.n(), "vectors of the wrong length");
         assert!(jac.len() == pattern.cols.len(), "a Jacobian of another model");
         // SAFETY: a model's pattern is built by `ModelBuilder::build` from
@@ -116,7 +239,15 @@ impl Dynamics {
     /// (the coupled control terms' two products), each with the arithmetic of
     /// [`add_weighted_jt`](Self::add_weighted_jt) at scale −1.
     pub fn add_weighted_jt_pair(&self, model: &Model, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
-        let (pattern, weight, jac) = (model.pattern(), model.mass().inverse(), &self.constraints.jac);
+        let weight = match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => mass.inverse(),
+            (Solver::General(g), _) => {
+                g.add_weighted_jt(model.n(), y0, -1.0, out0);
+                return g.add_weighted_jt(model.n(), y1, -1.0, out1);
+            }
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        };
+        let (pattern, jac) = (model.pattern(), &self.constraints.jac);
         assert!(y0.len() == model.m() && y1.len() == model.m(), "vectors of the wrong length");
         assert!(out0.len() == model.n() && out1.len() == model.n(), "vectors of the wrong length");
         assert!(jac.len() == pattern.cols.len(), "a Jacobian of another model");
@@ -155,7 +286,10 @@ impl Dynamics {
     /// Solves `(Φ_q M⁻¹ Φ_qᵀ) x = b` in place for up to four vectors at
     /// once, with the factorization of the last [`evaluate`](Self::evaluate).
     pub fn solve_many(&self, bs: &mut [&mut [f64]]) {
-        self.schur.solve_many(bs);
+        match &self.solver {
+            Solver::Constant(schur) => schur.solve_many(bs),
+            Solver::General(g) => bs.iter_mut().for_each(|b| g.schur.solve(b)),
+        }
     }
 
     /// The energy input `Ė = F·v + λᵀ Φ_t` of the last evaluation (see [`crate::energy`]).
@@ -183,11 +317,12 @@ impl Dynamics {
     pub fn jac(&self) -> &[f64] {
         &self.constraints.jac
     }
-    /// Generalized applied force `G = −∇V + F`.
+    /// Generalized applied force `G = −∇V + F`, with Lagrange's velocity
+    /// terms `∂T/∂q − Ṁ q̇` when `M` depends on `q`.
     pub fn force(&self) -> &[f64] {
         &self.force
     }
-    /// `∇V`, which is also `Ψ_q`.
+    /// `∇V` (which is `Ψ_q` when `M` is constant; see [`psi_q`](Self::psi_q)).
     pub fn grad_potential(&self) -> &[f64] {
         &self.grad_potential
     }

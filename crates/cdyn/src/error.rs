@@ -49,6 +49,18 @@ pub enum Error {
         /// The dependent constraint row.
         row: usize,
     },
+    /// The mass matrix `M(q)` of kinetic-energy elements is not positive definite at the state.
+    #[error(
+        "mass matrix M(q) not positive definite at step {step}, t = {}: coordinate {coordinate} has no inertia there", Time(*t)
+    )]
+    MassNotPositive {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+        /// The coordinate whose pivot failed.
+        coordinate: usize,
+    },
     /// The state stopped being finite.
     #[error("simulation diverged at step {step}, t = {}: the state is no longer finite", Time(*t))]
     Diverged {
@@ -323,6 +335,12 @@ pub enum Problem {
     /// Positions that are not finite.
     #[error("the positions are not finite")]
     NonFinitePositions,
+    /// The mass matrix `M(q)` of kinetic-energy elements is not positive definite.
+    #[error("the mass matrix M(q) is not positive definite (pivot of coordinate {coordinate})")]
+    MassNotPositive {
+        /// The coordinate whose pivot failed.
+        coordinate: usize,
+    },
     /// The projection onto the constraints did not converge.
     #[error("did not converge: max |Φ| = {phi:.3e} after {iterations} Newton iterations")]
     NoConvergence {

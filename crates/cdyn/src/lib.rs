@@ -15,6 +15,7 @@ pub mod gains;
 pub mod integrate;
 #[cfg(feature = "serde")]
 pub mod json_float;
+pub mod kinetic;
 mod linalg;
 pub mod mass;
 pub mod methods;
@@ -37,6 +38,7 @@ pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
 pub use error::{Error, Result};
 pub use force::{Force, Potential};
 pub use integrate::{Application, Scheme};
+pub use kinetic::Kinetic;
 pub use model::Model;
 pub use nonholonomic::Nonholonomic;
 pub use scalar::Scalar;

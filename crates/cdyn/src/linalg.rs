@@ -23,6 +23,10 @@ pub enum Breakdown {
     Singular(usize),
     /// `S` has non-finite entries: the state has blown up.
     NonFinite,
+    /// The configuration-dependent mass matrix `M(q)` is not positive
+    /// definite at this state (its pivot of this coordinate): the kinetic
+    /// energy elements leave a coordinate without inertia there.
+    Mass(usize),
 }
 
 /// How to factor `Φ_q M⁻¹ Φ_qᵀ`.
@@ -149,6 +153,96 @@ fn dependent_pivot(
         DependentRows::Tolerate => {
             *dropped += 1;
             Ok(0.0)
+        }
+    }
+}
+
+/// `S = Φ_q M⁻¹ Φ_qᵀ` held dense and factored as `L D Lᵀ`, for a mass
+/// matrix that changes with the state (`M(q)`): `S` is then formed anew at
+/// every evaluation, densely, which is what small systems in angles need.
+/// Same pivot test ([`inverse_pivot`]) and handling of dependent rows as
+/// the sparse kernel.
+pub(crate) struct DenseLdl {
+    m: usize,
+    /// `S` on entry to [`factor`](Self::factor) (lower triangle read), then
+    /// `L` below the diagonal, row-major.
+    lower: Vec<f64>,
+    /// `D` and `D⁻¹`.
+    d: Vec<f64>,
+    inv_d: Vec<f64>,
+    /// Whether a dependent row is an error or dropped.
+    dependent: DependentRows,
+    /// Rows dropped by the last factorization.
+    dropped: usize,
+}
+
+impl DenseLdl {
+    /// Storage for `m` rows.
+    pub fn new(m: usize) -> Self {
+        Self {
+            m,
+            lower: vec![0.0; m * m],
+            d: vec![0.0; m],
+            inv_d: vec![0.0; m],
+            dependent: DependentRows::Error,
+            dropped: 0,
+        }
+    }
+
+    /// Sets what a dependent row does in the next factorizations.
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.dependent = dependent;
+    }
+
+    /// Rows the last factorization dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        self.dropped
+    }
+
+    /// `S`, row-major, to be filled (lower triangle) before [`factor`](Self::factor).
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.lower
+    }
+
+    /// Factors the `S` written through [`matrix_mut`](Self::matrix_mut);
+    /// `jac` is the Jacobian it came from (for the pivot test).
+    pub fn factor(&mut self, jac: &[f64]) -> Result<(), Breakdown> {
+        let (m, a, dependent) = (self.m, &mut self.lower, self.dependent);
+        let tolerance = dependent.tolerance();
+        self.dropped = 0;
+        let mut count = 0;
+        for j in 0..m {
+            let s_jj = a[j * m + j];
+            let mut d = s_jj;
+            for k in 0..j {
+                d -= a[j * m + k] * a[j * m + k] * self.d[k];
+            }
+            // A dropped row has `D⁻¹ = 0`, so its column of `L` below is 0.
+            self.inv_d[j] = inverse_pivot(d, s_jj, tolerance, jac, dependent, &mut count, || j)?;
+            self.d[j] = d;
+            for i in j + 1..m {
+                let mut s = a[i * m + j];
+                for k in 0..j {
+                    s -= a[i * m + k] * a[j * m + k] * self.d[k];
+                }
+                a[i * m + j] = s * self.inv_d[j];
+            }
+        }
+        self.dropped = count;
+        Ok(())
+    }
+
+    /// Solves `S x = b` in place with the current factor.
+    pub fn solve(&self, b: &mut [f64]) {
+        let (m, l) = (self.m, &self.lower);
+        for i in 0..m {
+            b[i] -= (0..i).map(|k| l[i * m + k] * b[k]).sum::<f64>();
+        }
+        for (b, w) in b.iter_mut().zip(&self.inv_d) {
+            *b *= w;
+        }
+        for i in (0..m).rev() {
+            b[i] -= (i + 1..m).map(|k| l[k * m + i] * b[k]).sum::<f64>();
         }
     }
 }

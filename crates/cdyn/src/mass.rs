@@ -5,9 +5,11 @@
 //! and diagonal — `(m, m, I)` for a planar body, `m` per axis for a point
 //! mass — which is what makes the formulation cheap: `M⁻¹` is free and
 //! `S = Φ_q M⁻¹ Φ_qᵀ` inherits the sparsity of the constraints. That is the
-//! one kind today ([`DiagonalMass`]). Block and configuration-dependent
-//! kinds (`M(q)`) will implement [`MassMatrix`] too; the control laws and
-//! the energy already ask it, not the diagonal, for what they need.
+//! common kind ([`DiagonalMass`]). Coordinates such as angles have a
+//! configuration-dependent `M(q)` ([`crate::kinetic`]): it is evaluated at
+//! every state into a [`DenseMass`] and factored once per evaluation.
+//! [`MassAt`] is either, as the control laws and the energy see it: they
+//! ask it, not the diagonal, for what they need.
 //!
 //! The diagonal kind is generic over its storage: a `Vec` for a general
 //! model, an array for a small system, whose loops then keep their
@@ -135,6 +137,176 @@ impl<S: AsRef<[f64]>> MassMatrix for DiagonalMass<S> {
     }
 }
 
+/// A symmetric positive definite `M`, evaluated at one state and kept
+/// with its Cholesky factor `M = L Lᵀ`; storage allocated once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DenseMass {
+    n: usize,
+    /// `M`, row-major.
+    matrix: Vec<f64>,
+    /// `L`, row-major lower triangle.
+    factor: Vec<f64>,
+}
+
+impl DenseMass {
+    /// Storage for an `n × n` matrix, zero.
+    pub fn new(n: usize) -> Self {
+        Self { n, matrix: vec![0.0; n * n], factor: vec![0.0; n * n] }
+    }
+
+    /// `M`, row-major, to be filled before [`factor`](Self::factor).
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.matrix
+    }
+
+    /// `M`, row-major.
+    pub fn matrix(&self) -> &[f64] {
+        &self.matrix
+    }
+
+    /// Factors `M = L Lᵀ`. `Err(k)` names the first coordinate whose pivot
+    /// is not positive (or not finite): `M` is not positive definite there.
+    pub fn factor(&mut self) -> std::result::Result<(), usize> {
+        let n = self.n;
+        let (a, l) = (&self.matrix, &mut self.factor);
+        for j in 0..n {
+            let mut d = a[j * n + j];
+            for k in 0..j {
+                d -= l[j * n + k] * l[j * n + k];
+            }
+            // Relative to the diagonal entry: a pivot lost to round-off is singular.
+            if d.is_nan() || d <= 1e-14 * a[j * n + j].abs() || !d.is_finite() {
+                return Err(j);
+            }
+            let d = d.sqrt();
+            l[j * n + j] = d;
+            for i in j + 1..n {
+                let mut s = a[i * n + j];
+                for k in 0..j {
+                    s -= l[i * n + k] * l[j * n + k];
+                }
+                l[i * n + j] = s / d;
+            }
+        }
+        Ok(())
+    }
+
+    /// `(M v)_i`
+    #[inline(always)]
+    fn row_dot(&self, i: usize, v: &[f64]) -> f64 {
+        self.matrix[i * self.n..(i + 1) * self.n].iter().zip(v).map(|(m, v)| m * v).sum()
+    }
+}
+
+impl MassMatrix for DenseMass {
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    fn mul(&self, x: &[f64], out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.row_dot(i, x);
+        }
+    }
+
+    /// With the factor of the last [`factor`](DenseMass::factor): `L y = x`, then `Lᵀ out = y`, in `out`.
+    fn solve(&self, x: &[f64], out: &mut [f64]) {
+        let (n, l) = (self.n, &self.factor);
+        for i in 0..n {
+            let s: f64 = (0..i).map(|k| l[i * n + k] * out[k]).sum();
+            out[i] = (x[i] - s) / l[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let s: f64 = (i + 1..n).map(|k| l[k * n + i] * out[k]).sum();
+            out[i] = (out[i] - s) / l[i * n + i];
+        }
+    }
+
+    fn kinetic(&self, v: &[f64]) -> f64 {
+        0.5 * (0..self.n).map(|i| v[i] * self.row_dot(i, v)).sum::<f64>()
+    }
+
+    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
+        (0..self.n).map(|i| self.row_dot(i, v).powi(2)).sum()
+    }
+
+    fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
+        let mut sum = init;
+        for i in 0..self.n {
+            sum += self.row_dot(i, v) * x(i) + extra(i);
+        }
+        sum
+    }
+
+    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o += scale * self.row_dot(i, v);
+        }
+    }
+
+    fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        for (o, v) in out.iter_mut().zip(v) {
+            *o += scale * v;
+        }
+    }
+}
+
+/// The mass matrix at one state: constant diagonal, or `M(q)` evaluated
+/// there. Each product matches once, outside its loops, so the diagonal
+/// kind runs its own loops unchanged.
+#[derive(Debug, Clone, Copy)]
+pub enum MassAt<'a> {
+    /// A constant diagonal `M`.
+    Diagonal(&'a DiagonalMass),
+    /// `M(q)` at the state of the last evaluation.
+    Dense(&'a DenseMass),
+}
+
+/// Forwards each product to the kind at hand.
+macro_rules! either {
+    ($self:ident, $m:ident => $e:expr) => {
+        match $self {
+            MassAt::Diagonal($m) => $e,
+            MassAt::Dense($m) => $e,
+        }
+    };
+}
+
+impl MassMatrix for MassAt<'_> {
+    #[inline(always)]
+    fn n(&self) -> usize {
+        either!(self, m => m.n())
+    }
+    #[inline(always)]
+    fn mul(&self, x: &[f64], out: &mut [f64]) {
+        either!(self, m => m.mul(x, out))
+    }
+    #[inline(always)]
+    fn solve(&self, x: &[f64], out: &mut [f64]) {
+        either!(self, m => m.solve(x, out))
+    }
+    #[inline(always)]
+    fn kinetic(&self, v: &[f64]) -> f64 {
+        either!(self, m => m.kinetic(v))
+    }
+    #[inline(always)]
+    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
+        either!(self, m => m.psi_v_norm2(v))
+    }
+    #[inline(always)]
+    fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
+        either!(self, m => m.psi_v_dot(v, x, extra, init))
+    }
+    #[inline(always)]
+    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        either!(self, m => m.add_psi_v(v, scale, out))
+    }
+    #[inline(always)]
+    fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        either!(self, m => m.add_inverse_psi_v(v, scale, out))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -163,6 +335,31 @@ mod tests {
         let small = DiagonalMass::new([2.0, 0.5, 4.0]).unwrap();
         assert_eq!(small.kinetic(&v), mass.kinetic(&v));
         assert_eq!(small.inverse(), &[0.5, 2.0, 0.25]);
+    }
+
+    #[test]
+    fn dense_products_agree_with_their_definitions() {
+        let mut mass = DenseMass::new(3);
+        mass.matrix_mut().copy_from_slice(&[4.0, 1.0, 0.5, 1.0, 3.0, -1.0, 0.5, -1.0, 2.0]);
+        mass.factor().unwrap();
+        let v = [1.0, -2.0, 0.25];
+        let mut mv = [0.0; 3];
+        mass.mul(&v, &mut mv);
+        assert_eq!(mv, [4.0 - 2.0 + 0.125, 1.0 - 6.0 - 0.25, 0.5 + 2.0 + 0.5]);
+        let mut back = [0.0; 3];
+        mass.solve(&mv, &mut back);
+        for (b, v) in back.iter().zip(&v) {
+            assert!((b - v).abs() < 1e-14, "{back:?}");
+        }
+        let vmv: f64 = mv.iter().zip(&v).map(|(a, b)| a * b).sum();
+        assert_eq!(mass.kinetic(&v), 0.5 * vmv);
+        assert_eq!(mass.psi_v_norm2(&v), mv.iter().map(|x| x * x).sum::<f64>());
+        let mut out = [0.0; 3];
+        mass.add_psi_v(&v, 2.0, &mut out);
+        assert_eq!(out, mv.map(|x| 2.0 * x));
+        // Not positive definite: the pivot of coordinate 1 is 1 − 4 < 0.
+        mass.matrix_mut().copy_from_slice(&[1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(mass.factor(), Err(1));
     }
 
     #[test]

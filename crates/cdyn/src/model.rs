@@ -1,11 +1,12 @@
-//! What a system is: coordinates with a mass matrix (see [`crate::mass`]
-//! for why it is constant and diagonal), holonomic constraint elements,
-//! potentials and non-conservative forces.
+//! What a system is: coordinates with a mass matrix (constant and
+//! diagonal, or from kinetic-energy elements: see [`crate::mass`]),
+//! holonomic constraint elements, potentials and non-conservative forces.
 
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
-use crate::mass::{DiagonalMass, MassMatrix};
+use crate::kinetic::{Kinetic, KineticBlock, KineticGroup};
+use crate::mass::{DenseMass, DiagonalMass, MassMatrix};
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
@@ -13,7 +14,7 @@ pub use crate::sparse::Pattern;
 
 /// A constrained mechanical system, ready to simulate.
 pub struct Model {
-    mass: DiagonalMass,
+    inertia: Inertia,
     constraints: Vec<Box<dyn ConstraintBlock>>,
     potentials: Vec<Box<dyn PotentialBlock>>,
     forces: Vec<Box<dyn ForceBlock>>,
@@ -22,9 +23,22 @@ pub struct Model {
     offsets: Vec<(usize, usize)>,
 }
 
+/// Where the kinetic energy comes from, decided when the model is built.
+enum Inertia {
+    /// `T = ½ vᵀ M v` with a constant diagonal `M`: the fast path.
+    Constant(DiagonalMass),
+    /// `T = ½ Σ m_i v_i² + Σ T_e`: `M(q)` evaluated at every state.
+    General {
+        /// The diagonal part (zero where the elements give all the inertia).
+        diagonal: Vec<f64>,
+        kinetic: Vec<Box<dyn KineticBlock>>,
+    },
+}
+
 /// Builds a [`Model`] element by element.
 pub struct ModelBuilder {
     mass: Vec<f64>,
+    kinetic: Vec<Box<dyn KineticBlock>>,
     constraints: Vec<Box<dyn ConstraintBlock>>,
     potentials: Vec<Box<dyn PotentialBlock>>,
     forces: Vec<Box<dyn ForceBlock>>,
@@ -101,6 +115,23 @@ impl ModelBuilder {
         self
     }
 
+    /// Adds a kinetic-energy term `T_e(x, ẋ)` of the coordinates `at`
+    /// (see [`crate::kinetic`]): the model's `M` then depends on `q`, and the
+    /// diagonal masses given to [`Model::builder`] may be zero for
+    /// coordinates whose inertia comes from such terms. `M(q)` must be
+    /// positive definite wherever the motion goes; where it is not, the
+    /// evaluation fails with [`Breakdown::Mass`](crate::dynamics::Breakdown::Mass).
+    pub fn kinetic<T: Kinetic<K>, const K: usize>(mut self, t: T, at: [usize; K]) -> Self {
+        if self.check_indices("a kinetic energy", &at) {
+            let item = (t, at);
+            match self.kinetic.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<KineticGroup<T, K>>()) {
+                Some(g) => g.items.push(item),
+                None => self.kinetic.push(Box::new(KineticGroup { items: vec![item] })),
+            }
+        }
+        self
+    }
+
     /// Constraint rows added so far.
     pub fn rows(&self) -> usize {
         self.constraints.iter().map(|b| b.rows()).sum()
@@ -129,10 +160,17 @@ impl ModelBuilder {
                 pattern.start.push(last + b.width() as u32);
             }
         }
-        let mass = DiagonalMass::new(self.mass)?;
+        let inertia = if self.kinetic.is_empty() {
+            Inertia::Constant(DiagonalMass::new(self.mass)?)
+        } else {
+            for &m in &self.mass {
+                crate::error::non_negative("mass", m)?;
+            }
+            Inertia::General { diagonal: self.mass, kinetic: self.kinetic }
+        };
         check_rows(pattern.start.len() - 1, n)?;
         Ok(Model {
-            mass,
+            inertia,
             constraints: self.constraints,
             potentials: self.potentials,
             forces: self.forces,
@@ -154,20 +192,72 @@ pub(crate) fn check_rows(m: usize, n: usize) -> Result<()> {
 impl Model {
     /// Starts a model whose coordinates have these (diagonal) masses.
     pub fn builder(mass: Vec<f64>) -> ModelBuilder {
-        ModelBuilder { mass, constraints: Vec::new(), potentials: Vec::new(), forces: Vec::new(), error: None }
+        ModelBuilder {
+            mass,
+            kinetic: Vec::new(),
+            constraints: Vec::new(),
+            potentials: Vec::new(),
+            forces: Vec::new(),
+            error: None,
+        }
     }
 
     /// Number of coordinates `n`.
     pub fn n(&self) -> usize {
-        self.mass.n()
+        match &self.inertia {
+            Inertia::Constant(mass) => mass.n(),
+            Inertia::General { diagonal, .. } => diagonal.len(),
+        }
     }
     /// Number of constraint rows `m`.
     pub fn m(&self) -> usize {
         self.pattern.start.len() - 1
     }
-    /// The mass matrix `M`.
-    pub fn mass(&self) -> &DiagonalMass {
-        &self.mass
+    /// The mass matrix `M` when it is constant and diagonal; `None` when it
+    /// depends on `q` (kinetic-energy elements), see [`Model::mass_at`].
+    #[inline(always)]
+    pub fn mass(&self) -> Option<&DiagonalMass> {
+        match &self.inertia {
+            Inertia::Constant(mass) => Some(mass),
+            Inertia::General { .. } => None,
+        }
+    }
+
+    /// Evaluates `M(q)` into `mass` and factors it; adds `∂T/∂q` into
+    /// `grad_q` and `Ṁ q̇` into `mdot_v` (both zero for a constant `M`).
+    /// Returns `T`, or the coordinate whose pivot shows `M` is not
+    /// positive definite at `q`.
+    pub fn mass_at(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut DenseMass,
+        grad_q: &mut [f64],
+        mdot_v: &mut [f64],
+    ) -> std::result::Result<f64, usize> {
+        let n = self.n();
+        let m = mass.matrix_mut();
+        m.fill(0.0);
+        let mut energy = 0.0;
+        match &self.inertia {
+            Inertia::Constant(d) => {
+                for (i, &mi) in d.diagonal().iter().enumerate() {
+                    m[i * n + i] = mi;
+                }
+                energy = d.kinetic(v);
+            }
+            Inertia::General { diagonal, kinetic } => {
+                for (i, &mi) in diagonal.iter().enumerate() {
+                    m[i * n + i] = mi;
+                    energy += 0.5 * mi * v[i] * v[i];
+                }
+                for b in kinetic {
+                    energy += b.add_all(q, v, m, grad_q, mdot_v);
+                }
+            }
+        }
+        mass.factor()?;
+        Ok(energy)
     }
     /// Which coordinates each constraint row of `Φ_q` reads.
     pub fn pattern(&self) -> &Pattern {
@@ -214,8 +304,20 @@ impl Model {
         self.forces.iter().map(|b| b.add_forces(q, v, t, f)).sum()
     }
 
-    /// Kinetic energy `½ vᵀ M v`.
-    pub fn kinetic(&self, v: &[f64]) -> f64 {
-        self.mass.kinetic(v)
+    /// Kinetic energy `T(q, v) = ½ vᵀ M(q) v`.
+    pub fn kinetic(&self, q: &[f64], v: &[f64]) -> f64 {
+        self.kinetic_and_gradient(q, v, None)
+    }
+
+    /// `T(q, v)`, adding `∂T/∂q` into `grad_q` when given (nothing for a
+    /// constant `M`). `∇V + ∂T/∂q` is the energy constraint's `Ψ_q`.
+    pub fn kinetic_and_gradient(&self, q: &[f64], v: &[f64], mut grad_q: Option<&mut [f64]>) -> f64 {
+        match &self.inertia {
+            Inertia::Constant(mass) => mass.kinetic(v),
+            Inertia::General { diagonal, kinetic } => {
+                let own = 0.5 * diagonal.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>();
+                own + kinetic.iter().map(|b| b.energy(q, v, grad_q.as_deref_mut())).sum::<f64>()
+            }
+        }
     }
 }

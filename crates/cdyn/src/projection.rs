@@ -181,7 +181,7 @@ pub(crate) fn invariants(
         let remaining = settings.max_iterations.saturating_sub(iterations);
         iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
         velocities(model, d, v, work);
-        let (kinetic, potential) = (model.kinetic(v), d.potential());
+        let (kinetic, potential) = (d.mass(model).kinetic(v), d.potential());
         let psi = kinetic + potential - e0_plus_e;
         // Ψ is a difference of energies: its round-off grows with them.
         let psi_tol = tol * (kinetic + potential.abs()).max(1.0);
@@ -196,7 +196,7 @@ pub(crate) fn invariants(
         }
         energy_steps += 1;
         // Along g = P v: Ψ(s) = Ψ − a s + ½ a s², a = |P v|²_M = vᵀ M P v.
-        let mass = model.mass();
+        let mass = d.mass(model);
         project(model, d, v, &mut work.rows, &mut work.direction);
         let a = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
         let disc = 1.0 - 2.0 * psi / a;
@@ -207,17 +207,19 @@ pub(crate) fn invariants(
                 *v -= s * g;
             }
             // The velocity step keeps Φ and Φ̇; only round-off is left.
-            let psi = model.kinetic(v) + d.potential() - e0_plus_e;
+            let psi = mass.kinetic(v) + d.potential() - e0_plus_e;
             if psi.abs() <= psi_tol {
                 return Ok(iterations);
             }
             continue;
         }
-        // A turning point: move the positions along w = P M⁻¹ ∇V (Newton
-        // step on V), then project them again on the next pass.
-        mass.solve(d.grad_potential(), &mut work.direction);
+        // A turning point: move the positions along w = P M⁻¹ Ψ_q (Newton
+        // step on V, and on T when M depends on q: then Ψ_q is taken at the
+        // velocities of the last evaluation, close to these at a turning
+        // point), then project them again on the next pass.
+        mass.solve(d.psi_q(), &mut work.direction);
         project(model, d, &work.direction, &mut work.rows, &mut work.correction);
-        let slope: f64 = d.grad_potential().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
+        let slope: f64 = d.psi_q().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
         if slope.is_nan() || slope <= 0.0 {
             return Err(Failure::Energy { residual: psi.abs() });
         }

@@ -108,7 +108,7 @@ impl<'m> Simulation<'m> {
     pub fn new(model: &'m Model, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
         settings.validate()?;
         check_initial_state(model.n(), q0, v0)?;
-        let e0 = model.kinetic(v0) + model.potential(q0, None);
+        let e0 = model.kinetic(q0, v0) + model.potential(q0, None);
         let mut system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
         system.set_dependent_rows(settings.dependent_rows);
         Self::start(system, settings, q0, v0)
@@ -357,6 +357,7 @@ fn eval_error(e: EvalError, step: u64, t_next: f64) -> Error {
     match e {
         EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
         EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t_next },
+        EvalError::Mass { t, coordinate } => Error::MassNotPositive { step, t, coordinate },
     }
 }
 

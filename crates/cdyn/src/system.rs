@@ -6,7 +6,7 @@ use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::{Buffer, Rhs};
-use crate::mass::DiagonalMass;
+use crate::mass::MassAt;
 use crate::model::Model;
 use crate::projection::{self, Failure, Projection};
 
@@ -25,6 +25,13 @@ pub enum EvalError {
         /// Time of the evaluation.
         t: f64,
     },
+    /// `M(q)` is not positive definite at the state.
+    Mass {
+        /// Time of the evaluation.
+        t: f64,
+        /// The coordinate whose pivot failed.
+        coordinate: usize,
+    },
 }
 
 impl EvalError {
@@ -32,6 +39,7 @@ impl EvalError {
         match b {
             Breakdown::Singular(row) => EvalError::Singular { t, row },
             Breakdown::NonFinite => EvalError::NonFinite { t },
+            Breakdown::Mass(coordinate) => EvalError::Mass { t, coordinate },
         }
     }
 }
@@ -158,11 +166,11 @@ impl Rhs for ControlledSystem<'_> {
         f[n..2 * n].copy_from_slice(self.dynamics.acc());
         f[2 * n] = e_dot;
         if let Some(u) = u {
-            let psi = energy::psi(self.model.mass(), v, self.dynamics.potential(), e, self.e0);
+            let psi = energy::psi(&self.dynamics.mass(self.model), v, self.dynamics.potential(), e, self.e0);
             let (u_q, rest) = u.split_at_mut(n);
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
-            let d = Evaluated { model: self.model, dynamics: &self.dynamics };
+            let d = Evaluated::new(self.model, &self.dynamics);
             let [r0, r1, r2, r3, r4] = &mut self.rows;
             let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work };
             self.control.terms(&d, v, psi, e_dot, u_q, u_v, work);
@@ -198,7 +206,7 @@ impl System for ControlledSystem<'_> {
     fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError> {
         let (q, v, _) = split_state(x, self.model.n());
         self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let d = Evaluated { model: self.model, dynamics: &self.dynamics };
+        let d = Evaluated::new(self.model, &self.dynamics);
         let rows = (0..self.model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
         Ok((crate::gains::coupling(&d, self.model.n()), rows.fold(0.0, f64::max)))
     }
@@ -218,12 +226,19 @@ impl System for ControlledSystem<'_> {
 struct Evaluated<'a> {
     model: &'a Model,
     dynamics: &'a Dynamics,
+    mass: MassAt<'a>,
 }
 
-impl Evaluation for Evaluated<'_> {
-    type Mass = DiagonalMass;
-    fn mass(&self) -> &DiagonalMass {
-        self.model.mass()
+impl<'a> Evaluated<'a> {
+    fn new(model: &'a Model, dynamics: &'a Dynamics) -> Self {
+        Self { model, dynamics, mass: dynamics.mass(model) }
+    }
+}
+
+impl<'a> Evaluation for Evaluated<'a> {
+    type Mass = MassAt<'a>;
+    fn mass(&self) -> &MassAt<'a> {
+        &self.mass
     }
     fn phi(&self) -> &[f64] {
         self.dynamics.phi()
@@ -232,7 +247,7 @@ impl Evaluation for Evaluated<'_> {
         self.dynamics.phi_dot()
     }
     fn grad_potential(&self) -> &[f64] {
-        self.dynamics.grad_potential()
+        self.dynamics.psi_q()
     }
     fn acc(&self) -> &[f64] {
         self.dynamics.acc()

@@ -3,14 +3,18 @@
 //! Example 1 (as a general model and as a small system) and on a mechanism
 //! with every kind of element (also with a redundant row, tolerated); the
 //! robust preset after its automatic gains are chosen, and the projection
-//! method (general models only); and a tractor with a trailer on knife
-//! edges (nonholonomic rows).
+//! method (general models only); a tractor with a trailer on knife edges
+//! (nonholonomic rows); and the models whose `M(q)` comes from a kinetic
+//! energy (the double pendulum and the loaded four-bar in angles).
 
 use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity};
 use cdyn::dynamics::{DependentRows, LinearSolver};
 use cdyn::integrate::Application;
 use cdyn::methods;
-use cdyn::models::{Example, PendulumParams, andrews, cartesian_pendulum, small_pendulum};
+use cdyn::models::{
+    DoublePendulumParams, Example, FourBarParams, LoadPendulum, PendulumParams, andrews, cartesian_pendulum,
+    double_pendulum_angles, four_bar_angles, small_pendulum,
+};
 use cdyn::planar::{BodyId, Coordinate, Element, Mechanism};
 use cdyn::projection::{OnFailure, Projection};
 use cdyn::simulate::Stepper;
@@ -195,6 +199,9 @@ fn steps_do_not_allocate() {
     let chain = hanging_chain(64);
     let trailer = tractor_trailer();
     let redundant = redundant_chain(64);
+    let angles = double_pendulum_angles(DoublePendulumParams::default()).unwrap();
+    let four_bar =
+        four_bar_angles(FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() }).unwrap();
     assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
@@ -230,6 +237,13 @@ fn steps_do_not_allocate() {
             assert_eq!(n, 0, "pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
             let n = small_allocations_per_run(Settings::new(scheme, 0.01, control), 5, 200);
             assert_eq!(n, 0, "small pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+        }
+        // M(q) from kinetic energies: every law, the robust preset and the projection.
+        for control in controls().into_iter().chain(robust_controls()).chain(projections()) {
+            for (name, ex) in [("double pendulum in angles", &angles), ("four-bar in angles", &four_bar)] {
+                let n = allocations_per_run(ex, Settings::new(scheme, 1e-3, control), 5, 200);
+                assert_eq!(n, 0, "{name}, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+            }
         }
         let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, methods::robust()), 5, 200);
         assert_eq!(n, 0, "andrews, {scheme:?}, robust: {n} allocations in 200 steps");

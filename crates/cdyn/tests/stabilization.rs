@@ -141,7 +141,7 @@ impl Dense {
         }
         Dense {
             jac,
-            mass: DVector::from_column_slice(model.mass().diagonal()),
+            mass: DVector::from_column_slice(model.mass().expect("a constant mass").diagonal()),
             phi: DVector::from_column_slice(d.phi()),
             phi_dot: DVector::from_column_slice(d.phi_dot()),
             grad_v: DVector::from_column_slice(d.grad_potential()),
@@ -176,7 +176,7 @@ fn control_term(
     let e0 = 0.0;
     let mut system = ControlledSystem::new(model, control, e0);
     // Ψ = T + V − E₀ − e.
-    let e = model.kinetic(v) + model.potential(q, None) - e0 - psi;
+    let e = model.kinetic(q, v) + model.potential(q, None) - e0 - psi;
     let x: Vec<f64> = q.iter().chain(v).copied().chain([e]).collect();
     let (mut f, mut u) = (vec![0.0; 2 * n + 1], vec![f64::NAN; 2 * n + 1]);
     system.eval(&x, t, &mut f, Some(&mut u)).unwrap();
@@ -470,7 +470,7 @@ fn projection_holds_every_invariant_to_its_tolerance_after_every_step() {
             let m = s.measure();
             // Ψ is a difference of energies: the tolerance bounds it relative
             // to max(1, T + |V|) (`Projection::tolerance`).
-            let energy = ex.model.kinetic(s.v()) + ex.model.potential(s.q(), None).abs();
+            let energy = ex.model.kinetic(s.q(), s.v()) + ex.model.potential(s.q(), None).abs();
             assert!(
                 m.phi.abs() <= tolerance && m.phi_dot <= tolerance && m.psi.abs() <= tolerance * energy.max(1.0),
                 "{name}, t = {}: {m:?}",

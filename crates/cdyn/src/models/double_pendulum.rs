@@ -1,11 +1,16 @@
-//! The double pendulum: two point masses on massless rods, chaotic in general.
+//! The double pendulum: two point masses on massless rods, chaotic in
+//! general; in Cartesian coordinates (constant mass, two distance
+//! constraints) and in its two angles (kinetic energy `T(θ, θ̇)`, `M(θ)`
+//! by automatic differentiation, no constraints).
 
 use std::f64::consts::FRAC_PI_2;
 
 use super::Example;
 use super::parts::{add, dir, example, hanging, point_body};
 use crate::error::{Result, finite, non_negative, positive};
+use crate::kinetic::Kinetic;
 use crate::planar::{BodyId, Element, Mechanism};
+use crate::{Model, Potential, Scalar};
 
 /// A double pendulum: two point masses on massless rods, the first rod
 /// pinned at the origin. Angles are counter-clockwise from the downward
@@ -96,4 +101,74 @@ pub fn double_pendulum(p: DoublePendulumParams) -> Result<Example> {
         },
         None,
     ))
+}
+
+/// The kinetic energy of the two bobs in the rods' absolute angles from the
+/// downward vertical, written through the bobs' Cartesian velocities:
+/// `T = ½ m₁|ṗ₁|² + ½ m₂|ṗ₂|²`, `p₁ = l₁(sin θ₁, −cos θ₁)`, `p₂ = p₁ + l₂(sin θ₂, −cos θ₂)`.
+/// Its mass matrix is `[[(m₁+m₂)l₁², m₂l₁l₂cos(θ₁−θ₂)], [·, m₂l₂²]]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DoublePendulumKinetic {
+    /// Mass of the first bob.
+    pub m1: f64,
+    /// Mass of the second bob.
+    pub m2: f64,
+    /// Length of the first rod.
+    pub l1: f64,
+    /// Length of the second rod.
+    pub l2: f64,
+}
+
+impl Kinetic<2> for DoublePendulumKinetic {
+    fn energy<D: Scalar>(&self, [t1, t2]: [D; 2], [w1, w2]: [D; 2]) -> D {
+        // ṗ = l θ̇ (cos θ, sin θ) for each rod.
+        let (v1x, v1y) = (t1.cos() * w1 * self.l1, t1.sin() * w1 * self.l1);
+        let (v2x, v2y) = (v1x + t2.cos() * w2 * self.l2, v1y + t2.sin() * w2 * self.l2);
+        (v1x * v1x + v1y * v1y) * (0.5 * self.m1) + (v2x * v2x + v2y * v2y) * (0.5 * self.m2)
+    }
+}
+
+/// Gravity on the two bobs, in the angles: `V = g (m₁ y₁ + m₂ y₂)`.
+struct DoublePendulumWeight {
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    gravity: f64,
+}
+
+impl Potential<2> for DoublePendulumWeight {
+    fn energy<D: Scalar>(&self, [t1, t2]: [D; 2]) -> D {
+        let y1 = -t1.cos() * self.l1;
+        let y2 = y1 - t2.cos() * self.l2;
+        (y1 * self.m1 + y2 * self.m2) * self.gravity
+    }
+}
+
+/// The double pendulum in its angles `q = (θ₁, θ₂)` (absolute, from the
+/// downward vertical), with the same parameters as [`double_pendulum`]: two
+/// coordinates, no constraints, and a configuration-dependent mass matrix
+/// from the kinetic energy [`DoublePendulumKinetic`].
+///
+/// Observables as for [`double_pendulum`]: `bob2.x`, `bob2.y`, `theta1`,
+/// `theta2` (in (−π, π]), then the angles as integrated.
+pub fn double_pendulum_angles(p: DoublePendulumParams) -> Result<Example> {
+    p.validate()?;
+    let (m1, m2, l1, l2) = (p.m1, p.m2, p.l1, p.l2);
+    let model = Model::builder(vec![0.0, 0.0])
+        .kinetic(DoublePendulumKinetic { m1, m2, l1, l2 }, [0, 1])
+        .potential(DoublePendulumWeight { m1, m2, l1, l2, gravity: p.gravity }, [0, 1])
+        .build()?;
+    let wrap = |a: f64| a.sin().atan2(a.cos());
+    Ok(Example {
+        model,
+        q0: vec![p.theta1, p.theta2],
+        v0: vec![p.omega1, p.omega2],
+        observables: ["bob2.x", "bob2.y", "theta1", "theta2", "q0", "q1"].map(String::from).to_vec(),
+        observe: Box::new(move |q, _v, out| {
+            let tip = add(add([0.0, 0.0], l1, hanging(q[0])), l2, hanging(q[1]));
+            out.copy_from_slice(&[tip[0], tip[1], wrap(q[0]), wrap(q[1]), q[0], q[1]]);
+        }),
+        reference: None,
+    })
 }

@@ -6,8 +6,8 @@
 
 #[cfg(feature = "serde")]
 use super::{
-    Example, andrews, cartesian_pendulum, chain, damped_pendulum, double_pendulum, four_bar, moving_support_pendulum,
-    slider_crank, theta_pendulum,
+    Example, andrews, cartesian_pendulum, chain, damped_pendulum, double_pendulum, double_pendulum_angles, four_bar,
+    four_bar_angles, moving_support_pendulum, slider_crank, theta_pendulum,
 };
 
 /// A built-in model, by the name scenario files give it (`kind = "chain"`,
@@ -31,12 +31,19 @@ pub enum Kind {
     Andrews,
     /// [`double_pendulum`](super::double_pendulum), [`DoublePendulumParams`](super::DoublePendulumParams).
     DoublePendulum,
+    /// The same double pendulum in its two angles, its mass matrix `M(θ)`
+    /// from the kinetic energy: [`double_pendulum_angles`](super::double_pendulum_angles),
+    /// [`DoublePendulumParams`](super::DoublePendulumParams).
+    DoublePendulumAngles,
     /// [`chain`](super::chain), [`ChainParams`](super::ChainParams).
     Chain,
     /// [`slider_crank`](super::slider_crank), [`SliderCrankParams`](super::SliderCrankParams).
     SliderCrank,
     /// [`four_bar`](super::four_bar), [`FourBarParams`](super::FourBarParams).
     FourBar,
+    /// The same four-bar in its three joint angles, `M(q)` from the kinetic
+    /// energy: [`four_bar_angles`](super::four_bar_angles), [`FourBarParams`](super::FourBarParams).
+    FourBarAngles,
     /// [`moving_support_pendulum`](super::moving_support_pendulum),
     /// [`MovingSupportParams`](super::MovingSupportParams).
     MovingSupportPendulum,
@@ -46,15 +53,17 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in declaration order.
-    pub const ALL: [Kind; 10] = [
+    pub const ALL: [Kind; 12] = [
         Kind::Pendulum,
         Kind::PendulumTheta,
         Kind::Mechanism,
         Kind::Andrews,
         Kind::DoublePendulum,
+        Kind::DoublePendulumAngles,
         Kind::Chain,
         Kind::SliderCrank,
         Kind::FourBar,
+        Kind::FourBarAngles,
         Kind::MovingSupportPendulum,
         Kind::DampedPendulum,
     ];
@@ -78,9 +87,11 @@ impl Kind {
             )),
             Kind::Andrews => build(parameters, |NoParameters {}| andrews()),
             Kind::DoublePendulum => build(parameters, double_pendulum),
+            Kind::DoublePendulumAngles => build(parameters, double_pendulum_angles),
             Kind::Chain => build(parameters, chain),
             Kind::SliderCrank => build(parameters, slider_crank),
             Kind::FourBar => build(parameters, four_bar),
+            Kind::FourBarAngles => build(parameters, four_bar_angles),
             Kind::MovingSupportPendulum => build(parameters, moving_support_pendulum),
             Kind::DampedPendulum => build(parameters, damped_pendulum),
         }

@@ -8,9 +8,11 @@
 //! | model | free motion | reference |
 //! |---|---|---|
 //! | [`double_pendulum`] | 2 DOF | none (chaotic in general) |
+//! | [`double_pendulum_angles`] | 2 DOF, `M(θ)` from `T` | none; the same motion as [`double_pendulum`] |
 //! | [`chain`] | N DOF | rigid rotation when `g = 0`; the exact pendulum when `N = 1` |
 //! | [`slider_crank`] | none (driven); 1 DOF with a load | exact kinematics; a load pendulum by a fine RK-4 |
 //! | [`four_bar`] | none (driven); 1 DOF with a load | exact kinematics (circle intersection); a load by a fine RK-4 |
+//! | [`four_bar_angles`] | the same in three joint angles, `M(q)` from `T` | the same |
 //! | [`moving_support_pendulum`] | 1 DOF, driven support | exact pendulum in the accelerated frame, or a fine RK-4 |
 //! | [`damped_pendulum`] | 1 DOF, rotary damper | exact pendulum when undamped, else a fine RK-4 |
 //!
@@ -41,8 +43,8 @@ mod slider_crank;
 pub use andrews::andrews;
 pub use chain::{ChainParams, chain};
 pub use damped_pendulum::{DampedPendulumParams, damped_pendulum};
-pub use double_pendulum::{DoublePendulumParams, double_pendulum};
-pub use four_bar::{FourBarBranch, FourBarParams, four_bar};
+pub use double_pendulum::{DoublePendulumKinetic, DoublePendulumParams, double_pendulum, double_pendulum_angles};
+pub use four_bar::{FourBarBranch, FourBarParams, four_bar, four_bar_angles};
 pub use kind::Kind;
 pub use moving_support::{MovingSupportParams, moving_support_pendulum};
 pub use parts::LoadPendulum;

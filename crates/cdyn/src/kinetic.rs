@@ -1,0 +1,126 @@
+//! Kinetic energy as small local elements, for coordinates whose inertia
+//! depends on the configuration (angles, relative coordinates).
+//!
+//! The user writes `T(x, ẋ)` of `K` coordinates once, generic over the
+//! scalar, as for constraints and potentials. The library takes by dual
+//! numbers what the equations of motion need of it:
+//!
+//! * the local mass matrix `M_e = ∂²T/∂ẋ²` (one hyper-dual pass per pair
+//!   `i ≤ j`: `T` along `ẋ + ε₁eᵢ + ε₂eⱼ`, whose `ε₁ε₂` part is `M_ij`);
+//! * `Ṁ_e ẋ`, whose entry `i` is `Σⱼ ∂²T/∂ẋᵢ∂xⱼ ẋⱼ` (one hyper-dual pass per
+//!   coordinate: `T` at `(x + ε₂ẋ, ẋ + ε₁eᵢ)`);
+//! * `∂T/∂x` (one dual pass per coordinate).
+//!
+//! Lagrange's equations `d/dt(∂T/∂ẋ) − ∂T/∂x = Q` are then
+//! `M q̈ = Q + ∂T/∂q − Ṁ q̇`, so the velocity terms join the applied force
+//! `G`. `T` must be quadratic in the velocities (a natural system, the case
+//! of every mechanism without moving frames); then `∂T/∂ẋ = M ẋ` and
+//! `T = ½ ẋᵀ M ẋ`, which the energy constraint relies on.
+
+use crate::constraint::seeded;
+use crate::scalar::Scalar;
+use num_dual::HyperDual64;
+use std::any::Any;
+
+/// Kinetic energy `T(x, ẋ)` of `K` coordinates, quadratic in `ẋ`.
+pub trait Kinetic<const K: usize>: Send + Sync + 'static {
+    /// `T(x, ẋ)`, for any scalar type (dual numbers give `M(x)` and its derivatives).
+    fn energy<D: Scalar>(&self, x: [D; K], xd: [D; K]) -> D;
+}
+
+/// What one element contributes at a state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Local<const K: usize> {
+    /// `T`
+    pub energy: f64,
+    /// `M_e = ∂²T/∂ẋ²`
+    pub mass: [[f64; K]; K],
+    /// `∂T/∂x`
+    pub grad_q: [f64; K],
+    /// `Ṁ_e ẋ`
+    pub mdot_v: [f64; K],
+}
+
+/// Differentiates one element at `(x, ẋ)`.
+#[inline(always)]
+pub fn local<T: Kinetic<K>, const K: usize>(t: &T, x: [f64; K], xd: [f64; K]) -> Local<K> {
+    let hyper = |x0: &[f64; K], dx: &[f64; K], v0: &[f64; K], dv1: &[f64; K], dv2: &[f64; K]| -> HyperDual64 {
+        let x = std::array::from_fn(|k| HyperDual64::new(x0[k], 0.0, dx[k], 0.0));
+        let v = std::array::from_fn(|k| HyperDual64::new(v0[k], dv1[k], dv2[k], 0.0));
+        t.energy(x, v)
+    };
+    let unit = |i: usize| -> [f64; K] { std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 }) };
+    let zero = [0.0; K];
+    let mut mass = [[0.0; K]; K];
+    for i in 0..K {
+        for j in i..K {
+            let m = hyper(&x, &zero, &xd, &unit(i), &unit(j)).eps1eps2;
+            mass[i][j] = m;
+            mass[j][i] = m;
+        }
+    }
+    let mdot_v = std::array::from_fn(|i| hyper(&x, &xd, &xd, &unit(i), &zero).eps1eps2);
+    let grad_q = std::array::from_fn(|j| t.energy(seeded(&x, j), xd.map(Into::into)).eps);
+    // T = ½ ẋᵀ M ẋ for a T quadratic in ẋ; taken from T itself so that a
+    // user's T that is not quadratic shows up as an energy error, not silently.
+    let energy = t.energy(x, xd);
+    Local { energy, mass, grad_q, mdot_v }
+}
+
+/// A run of kinetic-energy elements of one type (object-safe face).
+pub(crate) trait KineticBlock: Send + Sync {
+    /// Adds `M(q)` into the row-major `n × n` matrix `mass`, `∂T/∂q` into
+    /// `grad_q` and `Ṁ q̇` into `mdot_v`; returns `T`.
+    fn add_all(&self, q: &[f64], v: &[f64], mass: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64;
+    /// `T`, adding `∂T/∂q` into `grad_q` when given.
+    fn energy(&self, q: &[f64], v: &[f64], grad_q: Option<&mut [f64]>) -> f64;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+pub(crate) struct KineticGroup<T, const K: usize> {
+    pub items: Vec<(T, [usize; K])>,
+}
+
+impl<T: Kinetic<K>, const K: usize> KineticBlock for KineticGroup<T, K> {
+    fn add_all(&self, q: &[f64], v: &[f64], mass: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64 {
+        let n = grad_q.len();
+        let mut total = 0.0;
+        for (t, idx) in &self.items {
+            let l = local(t, idx.map(|i| q[i]), idx.map(|i| v[i]));
+            total += l.energy;
+            for a in 0..K {
+                grad_q[idx[a]] += l.grad_q[a];
+                mdot_v[idx[a]] += l.mdot_v[a];
+                for b in 0..K {
+                    mass[idx[a] * n + idx[b]] += l.mass[a][b];
+                }
+            }
+        }
+        total
+    }
+
+    fn energy(&self, q: &[f64], v: &[f64], grad_q: Option<&mut [f64]>) -> f64 {
+        let mut total = 0.0;
+        match grad_q {
+            None => {
+                for (t, idx) in &self.items {
+                    total += t.energy(idx.map(|i| q[i]), idx.map(|i| v[i]));
+                }
+            }
+            Some(g) => {
+                for (t, idx) in &self.items {
+                    let (x, xd) = (idx.map(|i| q[i]), idx.map(|i| v[i]));
+                    total += t.energy(x, xd);
+                    for j in 0..K {
+                        g[idx[j]] += t.energy(seeded(&x, j), xd.map(Into::into)).eps;
+                    }
+                }
+            }
+        }
+        total
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
