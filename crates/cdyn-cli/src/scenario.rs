@@ -332,10 +332,7 @@ impl Scenario {
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
             None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        // The mechanism was built above, so its names resolve; gravity is not drawn.
-        let drawing = (self.model.kind == Kind::Mechanism)
-            .then(|| self.mechanism([0.0, 0.0]).ok().map(|m| m.drawing()))
-            .flatten();
+        let drawing = example.drawing.clone();
         Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, drawing })
     }
 

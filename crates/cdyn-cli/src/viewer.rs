@@ -27,7 +27,7 @@ impl ViewerArgs {
     pub fn prepare(self, cases: &mut [Case]) -> Result<()> {
         if self.gif && cases.iter().all(|c| c.drawing.is_none()) {
             anyhow::bail!(
-                "--gif: this model has no drawing (only mechanisms given by [[bodies]] and their elements have one)"
+                "--gif: this model has no drawing (models in independent angles have none; their Cartesian twins do)"
             );
         }
         if !self.html && !self.gif {

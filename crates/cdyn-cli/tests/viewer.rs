@@ -81,12 +81,12 @@ fn long_runs_are_decimated_and_say_so() {
 }
 
 #[test]
-fn compare_html_has_every_case_and_a_built_in_model_plots_only() {
+fn compare_html_has_every_case_and_draws_a_built_in() {
     let out = tempfile::tempdir().unwrap();
     let dp = examples().join("double_pendulum.toml");
     let r = cdyn(&["compare", path_str(&dp), "--out", path_str(out.path()), "--html"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (text, data) = page(out.path());
+    let (_, data) = page(out.path());
     let summary: Value =
         serde_json::from_str(&std::fs::read_to_string(out.path().join("summary.json")).unwrap()).unwrap();
     let names = |cases: &Value| -> Vec<String> {
@@ -95,13 +95,52 @@ fn compare_html_has_every_case_and_a_built_in_model_plots_only() {
     assert_eq!(names(&data["cases"]), names(&summary["cases"]));
     assert!(data["cases"].as_array().unwrap().len() > 3);
     assert_eq!(data["info"]["methods"], summary["methods"]);
+    // The built-in is a mechanism: two bobs on two rods, the first from the ground.
+    assert_eq!(names(&data["drawing"]["bodies"]), ["bob1", "bob2"]);
+    let links = data["drawing"]["links"].as_array().unwrap();
+    assert_eq!(links.iter().map(|l| l["kind"].as_str().unwrap()).collect::<Vec<_>>(), ["distance", "distance"]);
+    assert!(links[0]["ends"][0]["body"].is_null() && links[1]["ends"][0]["body"] == 0);
+    let frames = &data["cases"][0]["frames"];
+    assert_eq!(frames["t"].as_array().unwrap().len(), 501, "5 s sampled every 10 steps of 1e-3");
+    assert!(!data["cases"][0]["series"]["phi"].as_array().unwrap().is_empty());
+}
+
+#[test]
+fn the_cartesian_pendulum_is_drawn_as_a_bob_on_a_rod() {
+    let out = tempfile::tempdir().unwrap();
+    let pendulum = examples().join("cvsgf_energy.toml");
+    let r = cdyn(&["run", path_str(&pendulum), "--out", path_str(out.path()), "--html", "--gif"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (_, data) = page(out.path());
+    let drawing = &data["drawing"];
+    assert_eq!(drawing["bodies"][0]["name"], "bob");
+    assert_eq!((drawing["bodies"][0]["x"].as_u64(), drawing["bodies"].as_array().unwrap().len()), (Some(0), 1));
+    assert_eq!(drawing["links"][0]["kind"], "distance");
+    assert!(drawing["links"][0]["ends"][0]["body"].is_null() && drawing["links"][0]["ends"][1]["body"] == 0);
+    // The rod's length is the distance of the bob's coordinates from the pivot in every frame.
+    let q = data["cases"][0]["frames"]["q"].as_array().unwrap();
+    assert!(q.len() > 100);
+    for frame in q {
+        let (x, y) = (frame[0].as_f64().unwrap(), frame[1].as_f64().unwrap());
+        assert!(((x * x + y * y).sqrt() - 1.0).abs() < 1e-3, "{x} {y}");
+    }
+    assert!(out.path().join("animation.gif").exists());
+}
+
+#[test]
+fn a_model_in_angles_plots_only_and_refuses_a_gif() {
+    let out = tempfile::tempdir().unwrap();
+    let angles = examples().join("double_pendulum_angles.toml");
+    let r = cdyn(&["run", path_str(&angles), "--out", path_str(out.path()), "--html"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (text, data) = page(out.path());
     assert!(data["drawing"].is_null() && text.contains("has no drawing"));
     assert!(data["cases"][0]["frames"]["t"].as_array().unwrap().is_empty());
     assert!(!data["cases"][0]["series"]["phi"].as_array().unwrap().is_empty());
 
     // No GIF without a drawing: refused before anything runs.
     let out = tempfile::tempdir().unwrap();
-    let e = one_error_line(&cdyn(&["run", path_str(&dp), "--out", path_str(out.path()), "--gif"]));
+    let e = one_error_line(&cdyn(&["run", path_str(&angles), "--out", path_str(out.path()), "--gif"]));
     assert!(e.contains("--gif: this model has no drawing"), "{e}");
     assert!(!out.path().join("summary.json").exists());
 }

@@ -188,5 +188,6 @@ pub fn andrews() -> Result<Example> {
         observables: ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"].map(String::from).to_vec(),
         observe: Box::new(|q, _v, out| out.copy_from_slice(&test_set_angles(body_angles(q)))),
         reference: None,
+        drawing: Some(built.drawing),
     })
 }

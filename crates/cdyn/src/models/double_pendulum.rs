@@ -170,5 +170,6 @@ pub fn double_pendulum_angles(p: DoublePendulumParams) -> Result<Example> {
             out.copy_from_slice(&[tip[0], tip[1], wrap(q[0]), wrap(q[1]), q[0], q[1]]);
         }),
         reference: None,
+        drawing: None,
     })
 }

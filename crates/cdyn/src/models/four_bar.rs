@@ -429,6 +429,7 @@ pub fn four_bar_angles(p: FourBarParams) -> Result<Example> {
             out[k..].copy_from_slice(q);
         }),
         reference: Some(reference),
+        drawing: None,
     })
 }
 

@@ -72,6 +72,11 @@ pub struct Example {
     pub observe: Observe,
     /// The exact (or finely integrated) solution, where one exists.
     pub reference: Option<Reference>,
+    /// What the system looks like, for a viewer: built-ins described as
+    /// planar mechanisms have one; models in independent coordinates
+    /// (angles) have none, since a drawing places bodies by their
+    /// Cartesian coordinates.
+    pub drawing: Option<crate::planar::Drawing>,
 }
 
 impl Example {
@@ -85,6 +90,7 @@ impl Example {
             observables: built.names,
             observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
             reference,
+            drawing: Some(built.drawing),
         }
     }
 

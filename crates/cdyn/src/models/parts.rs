@@ -65,7 +65,8 @@ pub(super) fn example(
         observe_first(q, v, &mut out[..k]);
         out[k..k + n].copy_from_slice(&q[..n]);
     });
-    Example { model: built.model, q0: built.q0, v0: built.v0, observables, observe, reference }
+    let drawing = Some(built.drawing);
+    Example { model: built.model, q0: built.q0, v0: built.v0, observables, observe, reference, drawing }
 }
 
 // ---------------------------------------------------------------------------

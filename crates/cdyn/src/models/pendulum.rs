@@ -5,6 +5,7 @@
 
 use super::Example;
 use crate::error::{Result, finite, non_negative, positive};
+use crate::planar::{Anchor, Drawing, Link, Shape};
 use crate::reference::PendulumExact;
 use crate::small::SmallSystem;
 use crate::{Constraint, Model, Potential, Scalar};
@@ -114,7 +115,16 @@ pub fn cartesian_pendulum(p: PendulumParams) -> Result<Example> {
         observables: names(),
         observe: Box::new(|q, v, out| out.copy_from_slice(&[q[0], q[1], v[0], v[1]])),
         reference,
+        drawing: Some(bob_on_a_rod()),
     })
+}
+
+/// The Cartesian pendulum as a viewer draws it: the bob, a point mass at
+/// `q = (x, y)`, on a rod from the pivot at the origin.
+fn bob_on_a_rod() -> Drawing {
+    let bob = Shape { name: "bob".into(), x: 0, angle: None, points: Vec::new() };
+    let ends = vec![Anchor { body: None, point: [0.0, 0.0] }, Anchor { body: Some(0), point: [0.0, 0.0] }];
+    Drawing { bodies: vec![bob], links: vec![Link { kind: "distance", ends, axis: None }] }
 }
 
 /// The pendulum in Cartesian coordinates as a [`SmallSystem`]: the same
@@ -166,5 +176,6 @@ pub fn theta_pendulum(p: PendulumParams) -> Result<Example> {
         observables: names(),
         observe: Box::new(move |q, v, out| out.copy_from_slice(&tip(length, q[0], v[0]))),
         reference,
+        drawing: None,
     })
 }

@@ -26,6 +26,8 @@ pub struct Built {
     pub offsets: Vec<usize>,
     /// For every constraint row, the index of the element it comes from.
     pub row_elements: Vec<usize>,
+    /// What the mechanism looks like, for a viewer ([`Mechanism::drawing`]).
+    pub drawing: super::Drawing,
 }
 
 impl Mechanism {
@@ -66,7 +68,7 @@ impl Mechanism {
             builder = layout.add(builder, e).map_err(|why| why.at(Part::Element { index: k, kind: e.kind() }))?;
             row_elements.resize(builder.rows(), k);
         }
-        Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements })
+        Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements, drawing: self.drawing() })
     }
 }
 
