@@ -6,7 +6,7 @@ use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::energy;
 use crate::integrate::{Buffer, Rhs};
-use crate::mass::MassAt;
+use crate::mass::{MassAt, MassMatrix};
 use crate::model::Model;
 use crate::projection::{self, Failure, Projection};
 
@@ -170,10 +170,20 @@ impl Rhs for ControlledSystem<'_> {
             let (u_q, rest) = u.split_at_mut(n);
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
-            let d = Evaluated::new(self.model, &self.dynamics);
             let [r0, r1, r2, r3, r4] = &mut self.rows;
             let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work };
-            self.control.terms(&d, v, psi, e_dot, u_q, u_v, work);
+            let (model, dynamics) = (self.model, &self.dynamics);
+            // The laws are compiled once per kind of mass, so that a constant
+            // diagonal `M` runs its loops without a match per product
+            // (Example 1 took 6.6 % more instructions per step with one).
+            match dynamics.mass(model) {
+                MassAt::Diagonal(mass) => {
+                    self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
+                }
+                MassAt::Dense(mass) => {
+                    self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
+                }
+            }
         }
         Ok(())
     }
@@ -206,7 +216,7 @@ impl System for ControlledSystem<'_> {
     fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError> {
         let (q, v, _) = split_state(x, self.model.n());
         self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let d = Evaluated::new(self.model, &self.dynamics);
+        let d = Evaluated { model: self.model, dynamics: &self.dynamics, mass: &self.dynamics.mass(self.model) };
         let rows = (0..self.model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
         Ok((crate::gains::coupling(&d, self.model.n()), rows.fold(0.0, f64::max)))
     }
@@ -222,23 +232,18 @@ impl System for ControlledSystem<'_> {
     }
 }
 
-/// One evaluation of a general model, as the control laws read it.
-struct Evaluated<'a> {
+/// One evaluation of a general model, as the control laws read it, with
+/// its mass matrix `M` (a kind, or [`MassAt`] where either will do).
+struct Evaluated<'a, M> {
     model: &'a Model,
     dynamics: &'a Dynamics,
-    mass: MassAt<'a>,
+    mass: &'a M,
 }
 
-impl<'a> Evaluated<'a> {
-    fn new(model: &'a Model, dynamics: &'a Dynamics) -> Self {
-        Self { model, dynamics, mass: dynamics.mass(model) }
-    }
-}
-
-impl<'a> Evaluation for Evaluated<'a> {
-    type Mass = MassAt<'a>;
-    fn mass(&self) -> &MassAt<'a> {
-        &self.mass
+impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
+    type Mass = M;
+    fn mass(&self) -> &M {
+        self.mass
     }
     fn phi(&self) -> &[f64] {
         self.dynamics.phi()
