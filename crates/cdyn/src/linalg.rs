@@ -784,17 +784,7 @@ mod tests {
 
     #[test]
     fn a_dependent_row_is_named_and_a_blown_up_jacobian_is_not_called_singular() {
-        let (mut pattern, n) = star(3, 4);
-        // Repeat the last row.
-        let last = pattern.row(pattern.start.len() - 2);
-        let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
-        pattern.cols.extend(&repeated);
-        pattern.start.push(pattern.cols.len() as u32);
-        let mut jac = values(pattern.nnz(), 0.7);
-        let k = repeated.len();
-        let tail = jac.len() - k;
-        let copy = jac[tail - k..tail].to_vec();
-        jac[tail..].copy_from_slice(&copy);
+        let (pattern, n, jac) = repeated_row(1.0);
         let mass = DiagonalMass::new(vec![1.0; n]).unwrap();
         let m = pattern.start.len() - 1;
         for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
@@ -810,9 +800,8 @@ mod tests {
         }
     }
 
-    /// The repeated-row system of the test above, and a consistent
-    /// right-hand side `b = S y`.
-    fn repeated_row() -> (Pattern, usize, Vec<f64>) {
+    /// A star pattern whose last row repeats the row before it, `scale` times.
+    fn repeated_row(scale: f64) -> (Pattern, usize, Vec<f64>) {
         let (mut pattern, n) = star(3, 4);
         let last = pattern.row(pattern.start.len() - 2);
         let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
@@ -822,8 +811,7 @@ mod tests {
         let k = repeated.len();
         let tail = jac.len() - k;
         let copy = jac[tail - k..tail].to_vec();
-        // Twice the row before: dependent, and not of the same scale.
-        jac[tail..].iter_mut().zip(&copy).for_each(|(j, c)| *j = 2.0 * c);
+        jac[tail..].iter_mut().zip(&copy).for_each(|(j, c)| *j = scale * c);
         (pattern, n, jac)
     }
 
@@ -841,7 +829,8 @@ mod tests {
 
     #[test]
     fn a_tolerated_dependent_row_is_dropped_with_a_zero_multiplier_and_the_same_response() {
-        let (pattern, n, jac) = repeated_row();
+        // Twice the row before: dependent, and not of the same scale.
+        let (pattern, n, jac) = repeated_row(2.0);
         let m = pattern.start.len() - 1;
         let mass: DiagonalMass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
         let inv_mass = mass.inverse();
