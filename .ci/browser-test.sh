@@ -21,8 +21,7 @@ fi
 command -v python3 >/dev/null || skip "no python3"
 
 start=$SECONDS
-cargo build -q --locked -p cdyn-cli
-cdyn="$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_directory":"\([^"]*\)".*/\1/')/debug/cdyn"
+cdyn="$(.ci/cdyn-binary.sh)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 "$cdyn" run examples/four_bar.toml --out "$work/run" --html >/dev/null

@@ -21,10 +21,7 @@ fi
 # Quiet unless something fails; a cached install costs a second.
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r python/requirements-test.txt
 
-# The `cdyn` binary the Rust tests use (target/debug/cdyn): built for the
-# whole workspace's tests, a no-op after them. `cargo build -p cdyn-cli`
-# would build it again with another feature set, 45 crates (3.4 minutes).
-cargo test --workspace --locked --all-targets --no-run --quiet
+cdyn="$(.ci/cdyn-binary.sh)"
 wheels="$target/py-wheels"
 rm -rf "$wheels"
 VIRTUAL_ENV="$venv" "$venv/bin/maturin" build --locked --quiet --profile dev --interpreter "$venv/bin/python" --out "$wheels"
@@ -33,5 +30,5 @@ echo "python-test: environment and wheel ready in $((SECONDS - start)) s"
 
 # From the tests' directory, so `import cdyn` finds the installed wheel, not python/cdyn.
 cd python/tests
-CDYN_BIN="$target/debug/cdyn" "$venv/bin/python" -m pytest -q -p no:cacheprovider .
+CDYN_BIN="$cdyn" "$venv/bin/python" -m pytest -q -p no:cacheprovider .
 echo "python-test: done in $((SECONDS - start)) s"

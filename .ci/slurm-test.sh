@@ -34,8 +34,7 @@ if ! command -v sbatch >/dev/null || ! command -v slurmctld >/dev/null || ! comm
   [ -n "$ok" ] || skip "cannot install slurm-wlm and munge (no package registry?): $(tail -1 /tmp/slurm-test-apt.log)"
 fi
 
-cargo build -q --locked -p cdyn-cli
-cdyn="$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_directory":"\([^"]*\)".*/\1/')/debug/cdyn"
+cdyn="$(.ci/cdyn-binary.sh)"
 [ -x "$cdyn" ] || fail "no cdyn binary at $cdyn"
 
 work="$(mktemp -d /tmp/cdyn-slurm.XXXXXX)"
