@@ -5,7 +5,7 @@ use crate::report;
 use crate::runner::{Case, CaseResult};
 use anyhow::Result;
 use cdyn::methods::{MethodGains, independent_cases, redundant_cases};
-use cdyn::models::{PendulumParams, cartesian_pendulum, theta_pendulum};
+use cdyn::models::{Example, PendulumParams, cartesian_pendulum, theta_pendulum};
 use cdyn::{Scheme, Settings};
 use serde_json::json;
 use std::path::Path;
@@ -26,13 +26,13 @@ pub fn cases() -> Result<Vec<Case>> {
         for (name, control) in methods {
             cases.push(Case {
                 name: name.into(),
-                example: model(params)?,
+                // The paper's figures are plots: no frames kept for a viewer.
+                example: Example { drawing: None, ..model(params)? },
                 settings: Settings::new(Scheme::AdamsBashforth3, H, control),
                 t_end: T_END,
                 every: 1,
                 assembly: None,
                 row_entries: Vec::new(),
-                drawing: None,
             });
         }
     }

@@ -30,8 +30,6 @@ pub struct Case {
     /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
     /// where the model comes from entries; errors name it instead of the row.
     pub row_entries: Vec<String>,
-    /// What the mechanism looks like, for the viewer; `None` for models without a drawing.
-    pub drawing: Option<cdyn::planar::Drawing>,
 }
 
 impl Case {
@@ -310,7 +308,7 @@ fn simulate<K: Sink>(
 ) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     let mut frames = match watch {
-        Watch::Interrupts(_) if case.drawing.is_some() => Frames::of(ex.model.n()),
+        Watch::Interrupts(_) if ex.drawing.is_some() => Frames::of(ex.model.n()),
         _ => Frames::none(),
     };
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {

@@ -332,8 +332,7 @@ impl Scenario {
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
             None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        let drawing = example.drawing.clone();
-        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, drawing })
+        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows })
     }
 
     /// The model with its initial state, and for mechanisms the entry

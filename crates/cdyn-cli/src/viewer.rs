@@ -25,14 +25,14 @@ impl ViewerArgs {
     /// and drops the drawings when neither option is given, so that no
     /// frames are kept for nothing.
     pub fn prepare(self, cases: &mut [Case]) -> Result<()> {
-        if self.gif && cases.iter().all(|c| c.drawing.is_none()) {
+        if self.gif && cases.iter().all(|c| c.example.drawing.is_none()) {
             anyhow::bail!(
                 "--gif: this model has no drawing (models in independent angles have none; their Cartesian twins do)"
             );
         }
         if !self.html && !self.gif {
             for case in cases {
-                case.drawing = None;
+                case.example.drawing = None;
             }
         }
         Ok(())
@@ -44,7 +44,7 @@ impl ViewerArgs {
             write_html(dir, title, cases, results)?;
         }
         if self.gif {
-            let drawn = cases.iter().zip(results).find_map(|(c, r)| Some((c.drawing.as_ref()?, &r.frames)));
+            let drawn = cases.iter().zip(results).find_map(|(c, r)| Some((c.example.drawing.as_ref()?, &r.frames)));
             if let Some((drawing, frames)) = drawn.filter(|(_, f)| !f.is_empty()) {
                 crate::gif::write(&dir.join(GIF), drawing, frames)?;
             }
@@ -80,7 +80,7 @@ pub fn write_html(dir: &Path, title: &str, cases: &[Case], results: &[CaseResult
 
 /// The page's text.
 pub fn page(title: &str, cases: &[Case], results: &[CaseResult], info: &Value) -> Result<String> {
-    let drawing = cases.iter().find_map(|c| c.drawing.as_ref());
+    let drawing = cases.iter().find_map(|c| c.example.drawing.as_ref());
     let runs = cases.iter().zip(results).map(|(case, result)| run(case, result)).collect::<Result<Vec<_>>>()?;
     let data = json!({
         "title": title,

@@ -22,13 +22,19 @@ fn page(dir: &Path) -> (String, Value) {
     (text.clone(), serde_json::from_str(&text[start..end]).unwrap())
 }
 
+/// Runs `cdyn command scenario --out out extra…`, which must succeed, and
+/// returns the page it wrote.
+fn viewed(command: &str, scenario: &Path, out: &Path, extra: &[&str]) -> (String, Value) {
+    let r = cdyn(&[&[command, path_str(scenario), "--out", path_str(out)], extra].concat());
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    page(out)
+}
+
 #[test]
 fn run_html_and_gif_of_a_mechanism() {
     let out = tempfile::tempdir().unwrap();
     let four_bar = examples().join("four_bar.toml");
-    let r = cdyn(&["run", path_str(&four_bar), "--out", path_str(out.path()), "--html", "--gif"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (text, data) = page(out.path());
+    let (text, data) = viewed("run", &four_bar, out.path(), &["--html", "--gif"]);
     // Self-contained: a policy that forbids fetching anything, and no address to fetch.
     assert!(text.contains("default-src 'none'"));
     assert!(!text.contains("http:") && !text.contains("https:") && !text.contains("src="), "the page names an address");
@@ -68,9 +74,7 @@ fn long_runs_are_decimated_and_say_so() {
     assert!(text.contains("every = 5"));
     let (dir, path) = scenario("four_bar_every_step.toml", &text.replace("every = 5", "every = 1"));
     let out = dir.join("out");
-    let r = cdyn(&["run", path_str(&path), "--out", path_str(&out), "--html"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (_, data) = page(&out);
+    let (_, data) = viewed("run", &path, &out, &["--html"]);
     let frames = &data["cases"][0]["frames"];
     let (n, stride) = (frames["t"].as_array().unwrap().len(), frames["stride"].as_u64().unwrap());
     // 3001 samples: every other one, plus the end state.
@@ -84,9 +88,7 @@ fn long_runs_are_decimated_and_say_so() {
 fn compare_html_has_every_case_and_draws_a_built_in() {
     let out = tempfile::tempdir().unwrap();
     let dp = examples().join("double_pendulum.toml");
-    let r = cdyn(&["compare", path_str(&dp), "--out", path_str(out.path()), "--html"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (_, data) = page(out.path());
+    let (_, data) = viewed("compare", &dp, out.path(), &["--html"]);
     let summary: Value =
         serde_json::from_str(&std::fs::read_to_string(out.path().join("summary.json")).unwrap()).unwrap();
     let names = |cases: &Value| -> Vec<String> {
@@ -109,9 +111,7 @@ fn compare_html_has_every_case_and_draws_a_built_in() {
 fn the_cartesian_pendulum_is_drawn_as_a_bob_on_a_rod() {
     let out = tempfile::tempdir().unwrap();
     let pendulum = examples().join("cvsgf_energy.toml");
-    let r = cdyn(&["run", path_str(&pendulum), "--out", path_str(out.path()), "--html", "--gif"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (_, data) = page(out.path());
+    let (_, data) = viewed("run", &pendulum, out.path(), &["--html", "--gif"]);
     let drawing = &data["drawing"];
     assert_eq!(drawing["bodies"][0]["name"], "bob");
     assert_eq!((drawing["bodies"][0]["x"].as_u64(), drawing["bodies"].as_array().unwrap().len()), (Some(0), 1));
@@ -131,9 +131,7 @@ fn the_cartesian_pendulum_is_drawn_as_a_bob_on_a_rod() {
 fn a_model_in_angles_plots_only_and_refuses_a_gif() {
     let out = tempfile::tempdir().unwrap();
     let angles = examples().join("double_pendulum_angles.toml");
-    let r = cdyn(&["run", path_str(&angles), "--out", path_str(out.path()), "--html"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (text, data) = page(out.path());
+    let (text, data) = viewed("run", &angles, out.path(), &["--html"]);
     assert!(data["drawing"].is_null() && text.contains("has no drawing"));
     assert!(data["cases"][0]["frames"]["t"].as_array().unwrap().is_empty());
     assert!(!data["cases"][0]["series"]["phi"].as_array().unwrap().is_empty());
