@@ -5,7 +5,7 @@ use crate::constraint::ConstraintBuffers;
 use crate::energy;
 pub use crate::linalg::{Breakdown, DependentRows, LinearSolver, SPARSE_FROM};
 use crate::linalg::{DenseLdl, Schur};
-use crate::mass::{DenseMass, MassAt, MassMatrix};
+use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassAt, MassMatrix};
 use crate::model::Model;
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
@@ -32,6 +32,108 @@ enum Solver {
     Constant(Schur),
     /// `M(q)`: evaluated, factored and used densely.
     General(Box<General>),
+    /// A block-diagonal `M(q)`: factored block by block, `S` sparse.
+    Blocks(Box<Blocks>),
+}
+
+/// The workspace of a block-diagonal `M(q)` ([`BlockMass`]), allocated once.
+///
+/// With `M_b = L_b L_bᵀ` on each block, `S = Φ_q M⁻¹ Φ_qᵀ = J̃ W J̃ᵀ`, where
+/// `J̃` is `Φ_q` with each row's entries on a block multiplied by `L_b⁻ᵀ`
+/// and `W` is `M⁻¹` outside the blocks and 1 on them. Since a row that
+/// reads a block reads all of it (the model checks), `J̃` and `M⁻¹ Φ_qᵀ`
+/// keep the pattern of `Φ_q`, and `S` is assembled and factored by the
+/// same sparse [`Schur`] as for a constant `M`.
+struct Blocks {
+    mass: BlockMass,
+    /// `Ψ_q = ∇V + ∂T/∂q` (`∂T/∂q` first, while it is summed).
+    psi_q: Vec<f64>,
+    /// `Ṁ q̇`
+    mdot_v: Vec<f64>,
+    /// `J̃`, in the pattern's order.
+    scaled: Vec<f64>,
+    /// `M⁻¹ Φ_qᵀ`, entry by entry in the pattern's order.
+    weighted: Vec<f64>,
+    /// The Jacobian entries outside every block, with their coordinate.
+    plain: Vec<(u32, u32)>,
+    /// Each row's run of entries on one block: the block, and where its
+    /// entries (in the block's coordinate order) start in `entries`.
+    segments: Vec<(u32, u32)>,
+    entries: Vec<u32>,
+    schur: Schur,
+}
+
+impl Blocks {
+    fn new(model: &Model, blocks: &[Vec<u32>], solver: LinearSolver) -> Self {
+        let (n, pattern) = (model.n(), model.pattern());
+        let mut owner = vec![(u32::MAX, 0u32); n];
+        for (b, coords) in blocks.iter().enumerate() {
+            for (i, &c) in coords.iter().enumerate() {
+                owner[c as usize] = (b as u32, i as u32);
+            }
+        }
+        let diagonal = model.diagonal_mass();
+        let (mut plain, mut segments, mut entries) = (Vec::new(), Vec::new(), Vec::new());
+        for r in 0..model.m() {
+            let first_segment = segments.len();
+            for j in pattern.row(r) {
+                let c = pattern.cols[j];
+                let (b, i) = owner[c as usize];
+                if b == u32::MAX {
+                    plain.push((j as u32, c));
+                    continue;
+                }
+                let at = match segments[first_segment..].iter().find(|&&(sb, _)| sb == b) {
+                    Some(&(_, at)) => at,
+                    None => {
+                        let at = entries.len() as u32;
+                        segments.push((b, at));
+                        entries.resize(entries.len() + blocks[b as usize].len(), 0);
+                        at
+                    }
+                };
+                entries[(at + i) as usize] = j as u32;
+            }
+        }
+        // `S`'s weights: `M⁻¹` outside the blocks, 1 on them (in `J̃`).
+        let weights: Vec<f64> =
+            owner.iter().zip(diagonal).map(|(&(b, _), &m)| if b == u32::MAX { m } else { 1.0 }).collect();
+        let weights = DiagonalMass::new(weights).expect("positive masses outside the blocks (checked by the model)");
+        let nnz = pattern.nnz();
+        Self {
+            mass: BlockMass::new(diagonal, blocks),
+            psi_q: vec![0.0; n],
+            mdot_v: vec![0.0; n],
+            scaled: vec![0.0; nnz],
+            weighted: vec![0.0; nnz],
+            plain,
+            segments,
+            entries,
+            schur: Schur::new(pattern, &weights, solver),
+        }
+    }
+
+    /// `J̃` and `M⁻¹ Φ_qᵀ` from `Φ_q`, then `S` factored and `b` solved in place.
+    fn factor_and_solve(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        let inverse = self.mass.inverse();
+        for &(j, c) in &self.plain {
+            let (j, c) = (j as usize, c as usize);
+            self.scaled[j] = jac[j];
+            self.weighted[j] = jac[j] * inverse[c];
+        }
+        let mut x = [0.0; MAX_BLOCK];
+        for &(block, at) in &self.segments {
+            let (block, at) = (block as usize, at as usize);
+            let idx = &self.entries[at..at + self.mass.coordinates(block).len()];
+            let x = &mut x[..idx.len()];
+            idx.iter().zip(x.iter_mut()).for_each(|(&j, x)| *x = jac[j as usize]);
+            self.mass.forward(block, x);
+            idx.iter().zip(x.iter()).for_each(|(&j, x)| self.scaled[j as usize] = *x);
+            self.mass.backward(block, x);
+            idx.iter().zip(x.iter()).for_each(|(&j, x)| self.weighted[j as usize] = *x);
+        }
+        self.schur.factor_and_solve(&self.scaled, b)
+    }
 }
 
 /// The workspace of a configuration-dependent `M(q)`, allocated once.
@@ -83,19 +185,32 @@ impl General {
     }
 }
 
+/// Lagrange's velocity terms join `G`: `M q̈ = G + ∂T/∂q − Ṁ q̇` (see
+/// `kinetic.rs`); `∂T/∂q` becomes `Ψ_q = ∇V + ∂T/∂q`.
+fn lagrange_terms(force: &mut [f64], psi_q: &mut [f64], mdot_v: &[f64], grad_potential: &[f64]) {
+    for (((f, dt), mv), gv) in force.iter_mut().zip(psi_q).zip(mdot_v).zip(grad_potential) {
+        *f += *dt - mv;
+        *dt += gv;
+    }
+}
+
 impl Dynamics {
     /// A workspace for `model`, factoring `Φ_q M⁻¹ Φ_qᵀ` dense or sparse by its size.
     pub fn new(model: &Model) -> Self {
         Self::with_solver(model, LinearSolver::Auto)
     }
 
-    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ` (for a constant `M`;
-    /// with `M(q)` it is dense).
+    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ`. A block-diagonal
+    /// `M(q)` (see [`Model::mass_blocks`]) is factored by blocks unless the
+    /// solver is [`LinearSolver::Dense`]; any other `M(q)` is dense.
     pub fn with_solver(model: &Model, solver: LinearSolver) -> Self {
         let (n, m) = (model.n(), model.m());
-        let solver = match model.mass() {
-            Some(mass) => Solver::Constant(Schur::new(model.pattern(), mass, solver)),
-            None => Solver::General(Box::new(General {
+        let solver = match (model.mass(), model.mass_blocks()) {
+            (Some(mass), _) => Solver::Constant(Schur::new(model.pattern(), mass, solver)),
+            (None, Some(blocks)) if solver != LinearSolver::Dense => {
+                Solver::Blocks(Box::new(Blocks::new(model, blocks, solver)))
+            }
+            (None, _) => Solver::General(Box::new(General {
                 mass: DenseMass::new(n),
                 psi_q: vec![0.0; n],
                 mdot_v: vec![0.0; n],
@@ -122,6 +237,7 @@ impl Dynamics {
         match &mut self.solver {
             Solver::Constant(schur) => schur.set_dependent_rows(dependent),
             Solver::General(g) => g.schur.set_dependent_rows(dependent),
+            Solver::Blocks(b) => b.schur.set_dependent_rows(dependent),
         }
     }
 
@@ -130,6 +246,7 @@ impl Dynamics {
         match &self.solver {
             Solver::Constant(schur) => schur.dependent_rows(),
             Solver::General(g) => g.schur.dependent_rows(),
+            Solver::Blocks(b) => b.schur.dependent_rows(),
         }
     }
 
@@ -149,14 +266,15 @@ impl Dynamics {
                 g.psi_q.fill(0.0);
                 g.mdot_v.fill(0.0);
                 model.mass_at(q, v, &mut g.mass, &mut g.psi_q, &mut g.mdot_v).map_err(Breakdown::Mass)?;
-                // Lagrange's velocity terms join G: M q̈ = G + ∂T/∂q − Ṁ q̇ (see `kinetic.rs`).
-                for (((f, dt), mv), gv) in
-                    self.force.iter_mut().zip(&mut g.psi_q).zip(&g.mdot_v).zip(&self.grad_potential)
-                {
-                    *f += *dt - mv;
-                    *dt += gv;
-                }
+                lagrange_terms(&mut self.force, &mut g.psi_q, &g.mdot_v, &self.grad_potential);
                 g.mass.solve(&self.force, &mut self.acc);
+            }
+            (Solver::Blocks(b), _) => {
+                b.psi_q.fill(0.0);
+                b.mdot_v.fill(0.0);
+                model.block_mass_at(q, v, &mut b.mass, &mut b.psi_q, &mut b.mdot_v).map_err(Breakdown::Mass)?;
+                lagrange_terms(&mut self.force, &mut b.psi_q, &b.mdot_v, &self.grad_potential);
+                b.mass.solve(&self.force, &mut self.acc);
             }
             (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
         }
@@ -168,6 +286,7 @@ impl Dynamics {
         match &mut self.solver {
             Solver::Constant(schur) => schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
             Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
+            Solver::Blocks(b) => b.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
         }
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
         let mut acc = std::mem::take(&mut self.acc);
@@ -184,6 +303,7 @@ impl Dynamics {
         match &self.solver {
             Solver::Constant(schur) => schur.solve(b),
             Solver::General(g) => g.schur.solve(b),
+            Solver::Blocks(blocks) => blocks.schur.solve(b),
         }
         self.add_weighted_jt(model, b, -1.0, out);
     }
@@ -193,6 +313,7 @@ impl Dynamics {
     pub fn mass<'a>(&'a self, model: &'a Model) -> MassAt<'a> {
         match (&self.solver, model.mass()) {
             (Solver::General(g), _) => MassAt::Dense(&g.mass),
+            (Solver::Blocks(b), _) => MassAt::Blocks(&b.mass),
             (Solver::Constant(_), Some(mass)) => MassAt::Diagonal(mass),
             (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
         }
@@ -203,6 +324,7 @@ impl Dynamics {
         match &self.solver {
             Solver::Constant(_) => &self.grad_potential,
             Solver::General(g) => &g.psi_q,
+            Solver::Blocks(b) => &b.psi_q,
         }
     }
 
@@ -211,27 +333,23 @@ impl Dynamics {
     /// take up to three such products per evaluation, and the checks were
     /// half their cost on a chain of 1 000 bodies.
     pub fn add_weighted_jt(&self, model: &Model, y: &[f64], scale: f64, out: &mut [f64]) {
-        let weight = match (&self.solver, model.mass()) {
-            (Solver::Constant(_), Some(mass)) => mass.inverse(),
-            (Solver::General(g), _) => return g.add_weighted_jt(model.n(), y, scale, out),
-            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
-        };
-        let (pattern, jac) = (model.pattern(), &self.constraints.jac);
-        assert!(y.len() == model.m() && out.len() == model.n(), "vectors of the wrong length");
-        assert!(jac.len() == pattern.cols.len(), "a Jacobian of another model");
-        // SAFETY: a model's pattern is built by `ModelBuilder::build` from
-        // checked coordinates (< n) with `start` rising from 0 to
-        // `cols.len()`, and it cannot be changed afterwards; `weight` has n
-        // entries, `jac` as many as `cols`, `y` and `start` m (+ 1).
-        unsafe {
-            for (r, &yr) in y.iter().enumerate() {
-                let s = scale * yr;
-                let (a, b) = (*pattern.start.get_unchecked(r) as usize, *pattern.start.get_unchecked(r + 1) as usize);
-                for j in a..b {
-                    let c = *pattern.cols.get_unchecked(j) as usize;
-                    *out.get_unchecked_mut(c) += s * weight.get_unchecked(c) * jac.get_unchecked(j);
-                }
+        let jac = &self.constraints.jac;
+        match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => {
+                let weight = mass.inverse();
+                assert!(weight.len() == model.n(), "a mass of another model");
+                // SAFETY: `scatter` passes entries `j` < nnz = `jac.len()` and coordinates `c` < n.
+                scatter(model, jac, scale, [y], [out], |s, j, c| unsafe {
+                    s * weight.get_unchecked(c) * jac.get_unchecked(j)
+                })
             }
+            (Solver::Blocks(b), _) => {
+                let weighted = &b.weighted;
+                // SAFETY: as above; `weighted` has an entry per Jacobian entry.
+                scatter(model, weighted, scale, [y], [out], |s, j, _| unsafe { s * weighted.get_unchecked(j) })
+            }
+            (Solver::General(g), _) => g.add_weighted_jt(model.n(), y, scale, out),
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
         }
     }
 
@@ -239,30 +357,26 @@ impl Dynamics {
     /// (the coupled control terms' two products), each with the arithmetic of
     /// [`add_weighted_jt`](Self::add_weighted_jt) at scale −1.
     pub fn add_weighted_jt_pair(&self, model: &Model, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
-        let weight = match (&self.solver, model.mass()) {
-            (Solver::Constant(_), Some(mass)) => mass.inverse(),
+        let jac = &self.constraints.jac;
+        match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => {
+                let weight = mass.inverse();
+                assert!(weight.len() == model.n(), "a mass of another model");
+                // SAFETY: as in `add_weighted_jt`.
+                scatter(model, jac, -1.0, [y0, y1], [out0, out1], |s, j, c| unsafe {
+                    s * weight.get_unchecked(c) * jac.get_unchecked(j)
+                })
+            }
+            (Solver::Blocks(b), _) => {
+                let weighted = &b.weighted;
+                // SAFETY: as in `add_weighted_jt`.
+                scatter(model, weighted, -1.0, [y0, y1], [out0, out1], |s, j, _| unsafe { s * weighted.get_unchecked(j) })
+            }
             (Solver::General(g), _) => {
                 g.add_weighted_jt(model.n(), y0, -1.0, out0);
-                return g.add_weighted_jt(model.n(), y1, -1.0, out1);
+                g.add_weighted_jt(model.n(), y1, -1.0, out1)
             }
             (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
-        };
-        let (pattern, jac) = (model.pattern(), &self.constraints.jac);
-        assert!(y0.len() == model.m() && y1.len() == model.m(), "vectors of the wrong length");
-        assert!(out0.len() == model.n() && out1.len() == model.n(), "vectors of the wrong length");
-        assert!(jac.len() == pattern.cols.len(), "a Jacobian of another model");
-        // SAFETY: as in `add_weighted_jt`.
-        unsafe {
-            for r in 0..y0.len() {
-                let (s0, s1) = (-*y0.get_unchecked(r), -*y1.get_unchecked(r));
-                let (a, b) = (*pattern.start.get_unchecked(r) as usize, *pattern.start.get_unchecked(r + 1) as usize);
-                for j in a..b {
-                    let c = *pattern.cols.get_unchecked(j) as usize;
-                    let (wc, jv) = (*weight.get_unchecked(c), *jac.get_unchecked(j));
-                    *out0.get_unchecked_mut(c) += s0 * wc * jv;
-                    *out1.get_unchecked_mut(c) += s1 * wc * jv;
-                }
-            }
         }
     }
 
@@ -289,6 +403,7 @@ impl Dynamics {
         match &self.solver {
             Solver::Constant(schur) => schur.solve_many(bs),
             Solver::General(g) => bs.iter_mut().for_each(|b| g.schur.solve(b)),
+            Solver::Blocks(b) => b.schur.solve_many(bs),
         }
     }
 
@@ -341,5 +456,41 @@ impl Dynamics {
     /// `A = M⁻¹ (G − Φ_qᵀ λ)` of Eq. 8.
     pub fn acc(&self) -> &[f64] {
         &self.acc
+    }
+}
+
+/// `out[k]_c += term(s, j, c)` over every Jacobian entry `j` (coordinate
+/// `c`) of every row `r`, with `s = scale · y[k]_r`: the loop of
+/// `add_weighted_jt` (one vector) and of its pair (scale −1), without
+/// bounds checks. `values`, the per-entry array `term` reads, is checked
+/// for its length here.
+#[inline(always)]
+fn scatter<const K: usize>(
+    model: &Model,
+    values: &[f64],
+    scale: f64,
+    y: [&[f64]; K],
+    out: [&mut [f64]; K],
+    term: impl Fn(f64, usize, usize) -> f64,
+) {
+    let pattern = model.pattern();
+    let (m, n) = (model.m(), model.n());
+    assert!(y.iter().all(|y| y.len() == m) && out.iter().all(|o| o.len() == n), "vectors of the wrong length");
+    assert!(values.len() == pattern.cols.len(), "a Jacobian of another model");
+    // SAFETY: a model's pattern is built by `ModelBuilder::build` from
+    // checked coordinates (< n) with `start` rising from 0 to
+    // `cols.len()`, and it cannot be changed afterwards; `y` and `start`
+    // have m (+ 1) entries, `out` n.
+    unsafe {
+        for r in 0..m {
+            let s: [f64; K] = std::array::from_fn(|k| scale * *y[k].get_unchecked(r));
+            let (a, b) = (*pattern.start.get_unchecked(r) as usize, *pattern.start.get_unchecked(r + 1) as usize);
+            for j in a..b {
+                let c = *pattern.cols.get_unchecked(j) as usize;
+                for k in 0..K {
+                    *out[k].get_unchecked_mut(c) += term(s[k], j, c);
+                }
+            }
+        }
     }
 }

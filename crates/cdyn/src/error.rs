@@ -332,6 +332,24 @@ pub enum Problem {
         /// Crank, coupler, rocker and ground lengths.
         lengths: [f64; 4],
     },
+    /// A spatial body's orientation that is not a unit quaternion.
+    #[error("orientation has length {norm}: Euler parameters must be a unit quaternion (within 1e-6)")]
+    NotUnitQuaternion {
+        /// Its length.
+        norm: f64,
+    },
+    /// A spatial body's inertia tensor that is not physical.
+    #[error("inertia {reason}")]
+    Inertia {
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A joint axis of zero (or non-finite) length.
+    #[error("{name} has zero length")]
+    ZeroAxis {
+        /// The axis's name (`axis`, `axis_b`).
+        name: &'static str,
+    },
     /// Positions that are not finite.
     #[error("the positions are not finite")]
     NonFinitePositions,

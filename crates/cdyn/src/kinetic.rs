@@ -72,6 +72,16 @@ pub(crate) trait KineticBlock: Send + Sync {
     /// Adds `M(q)` into the row-major `n × n` matrix `mass`, `∂T/∂q` into
     /// `grad_q` and `Ṁ q̇` into `mdot_v`; returns `T`.
     fn add_all(&self, q: &[f64], v: &[f64], mass: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64;
+    /// As [`add_all`](Self::add_all), but each element's `M_e` is written
+    /// (not added) to its own `K × K` block of `blocks`, one after another:
+    /// the layout of a [`BlockMass`](crate::mass::BlockMass).
+    fn add_blocks(&self, q: &[f64], v: &[f64], blocks: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64;
+    /// Number of elements.
+    fn items(&self) -> usize;
+    /// Coordinates each element reads (`K`).
+    fn width(&self) -> usize;
+    /// The coordinates each element reads, element after element (`K` each).
+    fn coordinates(&self) -> Vec<Vec<u32>>;
     /// `T`, adding `∂T/∂q` into `grad_q` when given.
     fn energy(&self, q: &[f64], v: &[f64], grad_q: Option<&mut [f64]>) -> f64;
     fn as_any_mut(&mut self) -> &mut dyn Any;
@@ -97,6 +107,32 @@ impl<T: Kinetic<K>, const K: usize> KineticBlock for KineticGroup<T, K> {
             }
         }
         total
+    }
+
+    fn add_blocks(&self, q: &[f64], v: &[f64], blocks: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64 {
+        let mut total = 0.0;
+        for ((t, idx), block) in self.items.iter().zip(blocks.chunks_exact_mut(K * K)) {
+            let l = local(t, idx.map(|i| q[i]), idx.map(|i| v[i]));
+            total += l.energy;
+            for a in 0..K {
+                grad_q[idx[a]] += l.grad_q[a];
+                mdot_v[idx[a]] += l.mdot_v[a];
+                block[a * K..(a + 1) * K].copy_from_slice(&l.mass[a]);
+            }
+        }
+        total
+    }
+
+    fn items(&self) -> usize {
+        self.items.len()
+    }
+
+    fn width(&self) -> usize {
+        K
+    }
+
+    fn coordinates(&self) -> Vec<Vec<u32>> {
+        self.items.iter().map(|(_, idx)| idx.iter().map(|&i| i as u32).collect()).collect()
     }
 
     fn energy(&self, q: &[f64], v: &[f64], grad_q: Option<&mut [f64]>) -> f64 {

@@ -29,6 +29,7 @@ pub mod reference;
 pub mod scalar;
 pub mod simulate;
 pub mod small;
+pub mod spatial;
 mod sparse;
 pub mod system;
 pub mod timefn;

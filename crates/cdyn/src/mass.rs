@@ -251,6 +251,214 @@ impl MassMatrix for DenseMass {
     }
 }
 
+/// The largest kinetic element a [`BlockMass`] keeps as a block; a model
+/// with a wider one is factored densely.
+pub const MAX_BLOCK: usize = 8;
+
+/// A block-diagonal `M(q)`: a constant diagonal on most coordinates, and
+/// small dense blocks, each the mass of one kinetic element, on disjoint
+/// sets of coordinates (the Euler parameters of a spatial body, a 4 × 4
+/// block `4 Gᵀ J′ G + k p pᵀ`). Each block is factored on its own, so the
+/// cost is linear in the number of bodies where a dense `M(q)` is cubic.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockMass {
+    /// `M_cc` of the coordinates outside every block (0 inside one).
+    diagonal: Vec<f64>,
+    /// `1 / M_cc` outside the blocks (0 inside one).
+    inverse: Vec<f64>,
+    /// Block `b`'s coordinates are `coords[start[b]..start[b + 1]]`.
+    start: Vec<u32>,
+    coords: Vec<u32>,
+    /// Block `b`'s `k × k` matrix, row-major, from `values_start(b)`.
+    matrix: Vec<f64>,
+    /// Its Cholesky factor `L`, row-major lower triangle.
+    factor: Vec<f64>,
+    /// Where each block's matrix starts in `matrix` and `factor`.
+    at: Vec<u32>,
+}
+
+impl BlockMass {
+    /// `diagonal` on the coordinates outside `blocks` (each a list of
+    /// coordinates, pairwise disjoint, at most [`MAX_BLOCK`] long).
+    pub(crate) fn new(diagonal: &[f64], blocks: &[Vec<u32>]) -> Self {
+        let mut start = vec![0u32];
+        let mut coords = Vec::new();
+        let mut at = vec![0u32];
+        let mut inside = vec![false; diagonal.len()];
+        for b in blocks {
+            debug_assert!(b.len() <= MAX_BLOCK);
+            coords.extend_from_slice(b);
+            start.push(coords.len() as u32);
+            at.push(at.last().unwrap() + (b.len() * b.len()) as u32);
+            b.iter().for_each(|&c| inside[c as usize] = true);
+        }
+        let plain = |c: usize, x: f64| if inside[c] { 0.0 } else { x };
+        let len = *at.last().unwrap() as usize;
+        Self {
+            diagonal: diagonal.iter().enumerate().map(|(c, &m)| plain(c, m)).collect(),
+            inverse: diagonal.iter().enumerate().map(|(c, &m)| plain(c, 1.0 / m)).collect(),
+            start,
+            coords,
+            matrix: vec![0.0; len],
+            factor: vec![0.0; len],
+            at,
+        }
+    }
+
+    /// Number of blocks.
+    pub fn blocks(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Block `b`'s coordinates.
+    #[inline(always)]
+    pub fn coordinates(&self, b: usize) -> &[u32] {
+        &self.coords[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+
+    /// The diagonal of `M⁻¹` outside the blocks (0 on block coordinates).
+    #[inline(always)]
+    pub fn inverse(&self) -> &[f64] {
+        &self.inverse
+    }
+
+    /// All blocks' matrices, one after another (each `k × k`, row-major),
+    /// to be filled before [`factor`](Self::factor).
+    pub(crate) fn matrices_mut(&mut self) -> &mut [f64] {
+        &mut self.matrix
+    }
+
+    /// Adds `x` to entry `(i, i)` of block `b`'s matrix.
+    pub(crate) fn add_to_diagonal(&mut self, b: usize, i: usize, x: f64) {
+        let k = self.coordinates(b).len();
+        self.matrix[self.at[b] as usize + i * k + i] += x;
+    }
+
+    /// Block `b`'s width and matrix.
+    #[inline(always)]
+    fn block(&self, b: usize) -> (usize, &[u32], &[f64]) {
+        let coords = self.coordinates(b);
+        let k = coords.len();
+        (k, coords, &self.matrix[self.at[b] as usize..self.at[b] as usize + k * k])
+    }
+
+    /// Factors every block, `M_b = L_b L_bᵀ`. `Err(c)` names the first
+    /// coordinate whose pivot is not positive (or not finite).
+    pub fn factor(&mut self) -> std::result::Result<(), usize> {
+        for b in 0..self.blocks() {
+            let (s, e) = (self.start[b] as usize, self.start[b + 1] as usize);
+            let (k, at) = (e - s, self.at[b] as usize);
+            let (a, l) = (&self.matrix[at..at + k * k], &mut self.factor[at..at + k * k]);
+            for j in 0..k {
+                let d = a[j * k + j] - (0..j).map(|i| l[j * k + i] * l[j * k + i]).sum::<f64>();
+                // Relative to the diagonal entry, as for a dense `M`.
+                if d.is_nan() || d <= 1e-14 * a[j * k + j].abs() || !d.is_finite() {
+                    return Err(self.coords[s + j] as usize);
+                }
+                let d = d.sqrt();
+                l[j * k + j] = d;
+                for i in j + 1..k {
+                    let s = a[i * k + j] - (0..j).map(|c| l[i * k + c] * l[j * k + c]).sum::<f64>();
+                    l[i * k + j] = s / d;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `x ← L_b⁻¹ x` (forward substitution with block `b`'s factor).
+    #[inline(always)]
+    pub(crate) fn forward(&self, b: usize, x: &mut [f64]) {
+        let (k, at) = (x.len(), self.at[b] as usize);
+        let l = &self.factor[at..at + k * k];
+        for i in 0..k {
+            let s: f64 = (0..i).map(|c| l[i * k + c] * x[c]).sum();
+            x[i] = (x[i] - s) / l[i * k + i];
+        }
+    }
+
+    /// `x ← L_b⁻ᵀ x` (backward substitution with block `b`'s factor).
+    #[inline(always)]
+    pub(crate) fn backward(&self, b: usize, x: &mut [f64]) {
+        let (k, at) = (x.len(), self.at[b] as usize);
+        let l = &self.factor[at..at + k * k];
+        for i in (0..k).rev() {
+            let s: f64 = (i + 1..k).map(|c| l[c * k + i] * x[c]).sum();
+            x[i] = (x[i] - s) / l[i * k + i];
+        }
+    }
+
+    /// Calls `f(c, (M x)_c)` once for every coordinate `c` (every
+    /// coordinate outside the blocks has a positive mass: the model checks).
+    #[inline(always)]
+    fn each_product(&self, x: &[f64], mut f: impl FnMut(usize, f64)) {
+        for (c, (m, x)) in self.diagonal.iter().zip(x).enumerate() {
+            if *m != 0.0 {
+                f(c, m * x);
+            }
+        }
+        for b in 0..self.blocks() {
+            let (k, coords, a) = self.block(b);
+            for i in 0..k {
+                f(coords[i] as usize, (0..k).map(|j| a[i * k + j] * x[coords[j] as usize]).sum());
+            }
+        }
+    }
+}
+
+impl MassMatrix for BlockMass {
+    fn n(&self) -> usize {
+        self.diagonal.len()
+    }
+
+    fn mul(&self, x: &[f64], out: &mut [f64]) {
+        self.each_product(x, |c, y| out[c] = y);
+    }
+
+    fn solve(&self, x: &[f64], out: &mut [f64]) {
+        for ((o, w), x) in out.iter_mut().zip(&self.inverse).zip(x) {
+            *o = x * w;
+        }
+        let mut local = [0.0; MAX_BLOCK];
+        for b in 0..self.blocks() {
+            let coords = self.coordinates(b);
+            let y = &mut local[..coords.len()];
+            coords.iter().zip(y.iter_mut()).for_each(|(&c, y)| *y = x[c as usize]);
+            self.forward(b, y);
+            self.backward(b, y);
+            coords.iter().zip(y.iter()).for_each(|(&c, y)| out[c as usize] = *y);
+        }
+    }
+
+    fn kinetic(&self, v: &[f64]) -> f64 {
+        let mut sum = 0.0;
+        self.each_product(v, |c, y| sum += v[c] * y);
+        0.5 * sum
+    }
+
+    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
+        let mut sum = 0.0;
+        self.each_product(v, |_, y| sum += y * y);
+        sum
+    }
+
+    fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
+        let mut sum = init;
+        self.each_product(v, |c, y| sum += y * x(c) + extra(c));
+        sum
+    }
+
+    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        self.each_product(v, |c, y| out[c] += scale * y);
+    }
+
+    fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        for (o, v) in out.iter_mut().zip(v) {
+            *o += scale * v;
+        }
+    }
+}
+
 /// The mass matrix at one state: constant diagonal, or `M(q)` evaluated
 /// there. Each product matches once, outside its loops, so the diagonal
 /// kind runs its own loops unchanged.
@@ -260,6 +468,8 @@ pub enum MassAt<'a> {
     Diagonal(&'a DiagonalMass),
     /// `M(q)` at the state of the last evaluation.
     Dense(&'a DenseMass),
+    /// A block-diagonal `M(q)` at the state of the last evaluation.
+    Blocks(&'a BlockMass),
 }
 
 /// Forwards each product to the kind at hand.
@@ -268,6 +478,7 @@ macro_rules! either {
         match $self {
             MassAt::Diagonal($m) => $e,
             MassAt::Dense($m) => $e,
+            MassAt::Blocks($m) => $e,
         }
     };
 }

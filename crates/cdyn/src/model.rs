@@ -6,7 +6,7 @@ use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, Constraint
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
 use crate::kinetic::{Kinetic, KineticBlock, KineticGroup};
-use crate::mass::{DenseMass, DiagonalMass, MassMatrix};
+use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
@@ -32,6 +32,9 @@ enum Inertia {
         /// The diagonal part (zero where the elements give all the inertia).
         diagonal: Vec<f64>,
         kinetic: Vec<Box<dyn KineticBlock>>,
+        /// Each element's coordinates, when `M(q)` is block-diagonal (see
+        /// [`Model::mass_blocks`]); `None` when it must be factored densely.
+        blocks: Option<Vec<Vec<u32>>>,
     },
 }
 
@@ -166,7 +169,8 @@ impl ModelBuilder {
             for &m in &self.mass {
                 crate::error::non_negative("mass", m)?;
             }
-            Inertia::General { diagonal: self.mass, kinetic: self.kinetic }
+            let blocks = block_layout(&self.mass, &self.kinetic, &pattern);
+            Inertia::General { diagonal: self.mass, kinetic: self.kinetic, blocks }
         };
         check_rows(pattern.start.len() - 1, n)?;
         Ok(Model {
@@ -178,6 +182,48 @@ impl ModelBuilder {
             offsets,
         })
     }
+}
+
+/// The kinetic elements' coordinates when `M(q)` is block-diagonal in a
+/// way the sparse solver can use: the elements read disjoint sets of at
+/// most [`MAX_BLOCK`] coordinates, every other coordinate has a positive
+/// mass of its own, and a constraint row that reads a coordinate of a
+/// block reads all of them (so `M⁻¹ Φ_qᵀ` keeps the pattern of `Φ_qᵀ`). A
+/// spatial body's Euler parameters are such a block. `None` otherwise.
+fn block_layout(mass: &[f64], kinetic: &[Box<dyn KineticBlock>], pattern: &Pattern) -> Option<Vec<Vec<u32>>> {
+    let blocks: Vec<Vec<u32>> = kinetic.iter().flat_map(|b| b.coordinates()).collect();
+    let mut owner = vec![u32::MAX; mass.len()];
+    for (b, coords) in blocks.iter().enumerate() {
+        if coords.len() > MAX_BLOCK {
+            return None;
+        }
+        for &c in coords {
+            if owner[c as usize] != u32::MAX {
+                return None;
+            }
+            owner[c as usize] = b as u32;
+        }
+    }
+    if owner.iter().zip(mass).any(|(&o, &m)| o == u32::MAX && m <= 0.0) {
+        return None;
+    }
+    let mut seen = vec![0usize; blocks.len()];
+    for r in 0..pattern.start.len() - 1 {
+        let cols = &pattern.cols[pattern.row(r)];
+        for &c in cols {
+            if let Some(b) = owner.get(c as usize).filter(|&&o| o != u32::MAX) {
+                seen[*b as usize] += 1;
+            }
+        }
+        for &c in cols {
+            if let Some(&b) = owner.get(c as usize).filter(|&&o| o != u32::MAX) {
+                if std::mem::take(&mut seen[b as usize]) % blocks[b as usize].len() != 0 {
+                    return None;
+                }
+            }
+        }
+    }
+    Some(blocks)
 }
 
 /// Checks there are no more constraint rows `m` than coordinates `n`
@@ -246,7 +292,7 @@ impl Model {
                 }
                 energy = d.kinetic(v);
             }
-            Inertia::General { diagonal, kinetic } => {
+            Inertia::General { diagonal, kinetic, .. } => {
                 for (i, &mi) in diagonal.iter().enumerate() {
                     m[i * n + i] = mi;
                     energy += 0.5 * mi * v[i] * v[i];
@@ -259,6 +305,59 @@ impl Model {
         mass.factor()?;
         Ok(energy)
     }
+    /// The diagonal masses given to [`Model::builder`] (for a constant `M`, its diagonal).
+    pub fn diagonal_mass(&self) -> &[f64] {
+        match &self.inertia {
+            Inertia::Constant(mass) => mass.diagonal(),
+            Inertia::General { diagonal, .. } => diagonal,
+        }
+    }
+
+    /// The coordinates of each block of a block-diagonal `M(q)` (one per
+    /// kinetic element), or `None` when `M` is constant or must be
+    /// factored densely (see [`BlockMass`]).
+    pub fn mass_blocks(&self) -> Option<&[Vec<u32>]> {
+        match &self.inertia {
+            Inertia::General { blocks, .. } => blocks.as_deref(),
+            Inertia::Constant(_) => None,
+        }
+    }
+
+    /// As [`mass_at`](Self::mass_at), into the blocks of a
+    /// [`BlockMass`] laid out by [`mass_blocks`](Self::mass_blocks).
+    pub fn block_mass_at(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut BlockMass,
+        grad_q: &mut [f64],
+        mdot_v: &mut [f64],
+    ) -> std::result::Result<f64, usize> {
+        let Inertia::General { diagonal, kinetic, blocks: Some(_) } = &self.inertia else {
+            panic!("block_mass_at on a model without a block-diagonal M(q)");
+        };
+        let mut energy = 0.5 * diagonal.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>();
+        let mut rest = mass.matrices_mut();
+        for b in kinetic {
+            let k = b.width();
+            let (mine, others) = std::mem::take(&mut rest).split_at_mut(b.items() * k * k);
+            energy += b.add_blocks(q, v, mine, grad_q, mdot_v);
+            rest = others;
+        }
+        // A coordinate's own mass joins its block's diagonal.
+        for b in 0..mass.blocks() {
+            let k = mass.coordinates(b).len();
+            for i in 0..k {
+                let c = mass.coordinates(b)[i] as usize;
+                if diagonal[c] != 0.0 {
+                    mass.add_to_diagonal(b, i, diagonal[c]);
+                }
+            }
+        }
+        mass.factor()?;
+        Ok(energy)
+    }
+
     /// Which coordinates each constraint row of `Φ_q` reads.
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
@@ -314,7 +413,7 @@ impl Model {
     pub fn kinetic_and_gradient(&self, q: &[f64], v: &[f64], mut grad_q: Option<&mut [f64]>) -> f64 {
         match &self.inertia {
             Inertia::Constant(mass) => mass.kinetic(v),
-            Inertia::General { diagonal, kinetic } => {
+            Inertia::General { diagonal, kinetic, .. } => {
                 let own = 0.5 * diagonal.iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>();
                 own + kinetic.iter().map(|b| b.energy(q, v, grad_q.as_deref_mut())).sum::<f64>()
             }

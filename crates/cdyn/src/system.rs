@@ -183,6 +183,9 @@ impl Rhs for ControlledSystem<'_> {
                 MassAt::Dense(mass) => {
                     self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
                 }
+                MassAt::Blocks(mass) => {
+                    self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
+                }
             }
         }
         Ok(())

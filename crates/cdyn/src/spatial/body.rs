@@ -1,0 +1,114 @@
+//! A spatial rigid body: what the user gives, checked, and its rotational
+//! kinetic energy as a kinetic element of its Euler parameters.
+
+use super::rotation::body_rate;
+use crate::error::{Problem, Result, positive};
+use crate::kinetic::Kinetic;
+use crate::scalar::Scalar;
+
+/// A rigid body as the user describes it, at the initial instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Its name, for error messages and output.
+    pub name: String,
+    /// Mass.
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass, in body axes (symmetric
+    /// positive definite, and physical: each principal moment at most the
+    /// sum of the other two).
+    pub inertia: [[f64; 3]; 3],
+    /// Centre of mass in space.
+    pub position: [f64; 3],
+    /// Euler parameters of the body axes (scalar first). A unit quaternion
+    /// to round-off (within 1e-6 of unit length, then normalized); any
+    /// other length is refused rather than guessed at.
+    pub orientation: [f64; 4],
+    /// Velocity of the centre of mass.
+    pub velocity: [f64; 3],
+    /// Angular velocity, in body axes.
+    pub angular_velocity: [f64; 3],
+}
+
+impl Body {
+    /// A body at rest at the origin, with principal moments `inertia`.
+    pub fn new(name: &str, mass: f64, inertia: [f64; 3]) -> Self {
+        Self {
+            name: name.to_string(),
+            mass,
+            inertia: [[inertia[0], 0.0, 0.0], [0.0, inertia[1], 0.0], [0.0, 0.0, inertia[2]]],
+            position: [0.0; 3],
+            orientation: [1.0, 0.0, 0.0, 0.0],
+            velocity: [0.0; 3],
+            angular_velocity: [0.0; 3],
+        }
+    }
+
+    /// Checks the body; returns its unit orientation.
+    pub(crate) fn check(&self) -> Result<[f64; 4]> {
+        positive("mass", self.mass)?;
+        let finite = |x: &[f64]| x.iter().all(|x| x.is_finite());
+        let j = &self.inertia;
+        if !j.iter().all(|r| finite(r)) || (0..3).any(|a| (0..a).any(|b| (j[a][b] - j[b][a]).abs() > 1e-12 * (j[a][a] + j[b][b]).abs())) {
+            return Err(Problem::Inertia { reason: "must be finite and symmetric" }.into());
+        }
+        let moments = principal_moments(j);
+        if moments.iter().any(|&m| m <= 0.0) {
+            return Err(Problem::Inertia { reason: "must be positive definite" }.into());
+        }
+        let [a, b, c] = moments;
+        if c > (a + b) * (1.0 + 1e-12) {
+            return Err(Problem::Inertia { reason: "is not physical: a principal moment exceeds the sum of the other two" }.into());
+        }
+        for (name, x) in [("position", &self.position[..]), ("velocity", &self.velocity), ("angular_velocity", &self.angular_velocity)] {
+            if !finite(x) {
+                return Err(Problem::Parameter { name, value: f64::NAN, reason: "must be finite" }.into());
+            }
+        }
+        let norm = self.orientation.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !norm.is_finite() || (norm - 1.0).abs() > 1e-6 {
+            return Err(Problem::NotUnitQuaternion { norm }.into());
+        }
+        Ok(self.orientation.map(|x| x / norm))
+    }
+}
+
+/// The principal moments of a symmetric 3 × 3 tensor, ascending.
+fn principal_moments(j: &[[f64; 3]; 3]) -> [f64; 3] {
+    let m = nalgebra::Matrix3::from_fn(|a, b| j[a][b]);
+    let mut e: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+    e.sort_by(f64::total_cmp);
+    [e[0], e[1], e[2]]
+}
+
+/// The rotational kinetic energy of a body in its Euler parameters,
+/// `½ ω′ᵀ J′ ω′ + ½ k (pᵀṗ)²` with `ω′ = 2 G(p) ṗ` (see the module head).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rotation {
+    /// `J′`, in body axes.
+    pub inertia: [[f64; 3]; 3],
+    /// The weight of `(pᵀṗ)²`: `4 tr(J′)/3`, the mean of the block's other
+    /// eigenvalues `4 J_i`, so that the block is as well conditioned as the
+    /// inertia allows.
+    pub k: f64,
+}
+
+impl Rotation {
+    /// The element for inertia `J′`.
+    pub fn new(inertia: [[f64; 3]; 3]) -> Self {
+        Self { inertia, k: 4.0 * (inertia[0][0] + inertia[1][1] + inertia[2][2]) / 3.0 }
+    }
+}
+
+impl Kinetic<4> for Rotation {
+    fn energy<D: Scalar>(&self, p: [D; 4], pd: [D; 4]) -> D {
+        let w = body_rate(p, pd);
+        let j = &self.inertia;
+        let mut rot = D::zero();
+        for a in 0..3 {
+            let jw = w[0] * j[a][0] + w[1] * j[a][1] + w[2] * j[a][2];
+            rot += w[a] * jw;
+        }
+        let along = p[0] * pd[0] + p[1] * pd[1] + p[2] * pd[2] + p[3] * pd[3];
+        rot * 0.5 + along * along * (0.5 * self.k)
+    }
+}

@@ -1,0 +1,218 @@
+//! Joints between two spatial bodies, or a body and the ground, from
+//! Haug's primitive constraints, written once generic over the scalar:
+//!
+//! * spherical: the joint's point on each body coincides (3 rows);
+//! * dot-1: `(A_a u_a) · (A_b u_b) = 0` for body-fixed vectors;
+//! * dot-2: `(A_a u_a) · d = 0` with `d` from the point on `a` to that on `b`;
+//! * distance: `|d|² = L²`.
+//!
+//! | joint | rows | made of |
+//! |---|---|---|
+//! | spherical | 3 | spherical |
+//! | revolute | 5 | spherical, dot-1 (f_a, h_b), dot-1 (g_a, h_b) |
+//! | universal | 4 | spherical, dot-1 (h_a, h′_b) |
+//! | cylindrical | 4 | dot-1 (f_a, h_b), dot-1 (g_a, h_b), dot-2 (f_a), dot-2 (g_a) |
+//! | prismatic | 5 | cylindrical, dot-1 (f_a, g_b) |
+//! | fixed | 6 | spherical, dot-1 (f_a, g_b), dot-1 (g_a, h_b), dot-1 (h_a, f_b) |
+//! | distance | 1 | distance |
+//!
+//! where `(f, g, h)` is the joint's frame, `h` its axis, carried into each
+//! body at the initial pose (so every joint starts assembled).
+
+use super::rotation::rotate;
+use crate::constraint::Constraint;
+use crate::scalar::Scalar;
+
+/// What a joint allows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum JointKind {
+    /// Rotation about the point.
+    Spherical,
+    /// Rotation about the axis through the point.
+    Revolute,
+    /// Rotation about the axis on body `a` and about `axis_b` on body `b`
+    /// (perpendicular to the axis at the initial pose).
+    Universal {
+        /// The second axis, in space at the initial pose.
+        axis_b: [f64; 3],
+    },
+    /// Rotation about and sliding along the axis.
+    Cylindrical,
+    /// Sliding along the axis.
+    Prismatic,
+    /// No relative motion (a weld).
+    Fixed,
+    /// A massless rod from the point on `a` to `point_b` on `b`, keeping
+    /// their initial distance.
+    Distance {
+        /// The rod's end on body `b`, in space at the initial pose.
+        point_b: [f64; 3],
+    },
+}
+
+impl JointKind {
+    /// The constraint rows of the joint.
+    pub fn rows(&self) -> usize {
+        match self {
+            JointKind::Spherical => 3,
+            JointKind::Revolute | JointKind::Prismatic => 5,
+            JointKind::Universal { .. } | JointKind::Cylindrical => 4,
+            JointKind::Fixed => 6,
+            JointKind::Distance { .. } => 1,
+        }
+    }
+
+    /// Its name in messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            JointKind::Spherical => "spherical",
+            JointKind::Revolute => "revolute",
+            JointKind::Universal { .. } => "universal",
+            JointKind::Cylindrical => "cylindrical",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+            JointKind::Distance { .. } => "distance",
+        }
+    }
+}
+
+/// A joint as the user describes it, at the initial pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// What it allows.
+    pub kind: JointKind,
+    /// The first body (its index in the mechanism).
+    pub a: usize,
+    /// The second body, or `None` for the ground.
+    pub b: Option<usize>,
+    /// The joint's point, in space.
+    pub point: [f64; 3],
+    /// Its axis, in space (any length but zero; ignored by spherical and distance joints).
+    pub axis: [f64; 3],
+}
+
+/// A joint's frame on one side: point `s` and axes `(f, g, h)`, in the
+/// body's axes (relative to its centre of mass), or in space on the ground.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Frame {
+    pub s: [f64; 3],
+    pub axes: [[f64; 3]; 3],
+}
+
+/// One side of a joint at a state: a body's pose, or the ground.
+enum Side<'a, D> {
+    Body { r: [D; 3], p: [D; 4], frame: &'a Frame },
+    Ground(&'a Frame),
+}
+
+impl<D: Scalar> Side<'_, D> {
+    fn point(&self) -> [D; 3] {
+        match self {
+            Side::Body { r, p, frame } => {
+                let x = rotate(*p, frame.s.map(D::from));
+                std::array::from_fn(|i| r[i] + x[i])
+            }
+            Side::Ground(frame) => frame.s.map(D::from),
+        }
+    }
+    fn axis(&self, k: usize) -> [D; 3] {
+        match self {
+            Side::Body { p, frame, .. } => rotate(*p, frame.axes[k].map(D::from)),
+            Side::Ground(frame) => frame.axes[k].map(D::from),
+        }
+    }
+}
+
+fn dot<D: Scalar>(a: [D; 3], b: [D; 3]) -> D {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+const F: usize = 0;
+const G: usize = 1;
+const H: usize = 2;
+
+/// The rows of a joint of `R` rows, with its frames on both sides.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct JointRows<const R: usize> {
+    pub kind: JointKind,
+    pub a: Frame,
+    pub b: Frame,
+    /// Squared length of a distance joint.
+    pub length2: f64,
+}
+
+impl<const R: usize> JointRows<R> {
+    fn rows<D: Scalar>(&self, a: Side<'_, D>, b: Side<'_, D>) -> [D; R] {
+        let mut out = [D::zero(); R];
+        let (pa, pb) = (a.point(), b.point());
+        let d: [D; 3] = std::array::from_fn(|i| pb[i] - pa[i]);
+        let mut put = |k: usize, x: D| out[k] = x;
+        match self.kind {
+            JointKind::Spherical => (0..3).for_each(|i| put(i, d[i])),
+            JointKind::Revolute => {
+                (0..3).for_each(|i| put(i, d[i]));
+                let hb = b.axis(H);
+                put(3, dot(a.axis(F), hb));
+                put(4, dot(a.axis(G), hb));
+            }
+            JointKind::Universal { .. } => {
+                (0..3).for_each(|i| put(i, d[i]));
+                put(3, dot(a.axis(H), b.axis(H)));
+            }
+            JointKind::Cylindrical | JointKind::Prismatic => {
+                let (fa, ga, hb) = (a.axis(F), a.axis(G), b.axis(H));
+                put(0, dot(fa, hb));
+                put(1, dot(ga, hb));
+                put(2, dot(fa, d));
+                put(3, dot(ga, d));
+                if R == 5 {
+                    put(4, dot(fa, b.axis(G)));
+                }
+            }
+            JointKind::Fixed => {
+                (0..3).for_each(|i| put(i, d[i]));
+                put(3, dot(a.axis(F), b.axis(G)));
+                put(4, dot(a.axis(G), b.axis(H)));
+                put(5, dot(a.axis(H), b.axis(F)));
+            }
+            JointKind::Distance { .. } => put(0, dot(d, d) - self.length2),
+        }
+        out
+    }
+}
+
+/// A joint between two bodies: reads `(r_a, p_a, r_b, p_b)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BodyToBody<const R: usize>(pub JointRows<R>);
+
+/// A joint between a body and the ground: reads `(r_a, p_a)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BodyToGround<const R: usize>(pub JointRows<R>);
+
+fn pose<D: Copy, const K: usize>(x: &[D; K], at: usize) -> ([D; 3], [D; 4]) {
+    (std::array::from_fn(|i| x[at + i]), std::array::from_fn(|i| x[at + 3 + i]))
+}
+
+impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
+    fn eval<D: Scalar>(&self, x: [D; 14], _t: D) -> [D; R] {
+        let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
+        self.0.rows(Side::Body { r: ra, p: pa, frame: &self.0.a }, Side::Body { r: rb, p: pb, frame: &self.0.b })
+    }
+}
+
+impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
+    fn eval<D: Scalar>(&self, x: [D; 7], _t: D) -> [D; R] {
+        let (r, p) = pose(&x, 0);
+        self.0.rows(Side::Body { r, p, frame: &self.0.a }, Side::Ground(&self.0.b))
+    }
+}
+
+/// `pᵀp − 1 = 0`, the normalization of a body's Euler parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct UnitNorm;
+
+impl Constraint<4, 1> for UnitNorm {
+    fn eval<D: Scalar>(&self, p: [D; 4], _t: D) -> [D; 1] {
+        [p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3] - 1.0]
+    }
+}

@@ -1,0 +1,198 @@
+//! A spatial mechanism — bodies, joints and gravity — turned into a
+//! [`Model`] and its initial state.
+
+use super::body::{Body, Rotation};
+use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows, UnitNorm};
+use super::rotation::{rate_from_body, rotate, unrotate};
+use crate::error::{Error, Part, Problem, Result};
+use crate::force::Potential;
+use crate::model::{Model, ModelBuilder};
+use crate::scalar::Scalar;
+
+/// Bodies, joints and uniform gravity.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mechanism {
+    /// The bodies; body `i` has coordinates `7i .. 7i + 7` (see [`SpatialBody`]).
+    pub bodies: Vec<Body>,
+    /// The joints, placed at the bodies' initial poses.
+    pub joints: Vec<Joint>,
+    /// Gravitational acceleration, in space.
+    pub gravity: [f64; 3],
+}
+
+/// Where a body's coordinates are: `r` at `first .. first + 3`, `p` at
+/// `first + 3 .. first + 7`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SpatialBody {
+    /// Its first coordinate.
+    pub first: usize,
+}
+
+impl SpatialBody {
+    /// Body `index` of a [`Mechanism`].
+    pub fn of(index: usize) -> Self {
+        Self { first: 7 * index }
+    }
+    /// Its centre of mass in `q`.
+    pub fn position(&self, q: &[f64]) -> [f64; 3] {
+        std::array::from_fn(|i| q[self.first + i])
+    }
+    /// Its Euler parameters in `q`.
+    pub fn orientation(&self, q: &[f64]) -> [f64; 4] {
+        std::array::from_fn(|i| q[self.first + 3 + i])
+    }
+    /// The coordinates of its Euler parameters.
+    pub fn euler_parameters(&self) -> [usize; 4] {
+        std::array::from_fn(|i| self.first + 3 + i)
+    }
+    /// All seven coordinates.
+    pub fn coordinates(&self) -> [usize; 7] {
+        std::array::from_fn(|i| self.first + i)
+    }
+}
+
+/// `−m g · r`
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Gravity {
+    weight: [f64; 3],
+}
+
+impl Potential<3> for Gravity {
+    fn energy<D: Scalar>(&self, r: [D; 3]) -> D {
+        -(r[0] * self.weight[0] + r[1] * self.weight[1] + r[2] * self.weight[2])
+    }
+}
+
+fn unit(name: &'static str, x: [f64; 3]) -> Result<[f64; 3]> {
+    let norm = x.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(Problem::ZeroAxis { name }.into());
+    }
+    Ok(x.map(|x| x / norm))
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// A right-handed frame `(f, g, h)` with axis `h`.
+fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
+    // Start from the space axis least aligned with h.
+    let k = (0..3).min_by(|&i, &j| h[i].abs().total_cmp(&h[j].abs())).unwrap();
+    let e: [f64; 3] = std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
+    let f = cross(cross(h, e), h);
+    let norm = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let f = f.map(|x| x / norm);
+    [f, cross(h, f), h]
+}
+
+impl Mechanism {
+    /// The model, with the initial positions and velocities as given (not
+    /// yet projected onto the constraints: see [`crate::assemble`]).
+    pub fn build(&self) -> Result<(Model, Vec<f64>, Vec<f64>)> {
+        let n = 7 * self.bodies.len();
+        let mut mass = vec![0.0; n];
+        let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
+        let mut poses = Vec::with_capacity(self.bodies.len());
+        for (i, body) in self.bodies.iter().enumerate() {
+            let at = Part::Body { index: i, name: body.name.clone() };
+            let p = body.check().map_err(|e| e.at(at.clone()))?;
+            let b = SpatialBody::of(i);
+            mass[b.first..b.first + 3].fill(body.mass);
+            q[b.first..b.first + 3].copy_from_slice(&body.position);
+            q[b.first + 3..b.first + 7].copy_from_slice(&p);
+            v[b.first..b.first + 3].copy_from_slice(&body.velocity);
+            v[b.first + 3..b.first + 7].copy_from_slice(&rate_from_body(p, body.angular_velocity));
+            poses.push((body.position, p));
+        }
+        for g in self.gravity {
+            crate::error::finite("gravity", g)?;
+        }
+        let mut builder = Model::builder(mass);
+        for (i, body) in self.bodies.iter().enumerate() {
+            let b = SpatialBody::of(i);
+            builder = builder
+                .kinetic(Rotation::new(body.inertia), b.euler_parameters())
+                .constrain(UnitNorm, b.euler_parameters());
+            if self.gravity != [0.0; 3] {
+                let weight = self.gravity.map(|g| g * body.mass);
+                builder = builder.potential(Gravity { weight }, [b.first, b.first + 1, b.first + 2]);
+            }
+        }
+        for (index, joint) in self.joints.iter().enumerate() {
+            let at = Part::Element { index, kind: joint.kind.name() };
+            builder = self.add_joint(builder, joint, &poses).map_err(|e| e.at(at))?;
+        }
+        Ok((builder.build()?, q, v))
+    }
+
+    fn add_joint(&self, builder: ModelBuilder, joint: &Joint, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
+        let pose = |i: usize| poses.get(i).copied().ok_or(Error::from(Problem::NoSuchBody { index: i }));
+        let (ra, pa) = pose(joint.a)?;
+        if joint.b == Some(joint.a) {
+            return Err(Problem::SameBody { body: self.bodies[joint.a].name.clone() }.into());
+        }
+        let b = joint.b.map(pose).transpose()?;
+        if joint.point.iter().any(|x| !x.is_finite()) {
+            return Err(Problem::Parameter { name: "point", value: f64::NAN, reason: "must be finite" }.into());
+        }
+        let (axes_a, axes_b) = match joint.kind {
+            JointKind::Spherical | JointKind::Distance { .. } => (frame_about([0.0, 0.0, 1.0]), frame_about([0.0, 0.0, 1.0])),
+            JointKind::Universal { axis_b } => {
+                let (ha, hb) = (unit("axis", joint.axis)?, unit("axis_b", axis_b)?);
+                let c = ha[0] * hb[0] + ha[1] * hb[1] + ha[2] * hb[2];
+                if c.abs() > 1e-9 {
+                    return Err(Problem::Parameter { name: "axis · axis_b", value: c, reason: "must be 0: a universal joint's axes are perpendicular" }.into());
+                }
+                (frame_about(ha), frame_about(hb))
+            }
+            _ => {
+                let h = frame_about(unit("axis", joint.axis)?);
+                (h, h)
+            }
+        };
+        let point_b = match joint.kind {
+            JointKind::Distance { point_b } => point_b,
+            _ => joint.point,
+        };
+        let d: [f64; 3] = std::array::from_fn(|i| point_b[i] - joint.point[i]);
+        let length2 = d.iter().map(|x| x * x).sum::<f64>();
+        if matches!(joint.kind, JointKind::Distance { .. }) && !(length2 > 0.0 && length2.is_finite()) {
+            return Err(Problem::Parameter { name: "length", value: length2.sqrt(), reason: "must be finite and positive: point_b must differ from point" }.into());
+        }
+        let in_body = |(r, p): ([f64; 3], [f64; 4]), point: [f64; 3], axes: [[f64; 3]; 3]| Frame {
+            s: unrotate(p, std::array::from_fn(|i| point[i] - r[i])),
+            axes: axes.map(|x| unrotate(p, x)),
+        };
+        let fa = in_body((ra, pa), joint.point, axes_a);
+        let fb = match b {
+            Some(pose) => in_body(pose, point_b, axes_b),
+            None => Frame { s: point_b, axes: axes_b },
+        };
+        debug_assert!({
+            let x = rotate(pa, fa.s);
+            (0..3).all(|i| (ra[i] + x[i] - joint.point[i]).abs() < 1e-9 * (1.0 + joint.point[i].abs()))
+        });
+        let a_at = SpatialBody::of(joint.a).coordinates();
+        macro_rules! add {
+            ($r:literal) => {{
+                let rows = JointRows::<$r> { kind: joint.kind, a: fa, b: fb, length2 };
+                match joint.b {
+                    Some(jb) => {
+                        let b_at = SpatialBody::of(jb).coordinates();
+                        let at: [usize; 14] = std::array::from_fn(|i| if i < 7 { a_at[i] } else { b_at[i - 7] });
+                        builder.constrain(BodyToBody(rows), at)
+                    }
+                    None => builder.constrain(BodyToGround(rows), a_at),
+                }
+            }};
+        }
+        Ok(match joint.kind.rows() {
+            1 => add!(1),
+            3 => add!(3),
+            4 => add!(4),
+            5 => add!(5),
+            _ => add!(6),
+        })
+    }
+}

@@ -1,0 +1,32 @@
+//! Spatial multibody systems: rigid bodies in Euler parameters, joints
+//! from Haug's primitive constraints, gravity and springs, turned into a
+//! [`Model`](crate::Model) of local elements.
+//!
+//! A body has seven coordinates: its centre of mass `r` and its Euler
+//! parameters `p = (e₀, e₁, e₂, e₃)` (a unit quaternion, scalar first, with
+//! `A(p)` the rotation from body to space axes), and the velocities are
+//! `(ṙ, ṗ)`. Its kinetic energy is `½ m |ṙ|² + ½ ω′ᵀ J′ ω′` with the body
+//! angular velocity `ω′ = 2 G(p) ṗ`, plus `½ k (pᵀṗ)²`, which vanishes
+//! with its derivatives on the constraint `pᵀṗ = 0` and makes the 4 × 4
+//! mass block `4 GᵀJ′G + k p pᵀ` invertible. The normalization `pᵀp = 1`
+//! is one more constraint row, held by the same controls as any joint.
+//!
+//! Why `ṗ` and not the body angular velocity as velocities: it keeps
+//! `q̇ = v`, on which every integrator, control law, the projection and the
+//! energy balance of the library are written, and its mass is
+//! block-diagonal, which the sparse solver factors block by block
+//! ([`BlockMass`](crate::mass::BlockMass)) at a cost linear in the number
+//! of bodies. The price is the AD of the 4 × 4 block at every evaluation.
+//!
+//! Joints are placed by a point and axes in space at the initial pose, and
+//! carried into each body's frame there, so that a joint is always
+//! assembled where it is defined.
+
+mod body;
+mod joint;
+mod mechanism;
+pub mod rotation;
+
+pub use body::{Body, Rotation};
+pub use joint::{Joint, JointKind};
+pub use mechanism::{Mechanism, SpatialBody};

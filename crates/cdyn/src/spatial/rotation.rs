@@ -1,0 +1,97 @@
+//! Euler parameters `p = (e₀, e₁, e₂, e₃)`, scalar first (Haug's
+//! convention): `A(p) = E(p) G(p)ᵀ` rotates body axes to space axes, the
+//! body angular velocity is `ω′ = 2 G(p) ṗ` and the spatial one
+//! `ω = 2 E(p) ṗ`. Written generic over the scalar, for dual numbers.
+
+use crate::scalar::Scalar;
+
+/// `G(p)`, with `ω′ = 2 G ṗ`.
+pub fn g_matrix<D: Scalar>([e0, e1, e2, e3]: [D; 4]) -> [[D; 4]; 3] {
+    [[-e1, e0, e3, -e2], [-e2, -e3, e0, e1], [-e3, e2, -e1, e0]]
+}
+
+/// `E(p)`, with `ω = 2 E ṗ`.
+pub fn e_matrix<D: Scalar>([e0, e1, e2, e3]: [D; 4]) -> [[D; 4]; 3] {
+    [[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]]
+}
+
+/// `A(p) s = (e₀² − eᵀe) s + 2 e (eᵀs) + 2 e₀ (e × s)`: `E Gᵀ s`, a
+/// homogeneous quadratic in `p` (the rotation of `s` when `|p| = 1`).
+#[inline(always)]
+pub fn rotate<D: Scalar>(p: [D; 4], s: [D; 3]) -> [D; 3] {
+    let [e0, e1, e2, e3] = p;
+    let e = [e1, e2, e3];
+    let scale = e0 * e0 - (e1 * e1 + e2 * e2 + e3 * e3);
+    let es = e1 * s[0] + e2 * s[1] + e3 * s[2];
+    let cross = [e2 * s[2] - e3 * s[1], e3 * s[0] - e1 * s[2], e1 * s[1] - e2 * s[0]];
+    std::array::from_fn(|i| s[i] * scale + e[i] * es * 2.0 + e0 * cross[i] * 2.0)
+}
+
+/// `A(p)ᵀ x`: a space vector in body axes (`|p| = 1`).
+pub fn unrotate(p: [f64; 4], x: [f64; 3]) -> [f64; 3] {
+    rotate([p[0], -p[1], -p[2], -p[3]], x)
+}
+
+/// `ṗ = ½ G(p)ᵀ ω′` for the body angular velocity `ω′` (`|p| = 1`).
+pub fn rate_from_body(p: [f64; 4], w: [f64; 3]) -> [f64; 4] {
+    let g = g_matrix(p);
+    std::array::from_fn(|j| 0.5 * (0..3).map(|i| g[i][j] * w[i]).sum::<f64>())
+}
+
+/// The body angular velocity `ω′ = 2 G(p) ṗ`.
+pub fn body_rate<D: Scalar>(p: [D; 4], pd: [D; 4]) -> [D; 3] {
+    let g = g_matrix(p);
+    std::array::from_fn(|i| (g[i][0] * pd[0] + g[i][1] * pd[1] + g[i][2] * pd[2] + g[i][3] * pd[3]) * 2.0)
+}
+
+/// The spatial angular velocity `ω = 2 E(p) ṗ`.
+pub fn space_rate(p: [f64; 4], pd: [f64; 4]) -> [f64; 3] {
+    let e = e_matrix(p);
+    std::array::from_fn(|i| 2.0 * (0..4).map(|j| e[i][j] * pd[j]).sum::<f64>())
+}
+
+/// The unit quaternion of a rotation by `angle` about the unit `axis`.
+pub fn about(axis: [f64; 3], angle: f64) -> [f64; 4] {
+    let (s, c) = (0.5 * angle).sin_cos();
+    [c, s * axis[0], s * axis[1], s * axis[2]]
+}
+
+/// The product `a ⊗ b` (first `b`, then `a`: `A(a ⊗ b) = A(a) A(b)`).
+pub fn compose(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    let [a0, a1, a2, a3] = a;
+    let [b0, b1, b2, b3] = b;
+    [
+        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotations_compose_and_invert() {
+        let p = about([0.0, 0.0, 1.0], std::f64::consts::FRAC_PI_2);
+        let x = rotate(p, [1.0, 0.0, 0.0]);
+        assert!((x[0]).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15 && x[2].abs() < 1e-15, "{x:?}");
+        let q = about([0.6, 0.0, 0.8], 0.7);
+        let s = [0.3, -1.2, 2.0];
+        let twice = rotate(p, rotate(q, s));
+        let once = rotate(compose(p, q), s);
+        let back = unrotate(q, rotate(q, s));
+        for i in 0..3 {
+            assert!((twice[i] - once[i]).abs() < 1e-14 && (back[i] - s[i]).abs() < 1e-14);
+        }
+        // ω′ = 2 G ṗ inverts ṗ = ½ Gᵀ ω′, and ω = A ω′.
+        let w = [0.4, -2.0, 1.5];
+        let pd = rate_from_body(q, w);
+        let (wb, ws) = (body_rate(q, pd), space_rate(q, pd));
+        let wr = rotate(q, w);
+        for i in 0..3 {
+            assert!((wb[i] - w[i]).abs() < 1e-14 && (ws[i] - wr[i]).abs() < 1e-14);
+        }
+    }
+}
