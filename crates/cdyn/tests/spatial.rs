@@ -1,0 +1,312 @@
+//! Spatial bodies and joints (`cdyn::spatial`): derivatives against finite
+//! differences, the freedom each joint leaves, the block-diagonal mass
+//! path against the dense one, and the rigid-body references (Euler's
+//! torque-free motion, the heavy top benchmark).
+
+use cdyn::dynamics::{Dynamics, LinearSolver};
+use cdyn::reference::elliptic::jacobi;
+use cdyn::spatial::rotation::{about, body_rate, compose, rate_from_body, rotate, space_rate};
+use cdyn::spatial::{Body, Joint, JointKind, Mechanism, SpatialBody};
+use cdyn::{Control, Error, Model, Scheme, Settings, Simulation, methods};
+use nalgebra::DMatrix;
+use proptest::prelude::*;
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
+}
+
+fn unit(x: [f64; 3]) -> [f64; 3] {
+    let n = x.iter().map(|x| x * x).sum::<f64>().sqrt();
+    x.map(|x| x / n)
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// Every kind of joint, its relative freedom, with `axis` (for the
+/// universal joint's second axis, one perpendicular to it).
+fn kinds(axis: [f64; 3], point_b: [f64; 3]) -> Vec<(JointKind, usize)> {
+    let other = unit(cross(axis, [0.3, -0.5, 0.8]));
+    vec![
+        (JointKind::Spherical, 3),
+        (JointKind::Revolute, 1),
+        (JointKind::Universal { axis_b: other }, 2),
+        (JointKind::Cylindrical, 2),
+        (JointKind::Prismatic, 1),
+        (JointKind::Fixed, 0),
+        (JointKind::Distance { point_b }, 5),
+    ]
+}
+
+/// Two bodies at the given poses joined by `kind` at `point`, or one body
+/// and the ground.
+fn pair(kind: JointKind, grounded: bool, poses: [([f64; 3], [f64; 4]); 2], point: [f64; 3], axis: [f64; 3]) -> Mechanism {
+    let bodies: Vec<Body> = poses
+        .iter()
+        .enumerate()
+        .take(if grounded { 1 } else { 2 })
+        .map(|(i, &(r, p))| Body {
+            position: r,
+            orientation: p,
+            inertia: [[1.0, 0.1, 0.0], [0.1, 1.5, -0.2], [0.0, -0.2, 2.0]],
+            ..Body::new(&format!("b{i}"), 1.0 + i as f64, [1.0; 3])
+        })
+        .collect();
+    let b = (!grounded).then_some(1);
+    Mechanism { bodies, joints: vec![Joint { kind, a: 0, b, point, axis }], gravity: [0.0, 0.0, -9.81] }
+}
+
+fn phi(model: &Model, q: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; model.m()];
+    model.constraint_values(q, 0.0, &mut out);
+    out
+}
+
+fn dense_jacobian(model: &Model, d: &Dynamics) -> DMatrix<f64> {
+    let pattern = model.pattern();
+    DMatrix::from_fn(model.m(), model.n(), |r, c| {
+        pattern.row(r).find(|&j| pattern.cols[j] as usize == c).map_or(0.0, |j| d.jac()[j])
+    })
+}
+
+fn quaternion() -> impl Strategy<Value = [f64; 4]> {
+    (prop::array::uniform3(-1.0..1.0f64), -3.0..3.0f64)
+        .prop_filter("an axis", |(a, _)| a.iter().map(|x| x * x).sum::<f64>() > 0.01)
+        .prop_map(|(a, angle)| about(unit(a), angle))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// `Φ_q`, `Φ̇` and `γ` of every joint against central differences, at
+    /// random poses off the constraints and random velocities.
+    #[test]
+    fn joint_derivatives_match_finite_differences(
+        ra in prop::array::uniform3(-1.0..1.0f64), pa in quaternion(),
+        rb in prop::array::uniform3(-1.0..1.0f64), pb in quaternion(),
+        point in prop::array::uniform3(-1.0..1.0f64),
+        axis in prop::array::uniform3(0.1..1.0f64),
+        dq in prop::collection::vec(-0.2..0.2f64, 14),
+        v in prop::collection::vec(-2.0..2.0f64, 14),
+        grounded in any::<bool>(),
+    ) {
+        let point_b = [point[0] + 0.5, point[1], point[2] - 0.3];
+        for (kind, _) in kinds(unit(axis), point_b) {
+            let (model, q0, _) = pair(kind, grounded, [(ra, pa), (rb, pb)], point, axis).build().unwrap();
+            let n = model.n();
+            let q: Vec<f64> = q0.iter().zip(&dq).map(|(q, d)| q + d).collect();
+            let v = &v[..n];
+            let mut d = Dynamics::new(&model);
+            d.evaluate(&model, &q, v, 0.0).unwrap();
+            let jac = dense_jacobian(&model, &d);
+            let h = 1e-6;
+            for c in 0..n {
+                let (mut qp, mut qm) = (q.clone(), q.clone());
+                qp[c] += h;
+                qm[c] -= h;
+                let (p, m) = (phi(&model, &qp), phi(&model, &qm));
+                for r in 0..model.m() {
+                    let fd = (p[r] - m[r]) / (2.0 * h);
+                    prop_assert!(close(jac[(r, c)], fd, 1e-7), "{kind:?} Φ_q[{r},{c}]: AD {} vs FD {fd}", jac[(r, c)]);
+                }
+            }
+            let along = |s: f64| phi(&model, &q.iter().zip(v).map(|(q, v)| q + s * v).collect::<Vec<_>>());
+            let hs = 1e-4;
+            let (p1, p0, m1) = (along(hs), along(0.0), along(-hs));
+            for r in 0..model.m() {
+                let first = (p1[r] - m1[r]) / (2.0 * hs);
+                let second = (p1[r] - 2.0 * p0[r] + m1[r]) / (hs * hs);
+                prop_assert!(close(d.phi_dot()[r], first, 1e-6), "{kind:?} Φ̇[{r}]: AD {} vs FD {first}", d.phi_dot()[r]);
+                prop_assert!(close(-d.gamma()[r], second, 1e-5), "{kind:?} γ[{r}]: AD {} vs FD {}", d.gamma()[r], -second);
+            }
+        }
+    }
+
+    /// At an assembled pose, each joint's rows (with the two normalizations)
+    /// are independent, and the motions it should allow satisfy `Φ_q v = 0`:
+    /// so it leaves exactly its degrees of freedom, and the right ones.
+    #[test]
+    fn each_joint_leaves_exactly_its_degrees_of_freedom(
+        ra in prop::array::uniform3(-1.0..1.0f64), pa in quaternion(),
+        rb in prop::array::uniform3(-1.0..1.0f64), pb in quaternion(),
+        point in prop::array::uniform3(-1.0..1.0f64),
+        axis in prop::array::uniform3(0.1..1.0f64),
+    ) {
+        let axis = unit(axis);
+        let point_b = [point[0] + 0.5, point[1], point[2] - 0.3];
+        for (kind, freedom) in kinds(axis, point_b) {
+            let (model, q, _) = pair(kind, false, [(ra, pa), (rb, pb)], point, axis).build().unwrap();
+            prop_assert!(phi(&model, &q).iter().all(|x| x.abs() < 1e-12), "{kind:?} not assembled");
+            let mut d = Dynamics::new(&model);
+            d.evaluate(&model, &q, &[0.0; 14], 0.0).unwrap();
+            let jac = dense_jacobian(&model, &d);
+            let rank = jac.clone().svd(false, false).rank(1e-9);
+            prop_assert_eq!(rank, kind.rows() + 2, "{:?}: rank of Φ_q", kind);
+            prop_assert_eq!(14 - rank - 6, freedom, "{:?}: freedom left to body b", kind);
+            // Body b moving, body a still: rotations about axes through a
+            // point, and translations.
+            let b = SpatialBody::of(1);
+            let motion = |w: [f64; 3], about: [f64; 3], u: [f64; 3]| {
+                let mut v = vec![0.0; 14];
+                let arm: [f64; 3] = std::array::from_fn(|i| rb[i] - about[i]);
+                let vc = cross(w, arm);
+                let wb = rotate([pb[0], -pb[1], -pb[2], -pb[3]], w);
+                v[b.first..b.first + 3].copy_from_slice(&std::array::from_fn::<f64, 3, _>(|i| vc[i] + u[i]));
+                v[b.first + 3..b.first + 7].copy_from_slice(&rate_from_body(pb, wb));
+                v
+            };
+            let z = [0.0; 3];
+            let allowed: Vec<Vec<f64>> = match kind {
+                JointKind::Spherical => (0..3).map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point, z)).collect(),
+                JointKind::Revolute => vec![motion(axis, point, z)],
+                JointKind::Universal { axis_b } => vec![motion(axis, point, z), motion(axis_b, point, z)],
+                JointKind::Cylindrical => vec![motion(axis, point, z), motion(z, point, axis)],
+                JointKind::Prismatic => vec![motion(z, point, axis)],
+                JointKind::Fixed => vec![],
+                JointKind::Distance { point_b } => (0..3)
+                    .map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point, z))
+                    .chain((0..2).map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point_b, z)))
+                    .collect(),
+            };
+            for v in allowed {
+                let phi_dot = &jac * nalgebra::DVector::from_vec(v);
+                prop_assert!(phi_dot.amax() < 1e-12, "{:?}: an allowed motion violates Φ_q v = 0 by {}", kind, phi_dot.amax());
+            }
+        }
+    }
+}
+
+/// Principal moments `J₁ < J₂ < J₃` of the torque-free body.
+const J: [f64; 3] = [1.0, 2.0, 3.0];
+/// Initial body angular velocity `(a, 0, c)` in principal axes.
+const W0: [f64; 3] = [1.0, 0.0, 1.0];
+
+/// Euler's torque-free motion from `ω(0) = (a, 0, c)`:
+/// `ω = (a cn, b sn, c dn)(s t; k)`.
+fn euler_exact(t: f64) -> [f64; 3] {
+    let ([j1, j2, j3], [a, _, c]) = (J, W0);
+    let s = ((j3 - j2) * (j3 - j1) / (j1 * j2)).sqrt() * c;
+    let b = j1 * a * s / ((j3 - j2) * c);
+    let k = ((j2 - j1) * a * b / (j3 * c * s)).sqrt();
+    let (sn, cn, dn, _) = jacobi(s * t, k);
+    [a * cn, b * sn, c * dn]
+}
+
+/// A free body whose body axes are turned by `turn` from its principal
+/// axes: inertia `Q diag(J) Qᵀ` and initial angular velocity `Q ω₀` in its
+/// own axes, orientation `turn⁻¹`, so that the principal axes start on
+/// the space axes and the motion is Euler's.
+fn free_body(turn: [f64; 4]) -> Mechanism {
+    let column = |c: usize| rotate(turn, std::array::from_fn(|k| (k == c) as u8 as f64));
+    let q = [column(0), column(1), column(2)];
+    let inertia = std::array::from_fn(|a| std::array::from_fn(|b| (0..3).map(|k| q[k][a] * J[k] * q[k][b]).sum()));
+    let body = Body {
+        inertia,
+        orientation: [turn[0], -turn[1], -turn[2], -turn[3]],
+        angular_velocity: rotate(turn, W0),
+        ..Body::new("top", 2.0, J)
+    };
+    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3] }
+}
+
+/// Largest error of the spatial angular velocity against Euler's solution
+/// (rotated into space: the principal axes start on the space axes), of
+/// `|p| − 1` and of the energy, over `t_end`.
+fn torque_free(turn: [f64; 4], h: f64, t_end: f64, control: Control) -> [f64; 3] {
+    let (model, q0, v0) = free_body(turn).build().unwrap();
+    let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, control), &q0, &v0).unwrap();
+    let t0 = 0.5 * (0..3).map(|i| J[i] * W0[i] * W0[i]).sum::<f64>();
+    let mut worst = [0.0_f64; 3];
+    let b = SpatialBody::of(0);
+    sim.run::<Error>(t_end, (0.01 / h).round() as u64, |s| {
+        let (p, pd) = (b.orientation(s.q()), b.orientation(s.v()));
+        // Body rate in principal axes: ω_principal = Qᵀ ω′.
+        let w = rotate([turn[0], -turn[1], -turn[2], -turn[3]], body_rate(p, pd));
+        let exact = euler_exact(s.t());
+        let energy = 0.5 * (0..3).map(|i| J[i] * w[i] * w[i]).sum::<f64>();
+        let errors = [
+            (0..3).map(|i| (w[i] - exact[i]).abs()).fold(0.0, f64::max),
+            (p.iter().map(|x| x * x).sum::<f64>().sqrt() - 1.0).abs(),
+            (energy - t0).abs(),
+        ];
+        worst = std::array::from_fn(|i| worst[i].max(errors[i]));
+        Ok(())
+    })
+    .unwrap();
+    worst
+}
+
+#[test]
+fn a_free_body_with_a_full_inertia_tensor_follows_eulers_solution() {
+    let turn = compose(about([0.0, 0.0, 1.0], 0.4), about(unit([1.0, 1.0, 0.0]), 0.9));
+    let errors: Vec<[f64; 3]> = [0.02, 0.01].iter().map(|&h| torque_free(turn, h, 10.0, Control::none())).collect();
+    println!("RK-4, none, 10 s: h = 0.02 {:?}; h = 0.01 {:?}", errors[0], errors[1]);
+    let order = (errors[0][0] / errors[1][0]).log2();
+    assert!((order - 4.0).abs() < 0.25, "observed order {order:.2}: {errors:?}");
+    assert!(errors[1][0] < 3e-8, "{errors:?}");
+    // The controls hold |p| = 1 and the energy to round-off without
+    // making the angular velocity worse.
+    let robust = torque_free(turn, 0.02, 10.0, methods::robust());
+    println!("RK-4, robust, h = 0.02: {robust:?}");
+    assert!(robust[1] < 1e-12 && robust[2] < 1e-12, "{robust:?}");
+    assert!(robust[0] <= errors[0][0] * 1.01, "robust {robust:?} vs none {:?}", errors[0]);
+}
+
+/// The heavy top of Brüls & Cardona's Lie-group benchmark: 15 kg, inertia
+/// diag(0.234375, 0.46875, 0.234375) kg m² at the centre of mass, which is
+/// 1 m from the fixed point along the body y axis; gravity 9.81 along −z;
+/// body angular velocity (0, 150, −4.61538) rad/s; p₀ = (1, 0, 0, 0).
+fn heavy_top() -> Mechanism {
+    let w0 = [0.0, 150.0, -4.61538];
+    let top = Body {
+        position: [0.0, 1.0, 0.0],
+        velocity: cross(w0, [0.0, 1.0, 0.0]),
+        angular_velocity: w0,
+        ..Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
+    };
+    let fixed = Joint { kind: JointKind::Spherical, a: 0, b: None, point: [0.0; 3], axis: [0.0, 0.0, 1.0] };
+    Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81] }
+}
+
+fn heavy_top_at(t_end: f64, h: f64, control: Control, solver: LinearSolver) -> (Vec<f64>, Vec<f64>) {
+    let (model, q0, v0) = heavy_top().build().unwrap();
+    let settings = Settings { solver, ..Settings::new(Scheme::RungeKutta4, h, control) };
+    let mut sim = Simulation::new(&model, settings, &q0, &v0).unwrap();
+    sim.run::<Error>(t_end, u64::MAX, |_| Ok(())).unwrap();
+    (sim.q().to_vec(), sim.v().to_vec())
+}
+
+#[test]
+fn the_heavy_top_agrees_with_the_published_values_at_0_2_s() {
+    // Published (Exudyn's heavy-top test, MATLAB RK-4 at h = 1e-4): Euler
+    // parameters (−0.70828, 0.43878, 0.54573, 0.0894) and body angular
+    // velocity (−2.6916, 150, 4.9173) at t = 0.2 s.
+    let p_ref = [-0.70828, 0.43878, 0.54573, 0.0894];
+    let decimals = [5, 5, 5, 4];
+    let w_ref = [-2.6916, 150.0, 4.9173];
+    for control in [Control::none(), methods::robust()] {
+        let (q, v) = heavy_top_at(0.2, 1e-4, control, LinearSolver::Auto);
+        let p = SpatialBody::of(0).orientation(&q);
+        let w = body_rate(p, SpatialBody::of(0).orientation(&v));
+        println!("heavy top at 0.2 s: p = {p:?}, ω′ = {w:?}, spatial ω = {:?}", space_rate(p, SpatialBody::of(0).orientation(&v)));
+        for i in 0..4 {
+            // Agreement to the digits published: within half a unit of the last one.
+            let half = 0.5 * 10f64.powi(-decimals[i]);
+            assert!((p[i] - p_ref[i]).abs() <= half, "p[{i}] = {} vs published {}", p[i], p_ref[i]);
+        }
+        for i in 0..3 {
+            assert!((w[i] - w_ref[i]).abs() <= 0.5e-4, "ω′[{i}] = {} vs published {}", w[i], w_ref[i]);
+        }
+    }
+}
+
+#[test]
+fn block_diagonal_and_dense_mass_paths_agree() {
+    let (blocks, _) = heavy_top_at(0.05, 1e-4, Control::none(), LinearSolver::Auto);
+    let (dense, _) = heavy_top_at(0.05, 1e-4, Control::none(), LinearSolver::Dense);
+    let gap = blocks.iter().zip(&dense).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(gap < 1e-12, "block path and dense path differ by {gap:e}");
+    let (model, ..) = heavy_top().build().unwrap();
+    assert_eq!(model.mass_blocks().map(<[_]>::len), Some(1));
+}
