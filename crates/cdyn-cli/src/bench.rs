@@ -10,6 +10,10 @@
 //!   released at rest 0.3 rad from vertical; CVSGF + energy with
 //!   hα_g = hα_e = 0.4, AB-3, h = 1e-3): microseconds per step, max |Φ|
 //!   over the run, and the fitted exponent of cost against N.
+//! - The spatial chain (`cdyn::spatial::chain`: N rods of 1 kg and 1 m in
+//!   Euler parameters joined by spherical joints, released at rest 0.3 rad
+//!   from vertical, g = 1) with the same control, scheme and step: the same
+//!   figures.
 //! - The methods side by side, each on Example 1 (general `Model`, h = 0.01)
 //!   and on the chain (h = 1e-3), AB-3: `cvsgf_energy` (the control timed
 //!   above), the `robust` preset (automatic gains resolved when each
@@ -103,6 +107,10 @@ pub struct Report {
     pub chain: Vec<ChainRun>,
     /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
     pub chain_cost_exponent: Option<f64>,
+    /// The spatial chain, by N.
+    pub spatial_chain: Vec<ChainRun>,
+    /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
+    pub spatial_chain_cost_exponent: Option<f64>,
     /// `cvsgf_energy`, `robust` and `projection` on Example 1, then on the chain by N.
     pub methods: Vec<MethodComparison>,
     /// Over every run above, the methods' included.
@@ -172,12 +180,22 @@ fn example1(light: bool) -> Result<Example1> {
 }
 
 fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
-    let h = 1e-3;
     let ex = chain_example(n)?;
+    timed_chain(n, &ex.model, &ex.q0, &ex.v0, t_end)
+}
+
+fn spatial_chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
+    let (model, q0, v0) = cdyn::spatial::chain(n, 0.3, 1.0).build()?;
+    timed_chain(n, &model, &q0, &v0, t_end)
+}
+
+/// A chain's run at h = 1e-3, AB-3, with [`chain_control`].
+fn timed_chain(n: usize, model: &cdyn::Model, q0: &[f64], v0: &[f64], t_end: f64) -> Result<ChainRun> {
+    let h = 1e-3;
     let settings = Settings::new(Scheme::AdamsBashforth3, h, chain_control(h));
-    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
+    let mut sim = Simulation::new(model, settings, q0, v0)?;
     let steps = cdyn::simulate::steps_to(t_end, h)?;
-    let mut phi = vec![0.0; ex.model.m()];
+    let mut phi = vec![0.0; model.m()];
     let (mut worst, mut elapsed, mut allocs) = (0.0_f64, 0.0, 0);
     // Time the steps only; measure |Φ| every 10 steps outside the clock.
     while sim.steps() < steps {
@@ -188,10 +206,10 @@ fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
         }
         elapsed += start.elapsed().as_secs_f64();
         allocs += allocations() - before;
-        ex.model.constraint_values(sim.q(), sim.t(), &mut phi);
+        model.constraint_values(sim.q(), sim.t(), &mut phi);
         worst = phi.iter().fold(worst, |a, p| a.max(p.abs()));
     }
-    let solver = if ex.model.m() >= cdyn::dynamics::SPARSE_FROM { "sparse" } else { "dense" };
+    let solver = if model.m() >= cdyn::dynamics::SPARSE_FROM { "sparse" } else { "dense" };
     Ok(ChainRun {
         n,
         steps,
@@ -348,14 +366,32 @@ pub fn run(light: bool) -> Result<Report> {
     let (sizes, t_end): (&[usize], f64) =
         if light { (&[10, 100, 1000], 0.05) } else { (&[10, 100, 1000, 10_000], 10.0) };
     let chain = sizes.iter().map(|&n| chain_run(n, t_end)).collect::<Result<Vec<_>>>()?;
-    let fit: Vec<(f64, f64)> = chain.iter().filter(|c| c.n >= 100).map(|c| (c.n as f64, c.us_per_step)).collect();
+    // The spatial chain's step costs about 30 times the planar one's: its
+    // runs are shorter (N = 10 000 would take over an hour for 10 s).
+    let (spatial_sizes, spatial_t_end): (&[usize], f64) =
+        if light { (&[10, 100], 0.01) } else { (&[10, 100, 1000], 1.0) };
+    let spatial_chain = spatial_sizes.iter().map(|&n| spatial_chain_run(n, spatial_t_end)).collect::<Result<Vec<_>>>()?;
+    let fit = |runs: &[ChainRun]| {
+        let points: Vec<(f64, f64)> = runs.iter().filter(|c| c.n >= 100).map(|c| (c.n as f64, c.us_per_step)).collect();
+        fitted_exponent(&points)
+    };
     let methods = method_comparisons(light)?;
     let max_allocations_per_step = chain
         .iter()
+        .chain(&spatial_chain)
         .map(|c| c.allocations_per_step)
         .chain(methods.iter().flat_map(|m| m.methods.iter().map(|c| c.allocations_per_step)))
         .fold(example1.allocations_per_step, f64::max);
-    Ok(Report { light, example1, chain_cost_exponent: fitted_exponent(&fit), chain, methods, max_allocations_per_step })
+    Ok(Report {
+        light,
+        example1,
+        chain_cost_exponent: fit(&chain),
+        chain,
+        spatial_chain_cost_exponent: fit(&spatial_chain),
+        spatial_chain,
+        methods,
+        max_allocations_per_step,
+    })
 }
 
 /// The table printed on the terminal.
@@ -371,14 +407,21 @@ pub fn table(r: &Report) -> String {
         e.general_ns_per_step, e.general_overhead_ratio
     );
     out += &format!("  hand-written         {:>8.1} ns/step\n", e.handwritten_ns_per_step);
-    out += "N-link chain, CVSGF + energy, AB-3, h = 1e-3:\n";
-    out += &format!("  {:>6} {:>8} {:>12} {:>12} {:>8}\n", "N", "steps", "µs/step", "max|Φ|", "solver");
-    for c in &r.chain {
-        out +=
-            &format!("  {:>6} {:>8} {:>12.2} {:>12.3e} {:>8}\n", c.n, c.steps, c.us_per_step, c.max_abs_phi, c.solver);
-    }
-    if let Some(p) = r.chain_cost_exponent {
-        out += &format!("  cost exponent (N ≥ 100): {p:.3}\n");
+    for (title, runs, exponent) in [
+        ("N-link chain", &r.chain, r.chain_cost_exponent),
+        ("spatial chain (rods in Euler parameters, spherical joints)", &r.spatial_chain, r.spatial_chain_cost_exponent),
+    ] {
+        out += &format!("{title}, CVSGF + energy, AB-3, h = 1e-3:\n");
+        out += &format!("  {:>6} {:>8} {:>12} {:>12} {:>8}\n", "N", "steps", "µs/step", "max|Φ|", "solver");
+        for c in runs {
+            out += &format!(
+                "  {:>6} {:>8} {:>12.2} {:>12.3e} {:>8}\n",
+                c.n, c.steps, c.us_per_step, c.max_abs_phi, c.solver
+            );
+        }
+        if let Some(p) = exponent {
+            out += &format!("  cost exponent (N ≥ 100): {p:.3}\n");
+        }
     }
     if let Some(m) = r.methods.first() {
         out += &format!(

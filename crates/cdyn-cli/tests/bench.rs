@@ -24,6 +24,12 @@ fn light_bench_writes_a_complete_report() {
         assert_eq!(c["allocations_per_step"].as_f64(), Some(0.0), "{c}");
     }
     assert!(r["chain_cost_exponent"].as_f64().is_some());
+    let spatial = r["spatial_chain"].as_array().unwrap();
+    assert_eq!(spatial.iter().map(|c| c["n"].as_u64().unwrap()).collect::<Vec<_>>(), [10, 100]);
+    for c in spatial {
+        assert!(c["max_abs_phi"].as_f64().unwrap() < 1e-8, "{c}");
+        assert_eq!(c["allocations_per_step"].as_f64(), Some(0.0), "{c}");
+    }
     assert!(String::from_utf8_lossy(&out.stdout).contains("overhead"));
 }
 

@@ -202,6 +202,8 @@ fn steps_do_not_allocate() {
     let angles = double_pendulum_angles(DoublePendulumParams::default()).unwrap();
     let four_bar =
         four_bar_angles(FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() }).unwrap();
+    let (spatial, sq0, sv0) = cdyn::spatial::chain(40, 0.3, 1.0).build().unwrap();
+    assert!(spatial.mass_blocks().is_some());
     assert!(count() > before);
     for scheme in Scheme::ALL {
         for control in controls() {
@@ -238,12 +240,16 @@ fn steps_do_not_allocate() {
             let n = small_allocations_per_run(Settings::new(scheme, 0.01, control), 5, 200);
             assert_eq!(n, 0, "small pendulum, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
-        // M(q) from kinetic energies: every law, the robust preset and the projection.
+        // M(q) from kinetic energies: every law, the robust preset and the
+        // projection; the spatial chain's on the block-diagonal path.
         for control in controls().into_iter().chain(robust_controls()).chain(projections()) {
             for (name, ex) in [("double pendulum in angles", &angles), ("four-bar in angles", &four_bar)] {
                 let n = allocations_per_run(ex, Settings::new(scheme, 1e-3, control), 5, 200);
                 assert_eq!(n, 0, "{name}, {scheme:?}, {control:?}: {n} allocations in 200 steps");
             }
+            let sim = Simulation::new(&spatial, Settings::new(scheme, 1e-3, control), &sq0, &sv0).unwrap();
+            let n = allocations_stepping(sim, 5, 200);
+            assert_eq!(n, 0, "spatial chain, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
         let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, methods::robust()), 5, 200);
         assert_eq!(n, 0, "andrews, {scheme:?}, robust: {n} allocations in 200 steps");

@@ -23,10 +23,12 @@
 //! assembled where it is defined.
 
 mod body;
+mod chain;
 mod joint;
 mod mechanism;
 pub mod rotation;
 
 pub use body::{Body, Rotation};
+pub use chain::chain;
 pub use joint::{Joint, JointKind};
 pub use mechanism::{Mechanism, SpatialBody};
