@@ -185,8 +185,8 @@ fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
 }
 
 fn spatial_chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
-    let (model, q0, v0) = cdyn::spatial::chain(n, 0.3, 1.0).build()?;
-    timed_chain(n, &model, &q0, &v0, t_end)
+    let built = cdyn::spatial::chain(n, 0.3, 1.0).build()?;
+    timed_chain(n, &built.model, &built.q0, &built.v0, t_end)
 }
 
 /// A chain's run at h = 1e-3, AB-3, with [`chain_control`].
@@ -370,7 +370,8 @@ pub fn run(light: bool) -> Result<Report> {
     // runs are shorter (N = 10 000 would take over an hour for 10 s).
     let (spatial_sizes, spatial_t_end): (&[usize], f64) =
         if light { (&[10, 100], 0.01) } else { (&[10, 100, 1000], 1.0) };
-    let spatial_chain = spatial_sizes.iter().map(|&n| spatial_chain_run(n, spatial_t_end)).collect::<Result<Vec<_>>>()?;
+    let spatial_chain =
+        spatial_sizes.iter().map(|&n| spatial_chain_run(n, spatial_t_end)).collect::<Result<Vec<_>>>()?;
     let fit = |runs: &[ChainRun]| {
         let points: Vec<(f64, f64)> = runs.iter().filter(|c| c.n >= 100).map(|c| (c.n as f64, c.us_per_step)).collect();
         fitted_exponent(&points)

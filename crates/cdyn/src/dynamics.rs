@@ -370,7 +370,9 @@ impl Dynamics {
             (Solver::Blocks(b), _) => {
                 let weighted = &b.weighted;
                 // SAFETY: as in `add_weighted_jt`.
-                scatter(model, weighted, -1.0, [y0, y1], [out0, out1], |s, j, _| unsafe { s * weighted.get_unchecked(j) })
+                scatter(model, weighted, -1.0, [y0, y1], [out0, out1], |s, j, _| unsafe {
+                    s * weighted.get_unchecked(j)
+                })
             }
             (Solver::General(g), _) => {
                 g.add_weighted_jt(model.n(), y0, -1.0, out0);

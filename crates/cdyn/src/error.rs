@@ -344,6 +344,16 @@ pub enum Problem {
         /// What is wrong with it.
         reason: &'static str,
     },
+    /// A joint key given to a kind that does not take it, or missing from one that needs it.
+    #[error("{}", if *wanted { format!("a {kind} joint needs {key}") } else { format!("a {kind} joint takes no {key}") })]
+    JointKey {
+        /// The key.
+        key: &'static str,
+        /// The joint's kind.
+        kind: &'static str,
+        /// Whether the kind needs it.
+        wanted: bool,
+    },
     /// A joint axis of zero (or non-finite) length.
     #[error("{name} has zero length")]
     ZeroAxis {

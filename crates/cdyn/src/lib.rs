@@ -29,8 +29,8 @@ pub mod reference;
 pub mod scalar;
 pub mod simulate;
 pub mod small;
-pub mod spatial;
 mod sparse;
+pub mod spatial;
 pub mod system;
 pub mod timefn;
 

@@ -216,10 +216,10 @@ fn block_layout(mass: &[f64], kinetic: &[Box<dyn KineticBlock>], pattern: &Patte
             }
         }
         for &c in cols {
-            if let Some(&b) = owner.get(c as usize).filter(|&&o| o != u32::MAX) {
-                if std::mem::take(&mut seen[b as usize]) % blocks[b as usize].len() != 0 {
-                    return None;
-                }
+            if let Some(&b) = owner.get(c as usize).filter(|&&o| o != u32::MAX)
+                && !std::mem::take(&mut seen[b as usize]).is_multiple_of(blocks[b as usize].len())
+            {
+                return None;
             }
         }
     }

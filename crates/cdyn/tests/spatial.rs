@@ -6,7 +6,7 @@
 use cdyn::dynamics::{Dynamics, LinearSolver};
 use cdyn::reference::elliptic::jacobi;
 use cdyn::spatial::rotation::{about, body_rate, compose, rate_from_body, rotate, space_rate};
-use cdyn::spatial::{Body, Joint, JointKind, Mechanism, SpatialBody};
+use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
 use cdyn::{Control, Error, Model, Scheme, Settings, Simulation, methods};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -24,28 +24,30 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
-/// Every kind of joint, its relative freedom, with `axis` (for the
-/// universal joint's second axis, one perpendicular to it).
-fn kinds(axis: [f64; 3], point_b: [f64; 3]) -> Vec<(JointKind, usize)> {
+/// Every kind of joint with its relative freedom, at `point` with `axis`
+/// (a universal joint's second axis perpendicular to it; a distance
+/// joint's second end at `point_b`).
+fn joints(point: [f64; 3], axis: [f64; 3], point_b: [f64; 3], b: Option<usize>) -> Vec<(Joint, usize)> {
     let other = unit(cross(axis, [0.3, -0.5, 0.8]));
+    let at = |kind| Joint::new(kind, 0, b, point);
     vec![
-        (JointKind::Spherical, 3),
-        (JointKind::Revolute, 1),
-        (JointKind::Universal { axis_b: other }, 2),
-        (JointKind::Cylindrical, 2),
-        (JointKind::Prismatic, 1),
-        (JointKind::Fixed, 0),
-        (JointKind::Distance { point_b }, 5),
+        (at(JointKind::Spherical), 3),
+        (at(JointKind::Revolute).axis(axis), 1),
+        (at(JointKind::Universal).axis(axis).axis_b(other), 2),
+        (at(JointKind::Cylindrical).axis(axis), 2),
+        (at(JointKind::Prismatic).axis(axis), 1),
+        (at(JointKind::Fixed).axis(axis), 0),
+        (at(JointKind::Distance).point_b(point_b), 5),
     ]
 }
 
-/// Two bodies at the given poses joined by `kind` at `point`, or one body
-/// and the ground.
-fn pair(kind: JointKind, grounded: bool, poses: [([f64; 3], [f64; 4]); 2], point: [f64; 3], axis: [f64; 3]) -> Mechanism {
+/// Two bodies at the given poses joined by `joint`, or one body and the
+/// ground (`joint.b` is `None`).
+fn pair(joint: Joint, poses: [([f64; 3], [f64; 4]); 2]) -> Mechanism {
     let bodies: Vec<Body> = poses
         .iter()
         .enumerate()
-        .take(if grounded { 1 } else { 2 })
+        .take(if joint.b.is_none() { 1 } else { 2 })
         .map(|(i, &(r, p))| Body {
             position: r,
             orientation: p,
@@ -53,8 +55,7 @@ fn pair(kind: JointKind, grounded: bool, poses: [([f64; 3], [f64; 4]); 2], point
             ..Body::new(&format!("b{i}"), 1.0 + i as f64, [1.0; 3])
         })
         .collect();
-    let b = (!grounded).then_some(1);
-    Mechanism { bodies, joints: vec![Joint { kind, a: 0, b, point, axis }], gravity: [0.0, 0.0, -9.81] }
+    Mechanism { bodies, joints: vec![joint], gravity: [0.0, 0.0, -9.81] }
 }
 
 fn phi(model: &Model, q: &[f64]) -> Vec<f64> {
@@ -92,8 +93,9 @@ proptest! {
         grounded in any::<bool>(),
     ) {
         let point_b = [point[0] + 0.5, point[1], point[2] - 0.3];
-        for (kind, _) in kinds(unit(axis), point_b) {
-            let (model, q0, _) = pair(kind, grounded, [(ra, pa), (rb, pb)], point, axis).build().unwrap();
+        for (joint, _) in joints(point, unit(axis), point_b, (!grounded).then_some(1)) {
+            let kind = joint.kind;
+            let Built { model, q0, .. } = pair(joint, [(ra, pa), (rb, pb)]).build().unwrap();
             let n = model.n();
             let q: Vec<f64> = q0.iter().zip(&dq).map(|(q, d)| q + d).collect();
             let v = &v[..n];
@@ -112,10 +114,14 @@ proptest! {
                 }
             }
             let along = |s: f64| phi(&model, &q.iter().zip(v).map(|(q, v)| q + s * v).collect::<Vec<_>>());
-            let hs = 1e-4;
+            // Φ along the line is a quartic in s (A(p) is quadratic in p): a
+            // shorter step for the first difference keeps its truncation
+            // error (h²/6 times the third derivative) below the tolerance.
+            let (hs, h1) = (1e-4, 1e-5);
             let (p1, p0, m1) = (along(hs), along(0.0), along(-hs));
+            let (f1, b1) = (along(h1), along(-h1));
             for r in 0..model.m() {
-                let first = (p1[r] - m1[r]) / (2.0 * hs);
+                let first = (f1[r] - b1[r]) / (2.0 * h1);
                 let second = (p1[r] - 2.0 * p0[r] + m1[r]) / (hs * hs);
                 prop_assert!(close(d.phi_dot()[r], first, 1e-6), "{kind:?} Φ̇[{r}]: AD {} vs FD {first}", d.phi_dot()[r]);
                 prop_assert!(close(-d.gamma()[r], second, 1e-5), "{kind:?} γ[{r}]: AD {} vs FD {}", d.gamma()[r], -second);
@@ -135,8 +141,10 @@ proptest! {
     ) {
         let axis = unit(axis);
         let point_b = [point[0] + 0.5, point[1], point[2] - 0.3];
-        for (kind, freedom) in kinds(axis, point_b) {
-            let (model, q, _) = pair(kind, false, [(ra, pa), (rb, pb)], point, axis).build().unwrap();
+        for (joint, freedom) in joints(point, axis, point_b, Some(1)) {
+            let kind = joint.kind;
+            let axis_b = joint.axis_b.unwrap_or_default();
+            let Built { model, q0: q, .. } = pair(joint, [(ra, pa), (rb, pb)]).build().unwrap();
             prop_assert!(phi(&model, &q).iter().all(|x| x.abs() < 1e-12), "{kind:?} not assembled");
             let mut d = Dynamics::new(&model);
             d.evaluate(&model, &q, &[0.0; 14], 0.0).unwrap();
@@ -160,11 +168,11 @@ proptest! {
             let allowed: Vec<Vec<f64>> = match kind {
                 JointKind::Spherical => (0..3).map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point, z)).collect(),
                 JointKind::Revolute => vec![motion(axis, point, z)],
-                JointKind::Universal { axis_b } => vec![motion(axis, point, z), motion(axis_b, point, z)],
+                JointKind::Universal => vec![motion(axis, point, z), motion(axis_b, point, z)],
                 JointKind::Cylindrical => vec![motion(axis, point, z), motion(z, point, axis)],
                 JointKind::Prismatic => vec![motion(z, point, axis)],
                 JointKind::Fixed => vec![],
-                JointKind::Distance { point_b } => (0..3)
+                JointKind::Distance => (0..3)
                     .map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point, z))
                     .chain((0..2).map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point_b, z)))
                     .collect(),
@@ -214,7 +222,7 @@ fn free_body(turn: [f64; 4]) -> Mechanism {
 /// (rotated into space: the principal axes start on the space axes), of
 /// `|p| − 1` and of the energy, over `t_end`.
 fn torque_free(turn: [f64; 4], h: f64, t_end: f64, control: Control) -> [f64; 3] {
-    let (model, q0, v0) = free_body(turn).build().unwrap();
+    let Built { model, q0, v0, .. } = free_body(turn).build().unwrap();
     let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, control), &q0, &v0).unwrap();
     let t0 = 0.5 * (0..3).map(|i| J[i] * W0[i] * W0[i]).sum::<f64>();
     let mut worst = [0.0_f64; 3];
@@ -265,12 +273,12 @@ fn heavy_top() -> Mechanism {
         angular_velocity: w0,
         ..Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
     };
-    let fixed = Joint { kind: JointKind::Spherical, a: 0, b: None, point: [0.0; 3], axis: [0.0, 0.0, 1.0] };
+    let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
     Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81] }
 }
 
 fn heavy_top_at(t_end: f64, h: f64, control: Control, solver: LinearSolver) -> (Vec<f64>, Vec<f64>) {
-    let (model, q0, v0) = heavy_top().build().unwrap();
+    let Built { model, q0, v0, .. } = heavy_top().build().unwrap();
     let settings = Settings { solver, ..Settings::new(Scheme::RungeKutta4, h, control) };
     let mut sim = Simulation::new(&model, settings, &q0, &v0).unwrap();
     sim.run::<Error>(t_end, u64::MAX, |_| Ok(())).unwrap();
@@ -289,7 +297,10 @@ fn the_heavy_top_agrees_with_the_published_values_at_0_2_s() {
         let (q, v) = heavy_top_at(0.2, 1e-4, control, LinearSolver::Auto);
         let p = SpatialBody::of(0).orientation(&q);
         let w = body_rate(p, SpatialBody::of(0).orientation(&v));
-        println!("heavy top at 0.2 s: p = {p:?}, ω′ = {w:?}, spatial ω = {:?}", space_rate(p, SpatialBody::of(0).orientation(&v)));
+        println!(
+            "heavy top at 0.2 s: p = {p:?}, ω′ = {w:?}, spatial ω = {:?}",
+            space_rate(p, SpatialBody::of(0).orientation(&v))
+        );
         for i in 0..4 {
             // Agreement to the digits published: within half a unit of the last one.
             let half = 0.5 * 10f64.powi(-decimals[i]);
@@ -307,7 +318,7 @@ fn block_diagonal_and_dense_mass_paths_agree() {
     let (dense, _) = heavy_top_at(0.05, 1e-4, Control::none(), LinearSolver::Dense);
     let gap = blocks.iter().zip(&dense).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     assert!(gap < 1e-12, "block path and dense path differ by {gap:e}");
-    let (model, ..) = heavy_top().build().unwrap();
+    let model = heavy_top().build().unwrap().model;
     assert_eq!(model.mass_blocks().map(<[_]>::len), Some(1));
 }
 
@@ -331,16 +342,17 @@ fn steady_precession(h: f64, t_end: f64, control: Control) -> (f64, f64, f64) {
         angular_velocity: rotate([p0[0], -p0[1], -p0[2], -p0[3]], w),
         ..Body::new("top", m, [ac, ac, c])
     };
-    let fixed = Joint { kind: JointKind::Spherical, a: 0, b: None, point: [0.0; 3], axis: [0.0, 0.0, 1.0] };
+    let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
     let mechanism = Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -g] };
-    let (model, q0, v0) = mechanism.build().unwrap();
+    let Built { model, q0, v0, .. } = mechanism.build().unwrap();
     let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, control), &q0, &v0).unwrap();
     let (mut tilt, mut azimuth) = (0.0_f64, 0.0_f64);
     sim.run::<Error>(t_end, (0.01 / h).round() as u64, |s| {
         let k = rotate(SpatialBody::of(0).orientation(s.q()), [0.0, 0.0, 1.0]);
         tilt = tilt.max((k[2].acos() - theta).abs());
         let turned = k[1].atan2(k[0]) - omega * s.t();
-        azimuth = azimuth.max(((turned + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI).abs());
+        azimuth = azimuth
+            .max(((turned + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI).abs());
         Ok(())
     })
     .unwrap();
@@ -352,13 +364,18 @@ fn a_symmetric_top_precesses_steadily_at_the_closed_form_rate() {
     let coarse = steady_precession(2e-4, 2.0, Control::none());
     let fine = steady_precession(1e-4, 2.0, Control::none());
     let robust = steady_precession(2e-4, 2.0, methods::robust());
-    println!("Ω = {:.6} rad/s; tilt and azimuth errors over 2 s: h = 2e-4 {:.2e} {:.2e}, h = 1e-4 {:.2e} {:.2e}, robust h = 2e-4 {:.2e} {:.2e}",
-        coarse.2, coarse.0, coarse.1, fine.0, fine.1, robust.0, robust.1);
+    println!(
+        "Ω = {:.6} rad/s; tilt and azimuth errors over 2 s: h = 2e-4 {:.2e} {:.2e}, h = 1e-4 {:.2e} {:.2e}, robust h = 2e-4 {:.2e} {:.2e}",
+        coarse.2, coarse.0, coarse.1, fine.0, fine.1, robust.0, robust.1
+    );
     // The precession turns Ω · 2 s ≈ 3 rad; the axis stays on its cone and
     // on schedule to the integrator's error, which falls at order four.
     assert!(fine.0 < 1e-7 && fine.1 < 1e-7, "{fine:?}");
     assert!(coarse.1 / fine.1 > 12.0, "no fourth-order convergence: {coarse:?} → {fine:?}");
-    assert!(robust.0 <= coarse.0 * 1.01 + 1e-12 && robust.1 <= coarse.1 * 1.01 + 1e-12, "robust {robust:?} vs none {coarse:?}");
+    assert!(
+        robust.0 <= coarse.0 * 1.01 + 1e-12 && robust.1 <= coarse.1 * 1.01 + 1e-12,
+        "robust {robust:?} vs none {coarse:?}"
+    );
 }
 
 /// The normalization `pᵀp = 1` held by each method of `cdyn compare`, on
@@ -369,7 +386,7 @@ fn every_method_holds_the_heavy_tops_normalization_and_robust_is_no_worse() {
     let (reference, _) = heavy_top_at(0.2, 2.5e-5, Control::none(), LinearSolver::Auto);
     let p_ref = SpatialBody::of(0).orientation(&reference);
     let run = |scheme: Scheme, h: f64, control: Control| {
-        let (model, q0, v0) = heavy_top().build().unwrap();
+        let Built { model, q0, v0, .. } = heavy_top().build().unwrap();
         let mut sim = Simulation::new(&model, Settings::new(scheme, h, control), &q0, &v0).unwrap();
         let mut drift = 0.0_f64;
         sim.run::<Error>(0.2, 10, |s| {
@@ -392,4 +409,54 @@ fn every_method_holds_the_heavy_tops_normalization_and_robust_is_no_worse() {
             }
         }
     }
+}
+
+/// Every refused input is one error naming the part and the reason.
+#[test]
+fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
+    let body = |f: &dyn Fn(&mut Body)| {
+        let mut b = Body::new("arm", 1.0, [1.0, 1.0, 1.0]);
+        f(&mut b);
+        let joint = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
+        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3] }.build().err().map(|e| e.to_string())
+    };
+    let cases: [(&dyn Fn(&mut Body), &str); 7] = [
+        (&|b| b.orientation = [0.0; 4], "body 0 (arm): orientation has length 0"),
+        (&|b| b.orientation = [0.9, 0.1, 0.0, 0.0], "unit quaternion"),
+        (&|b| b.orientation[1] = f64::NAN, "orientation has length NaN"),
+        (&|b| b.inertia[2][2] = -1.0, "body 0 (arm): inertia must be positive definite"),
+        (&|b| b.inertia = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 3.0]], "not physical"),
+        (&|b| b.inertia[0][1] = 0.5, "symmetric"),
+        (&|b| b.mass = 0.0, "body 0 (arm): mass = 0"),
+    ];
+    for (change, expected) in cases {
+        let message = body(change).expect("refused");
+        assert!(message.contains(expected), "{message:?} should contain {expected:?}");
+    }
+    // A unit quaternion typed to 7 digits is normalized, not refused.
+    assert_eq!(body(&|b| b.orientation = [0.7071068, 0.7071068, 0.0, 0.0]), None);
+
+    let two = |joint: Joint<String>| {
+        let bodies = vec![Body::new("a", 1.0, [1.0; 3]), Body::new("b", 1.0, [1.0; 3])];
+        Mechanism::named(bodies, vec![joint], [0.0; 3]).and_then(|m| m.build()).err().map(|e| e.to_string())
+    };
+    let joint = |kind| Joint { kind, a: "a".to_string(), b: Some("b".to_string()), point: [0.0; 3], axis: None, axis_b: None, point_b: None };
+    let cases = [
+        (Joint { axis: Some([0.0; 3]), ..joint(JointKind::Revolute) }, "element 0 (revolute): axis has zero length"),
+        (joint(JointKind::Revolute), "element 0 (revolute): a revolute joint needs axis"),
+        (Joint { axis: Some([1.0, 0.0, 0.0]), ..joint(JointKind::Spherical) }, "a spherical joint takes no axis"),
+        (Joint { axis: Some([1.0, 0.0, 0.0]), axis_b: Some([1.0, 1.0, 0.0]), ..joint(JointKind::Universal) }, "perpendicular"),
+        (Joint { point_b: Some([0.0; 3]), ..joint(JointKind::Distance) }, "point_b must differ from point"),
+        (Joint { a: "c".to_string(), ..joint(JointKind::Spherical) }, "a = \"c\": no body of that name"),
+        (Joint { b: Some("a".to_string()), ..joint(JointKind::Spherical) }, "connects a to itself"),
+        (Joint { point: [f64::INFINITY, 0.0, 0.0], ..joint(JointKind::Spherical) }, "point = inf must be finite"),
+    ];
+    for (j, expected) in cases {
+        let message = two(j).expect("refused");
+        assert!(message.contains(expected), "{message:?} should contain {expected:?}");
+    }
+    // The ground is `b` omitted or named; duplicate and reserved body names are refused.
+    assert_eq!(two(Joint { b: Some("ground".to_string()), ..joint(JointKind::Spherical) }), None);
+    let dup = Mechanism::named(vec![Body::new("a", 1.0, [1.0; 3]), Body::new("a", 1.0, [1.0; 3])], vec![], [0.0; 3]);
+    assert!(dup.unwrap_err().to_string().contains("body 1 (a): a body with this name already exists"));
 }

@@ -6,27 +6,58 @@ use crate::error::{Problem, Result, positive};
 use crate::kinetic::Kinetic;
 use crate::scalar::Scalar;
 
-/// A rigid body as the user describes it, at the initial instant.
+/// A rigid body as the user describes it, at the initial instant; in a
+/// scenario file a `[[bodies]]` entry with these keys (`orientation`,
+/// `velocity` and `angular_velocity` may be omitted).
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
 pub struct Body {
-    /// Its name, for error messages and output.
+    /// Its name, for joints, error messages and output; unique, not `ground`.
     pub name: String,
     /// Mass.
     pub mass: f64,
     /// Inertia tensor about the centre of mass, in body axes (symmetric
     /// positive definite, and physical: each principal moment at most the
-    /// sum of the other two).
+    /// sum of the other two). Scenario files give the principal moments
+    /// `[Ixx, Iyy, Izz]` or the whole tensor `[[..], [..], [..]]`.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "tensor"))]
     pub inertia: [[f64; 3]; 3],
     /// Centre of mass in space.
     pub position: [f64; 3],
     /// Euler parameters of the body axes (scalar first). A unit quaternion
     /// to round-off (within 1e-6 of unit length, then normalized); any
     /// other length is refused rather than guessed at.
+    #[cfg_attr(feature = "serde", serde(default = "identity"))]
     pub orientation: [f64; 4],
     /// Velocity of the centre of mass.
+    #[cfg_attr(feature = "serde", serde(default))]
     pub velocity: [f64; 3],
     /// Angular velocity, in body axes.
+    #[cfg_attr(feature = "serde", serde(default))]
     pub angular_velocity: [f64; 3],
+}
+
+#[cfg(feature = "serde")]
+fn identity() -> [f64; 4] {
+    [1.0, 0.0, 0.0, 0.0]
+}
+
+/// Principal moments `[a, b, c]` or a whole tensor.
+#[cfg(feature = "serde")]
+fn tensor<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[[f64; 3]; 3], D::Error> {
+    #[derive(serde::Deserialize)]
+    #[serde(untagged)]
+    enum Given {
+        Principal([f64; 3]),
+        Full([[f64; 3]; 3]),
+    }
+    match serde::Deserialize::deserialize(d) {
+        Ok(Given::Principal([a, b, c])) => Ok([[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]]),
+        Ok(Given::Full(j)) => Ok(j),
+        Err::<Given, D::Error>(_) => Err(serde::de::Error::custom(
+            "expected the principal moments [Ixx, Iyy, Izz] or a 3 × 3 tensor [[..], [..], [..]]",
+        )),
+    }
 }
 
 impl Body {
@@ -48,7 +79,9 @@ impl Body {
         positive("mass", self.mass)?;
         let finite = |x: &[f64]| x.iter().all(|x| x.is_finite());
         let j = &self.inertia;
-        if !j.iter().all(|r| finite(r)) || (0..3).any(|a| (0..a).any(|b| (j[a][b] - j[b][a]).abs() > 1e-12 * (j[a][a] + j[b][b]).abs())) {
+        if !j.iter().all(|r| finite(r))
+            || (0..3).any(|a| (0..a).any(|b| (j[a][b] - j[b][a]).abs() > 1e-12 * (j[a][a] + j[b][b]).abs()))
+        {
             return Err(Problem::Inertia { reason: "must be finite and symmetric" }.into());
         }
         let moments = principal_moments(j);
@@ -57,9 +90,16 @@ impl Body {
         }
         let [a, b, c] = moments;
         if c > (a + b) * (1.0 + 1e-12) {
-            return Err(Problem::Inertia { reason: "is not physical: a principal moment exceeds the sum of the other two" }.into());
+            return Err(Problem::Inertia {
+                reason: "is not physical: a principal moment exceeds the sum of the other two",
+            }
+            .into());
         }
-        for (name, x) in [("position", &self.position[..]), ("velocity", &self.velocity), ("angular_velocity", &self.angular_velocity)] {
+        for (name, x) in [
+            ("position", &self.position[..]),
+            ("velocity", &self.velocity),
+            ("angular_velocity", &self.angular_velocity),
+        ] {
             if !finite(x) {
                 return Err(Problem::Parameter { name, value: f64::NAN, reason: "must be finite" }.into());
             }

@@ -27,13 +27,7 @@ pub fn chain(n: usize, theta0: f64, g: f64) -> Mechanism {
         })
         .collect();
     let joints = (0..n)
-        .map(|i| Joint {
-            kind: JointKind::Spherical,
-            a: i,
-            b: i.checked_sub(1),
-            point: end(i),
-            axis: [0.0, 0.0, 1.0],
-        })
+        .map(|i| Joint::new(JointKind::Spherical, i, i.checked_sub(1), end(i)))
         .collect();
     Mechanism { bodies, joints, gravity: [0.0, 0.0, -g] }
 }

@@ -23,31 +23,26 @@ use super::rotation::rotate;
 use crate::constraint::Constraint;
 use crate::scalar::Scalar;
 
-/// What a joint allows.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What a joint allows (its `kind` in scenario files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(rename_all = "snake_case"))]
 pub enum JointKind {
     /// Rotation about the point.
     Spherical,
     /// Rotation about the axis through the point.
     Revolute,
-    /// Rotation about the axis on body `a` and about `axis_b` on body `b`
-    /// (perpendicular to the axis at the initial pose).
-    Universal {
-        /// The second axis, in space at the initial pose.
-        axis_b: [f64; 3],
-    },
+    /// Rotation about `axis` on body `a` and about `axis_b` on body `b`
+    /// (perpendicular to `axis` at the initial pose).
+    Universal,
     /// Rotation about and sliding along the axis.
     Cylindrical,
     /// Sliding along the axis.
     Prismatic,
     /// No relative motion (a weld).
     Fixed,
-    /// A massless rod from the point on `a` to `point_b` on `b`, keeping
+    /// A massless rod from `point` on `a` to `point_b` on `b`, keeping
     /// their initial distance.
-    Distance {
-        /// The rod's end on body `b`, in space at the initial pose.
-        point_b: [f64; 3],
-    },
+    Distance,
 }
 
 impl JointKind {
@@ -56,39 +51,80 @@ impl JointKind {
         match self {
             JointKind::Spherical => 3,
             JointKind::Revolute | JointKind::Prismatic => 5,
-            JointKind::Universal { .. } | JointKind::Cylindrical => 4,
+            JointKind::Universal | JointKind::Cylindrical => 4,
             JointKind::Fixed => 6,
-            JointKind::Distance { .. } => 1,
+            JointKind::Distance => 1,
         }
     }
 
-    /// Its name in messages.
+    /// Its name in scenario files and messages.
     pub fn name(&self) -> &'static str {
         match self {
             JointKind::Spherical => "spherical",
             JointKind::Revolute => "revolute",
-            JointKind::Universal { .. } => "universal",
+            JointKind::Universal => "universal",
             JointKind::Cylindrical => "cylindrical",
             JointKind::Prismatic => "prismatic",
             JointKind::Fixed => "fixed",
-            JointKind::Distance { .. } => "distance",
+            JointKind::Distance => "distance",
+        }
+    }
+
+    /// Whether it takes `axis`, `axis_b` and `point_b`.
+    pub(crate) fn keys(&self) -> [bool; 3] {
+        match self {
+            JointKind::Spherical => [false, false, false],
+            JointKind::Universal => [true, true, false],
+            JointKind::Distance => [false, false, true],
+            _ => [true, false, false],
         }
     }
 }
 
-/// A joint as the user describes it, at the initial pose.
+/// A joint as the user describes it, at the initial pose; in a scenario
+/// file a `[[joints]]` entry, its bodies named (`B = String`, `b` omitted
+/// or `"ground"` for the ground).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Joint {
+#[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
+pub struct Joint<B = usize> {
     /// What it allows.
     pub kind: JointKind,
-    /// The first body (its index in the mechanism).
-    pub a: usize,
+    /// The first body.
+    pub a: B,
     /// The second body, or `None` for the ground.
-    pub b: Option<usize>,
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub b: Option<B>,
     /// The joint's point, in space.
     pub point: [f64; 3],
-    /// Its axis, in space (any length but zero; ignored by spherical and distance joints).
-    pub axis: [f64; 3],
+    /// Its axis, in space (any length but zero): for revolute, universal,
+    /// cylindrical, prismatic and fixed joints only.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub axis: Option<[f64; 3]>,
+    /// A universal joint's axis on body `b`, in space.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub axis_b: Option<[f64; 3]>,
+    /// A distance joint's end on body `b`, in space.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub point_b: Option<[f64; 3]>,
+}
+
+impl Joint {
+    /// A joint of `kind` between `a` and `b` (`None`: the ground) at `point`, without axes.
+    pub fn new(kind: JointKind, a: usize, b: Option<usize>, point: [f64; 3]) -> Self {
+        Self { kind, a, b, point, axis: None, axis_b: None, point_b: None }
+    }
+    /// With its axis.
+    pub fn axis(self, axis: [f64; 3]) -> Self {
+        Self { axis: Some(axis), ..self }
+    }
+    /// With a universal joint's second axis.
+    pub fn axis_b(self, axis_b: [f64; 3]) -> Self {
+        Self { axis_b: Some(axis_b), ..self }
+    }
+    /// With a distance joint's second point.
+    pub fn point_b(self, point_b: [f64; 3]) -> Self {
+        Self { point_b: Some(point_b), ..self }
+    }
 }
 
 /// A joint's frame on one side: point `s` and axes `(f, g, h)`, in the
@@ -155,7 +191,7 @@ impl<const R: usize> JointRows<R> {
                 put(3, dot(a.axis(F), hb));
                 put(4, dot(a.axis(G), hb));
             }
-            JointKind::Universal { .. } => {
+            JointKind::Universal => {
                 (0..3).for_each(|i| put(i, d[i]));
                 put(3, dot(a.axis(H), b.axis(H)));
             }
@@ -175,7 +211,7 @@ impl<const R: usize> JointRows<R> {
                 put(4, dot(a.axis(G), b.axis(H)));
                 put(5, dot(a.axis(H), b.axis(F)));
             }
-            JointKind::Distance { .. } => put(0, dot(d, d) - self.length2),
+            JointKind::Distance => put(0, dot(d, d) - self.length2),
         }
         out
     }

@@ -3,11 +3,12 @@
 
 use super::body::{Body, Rotation};
 use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows, UnitNorm};
-use super::rotation::{rate_from_body, rotate, unrotate};
+use super::rotation::{rate_from_body, unrotate};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::Potential;
 use crate::model::{Model, ModelBuilder};
 use crate::scalar::Scalar;
+use std::collections::HashMap;
 
 /// Bodies, joints and uniform gravity.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -18,6 +19,21 @@ pub struct Mechanism {
     pub joints: Vec<Joint>,
     /// Gravitational acceleration, in space.
     pub gravity: [f64; 3],
+}
+
+/// A mechanism's model, its initial state (as given, not yet projected
+/// onto the constraints: see [`crate::assemble`]) and, for every
+/// constraint row, the part it comes from: [`Part::Body`] for a body's
+/// normalization, [`Part::Element`] for a joint.
+pub struct Built {
+    /// The equations of motion.
+    pub model: Model,
+    /// Initial positions.
+    pub q0: Vec<f64>,
+    /// Initial velocities.
+    pub v0: Vec<f64>,
+    /// The part behind each constraint row.
+    pub rows: Vec<Part>,
 }
 
 /// Where a body's coordinates are: `r` at `first .. first + 3`, `p` at
@@ -51,6 +67,11 @@ impl SpatialBody {
     }
 }
 
+/// The names of a body's coordinates: `name.x`, `name.y`, `name.z`, `name.e0` … `name.e3`.
+pub fn coordinate_names(name: &str) -> [String; 7] {
+    ["x", "y", "z", "e0", "e1", "e2", "e3"].map(|c| format!("{name}.{c}"))
+}
+
 /// `−m g · r`
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Gravity {
@@ -78,7 +99,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// A right-handed frame `(f, g, h)` with axis `h`.
 fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
     // Start from the space axis least aligned with h.
-    let k = (0..3).min_by(|&i, &j| h[i].abs().total_cmp(&h[j].abs())).unwrap();
+    let k = (0..3).min_by(|&i, &j| h[i].abs().total_cmp(&h[j].abs())).unwrap_or(0);
     let e: [f64; 3] = std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
     let f = cross(cross(h, e), h);
     let norm = f.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -87,33 +108,70 @@ fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
 }
 
 impl Mechanism {
-    /// The model, with the initial positions and velocities as given (not
-    /// yet projected onto the constraints: see [`crate::assemble`]).
-    pub fn build(&self) -> Result<(Model, Vec<f64>, Vec<f64>)> {
+    /// A mechanism whose joints name their bodies (`b` omitted or
+    /// `"ground"` for the ground), as scenario files do.
+    pub fn named(bodies: Vec<Body>, joints: Vec<Joint<String>>, gravity: [f64; 3]) -> Result<Self> {
+        let mut index = HashMap::new();
+        for (i, body) in bodies.iter().enumerate() {
+            let at = || Part::Body { index: i, name: body.name.clone() };
+            if body.name.is_empty() || body.name == crate::planar::GROUND {
+                return Err(Problem::ReservedName { name: body.name.clone() }.at(at()));
+            }
+            if index.insert(body.name.as_str(), i).is_some() {
+                return Err(Problem::DuplicateName.at(at()));
+            }
+        }
+        let resolve = |key: &'static str, name: &str| match index.get(name) {
+            Some(&i) => Ok(Some(i)),
+            None if name == crate::planar::GROUND && key == "b" => Ok(None),
+            None => Err(Error::from(Problem::UnknownBody { key, name: name.to_string() })),
+        };
+        let joints = joints
+            .into_iter()
+            .enumerate()
+            .map(|(k, j)| {
+                let at = Part::Element { index: k, kind: j.kind.name() };
+                let a = resolve("a", &j.a).map_err(|e| e.at(at.clone()))?.ok_or_else(|| {
+                    Problem::UnknownBody { key: "a", name: j.a.clone() }.at(at.clone())
+                })?;
+                let b = match &j.b {
+                    Some(name) => resolve("b", name).map_err(|e| e.at(at.clone()))?,
+                    None => None,
+                };
+                Ok(Joint { kind: j.kind, a, b, point: j.point, axis: j.axis, axis_b: j.axis_b, point_b: j.point_b })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self { bodies, joints, gravity })
+    }
+
+    /// The model, its initial state and the part behind each row.
+    pub fn build(&self) -> Result<Built> {
         let n = 7 * self.bodies.len();
         let mut mass = vec![0.0; n];
-        let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
+        let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
         let mut poses = Vec::with_capacity(self.bodies.len());
         for (i, body) in self.bodies.iter().enumerate() {
             let at = Part::Body { index: i, name: body.name.clone() };
             let p = body.check().map_err(|e| e.at(at.clone()))?;
             let b = SpatialBody::of(i);
             mass[b.first..b.first + 3].fill(body.mass);
-            q[b.first..b.first + 3].copy_from_slice(&body.position);
-            q[b.first + 3..b.first + 7].copy_from_slice(&p);
-            v[b.first..b.first + 3].copy_from_slice(&body.velocity);
-            v[b.first + 3..b.first + 7].copy_from_slice(&rate_from_body(p, body.angular_velocity));
+            q0[b.first..b.first + 3].copy_from_slice(&body.position);
+            q0[b.first + 3..b.first + 7].copy_from_slice(&p);
+            v0[b.first..b.first + 3].copy_from_slice(&body.velocity);
+            v0[b.first + 3..b.first + 7].copy_from_slice(&rate_from_body(p, body.angular_velocity));
             poses.push((body.position, p));
         }
         for g in self.gravity {
             crate::error::finite("gravity", g)?;
         }
+        let mut rows = Vec::new();
         let mut builder = Model::builder(mass);
         for (i, body) in self.bodies.iter().enumerate() {
             let b = SpatialBody::of(i);
             builder = builder
                 .kinetic(Rotation::new(body.inertia), b.euler_parameters())
                 .constrain(UnitNorm, b.euler_parameters());
+            rows.push(Part::Body { index: i, name: body.name.clone() });
             if self.gravity != [0.0; 3] {
                 let weight = self.gravity.map(|g| g * body.mass);
                 builder = builder.potential(Gravity { weight }, [b.first, b.first + 1, b.first + 2]);
@@ -121,9 +179,10 @@ impl Mechanism {
         }
         for (index, joint) in self.joints.iter().enumerate() {
             let at = Part::Element { index, kind: joint.kind.name() };
-            builder = self.add_joint(builder, joint, &poses).map_err(|e| e.at(at))?;
+            builder = self.add_joint(builder, joint, &poses).map_err(|e| e.at(at.clone()))?;
+            rows.extend(std::iter::repeat_n(at, joint.kind.rows()));
         }
-        Ok((builder.build()?, q, v))
+        Ok(Built { model: builder.build()?, q0, v0, rows })
     }
 
     fn add_joint(&self, builder: ModelBuilder, joint: &Joint, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
@@ -133,32 +192,51 @@ impl Mechanism {
             return Err(Problem::SameBody { body: self.bodies[joint.a].name.clone() }.into());
         }
         let b = joint.b.map(pose).transpose()?;
-        if joint.point.iter().any(|x| !x.is_finite()) {
-            return Err(Problem::Parameter { name: "point", value: f64::NAN, reason: "must be finite" }.into());
+        let [wants_axis, wants_axis_b, wants_point_b] = joint.kind.keys();
+        let kind = joint.kind.name();
+        for (key, wanted, given) in [
+            ("axis", wants_axis, joint.axis.is_some()),
+            ("axis_b", wants_axis_b, joint.axis_b.is_some()),
+            ("point_b", wants_point_b, joint.point_b.is_some()),
+        ] {
+            if wanted != given {
+                return Err(Problem::JointKey { key, kind, wanted }.into());
+            }
         }
-        let (axes_a, axes_b) = match joint.kind {
-            JointKind::Spherical | JointKind::Distance { .. } => (frame_about([0.0, 0.0, 1.0]), frame_about([0.0, 0.0, 1.0])),
-            JointKind::Universal { axis_b } => {
-                let (ha, hb) = (unit("axis", joint.axis)?, unit("axis_b", axis_b)?);
+        let given = joint.point.iter().chain(joint.point_b.iter().flatten());
+        if given.clone().any(|x| !x.is_finite()) {
+            let value = given.copied().find(|x| !x.is_finite()).unwrap_or(f64::NAN);
+            return Err(Problem::Parameter { name: "point", value, reason: "must be finite" }.into());
+        }
+        let z = frame_about([0.0, 0.0, 1.0]);
+        let axes_a = joint.axis.map(|a| unit("axis", a)).transpose()?;
+        let axes_b = joint.axis_b.map(|a| unit("axis_b", a)).transpose()?;
+        let (axes_a, axes_b) = match (axes_a, axes_b) {
+            (Some(ha), Some(hb)) => {
                 let c = ha[0] * hb[0] + ha[1] * hb[1] + ha[2] * hb[2];
                 if c.abs() > 1e-9 {
-                    return Err(Problem::Parameter { name: "axis · axis_b", value: c, reason: "must be 0: a universal joint's axes are perpendicular" }.into());
+                    return Err(Problem::Parameter {
+                        name: "axis · axis_b",
+                        value: c,
+                        reason: "must be 0: a universal joint's axes are perpendicular",
+                    }
+                    .into());
                 }
                 (frame_about(ha), frame_about(hb))
             }
-            _ => {
-                let h = frame_about(unit("axis", joint.axis)?);
-                (h, h)
-            }
+            (Some(h), None) => (frame_about(h), frame_about(h)),
+            _ => (z, z),
         };
-        let point_b = match joint.kind {
-            JointKind::Distance { point_b } => point_b,
-            _ => joint.point,
-        };
+        let point_b = joint.point_b.unwrap_or(joint.point);
         let d: [f64; 3] = std::array::from_fn(|i| point_b[i] - joint.point[i]);
         let length2 = d.iter().map(|x| x * x).sum::<f64>();
-        if matches!(joint.kind, JointKind::Distance { .. }) && !(length2 > 0.0 && length2.is_finite()) {
-            return Err(Problem::Parameter { name: "length", value: length2.sqrt(), reason: "must be finite and positive: point_b must differ from point" }.into());
+        if joint.kind == JointKind::Distance && length2 == 0.0 {
+            return Err(Problem::Parameter {
+                name: "length",
+                value: 0.0,
+                reason: "must be positive: point_b must differ from point",
+            }
+            .into());
         }
         let in_body = |(r, p): ([f64; 3], [f64; 4]), point: [f64; 3], axes: [[f64; 3]; 3]| Frame {
             s: unrotate(p, std::array::from_fn(|i| point[i] - r[i])),
@@ -169,10 +247,6 @@ impl Mechanism {
             Some(pose) => in_body(pose, point_b, axes_b),
             None => Frame { s: point_b, axes: axes_b },
         };
-        debug_assert!({
-            let x = rotate(pa, fa.s);
-            (0..3).all(|i| (ra[i] + x[i] - joint.point[i]).abs() < 1e-9 * (1.0 + joint.point[i].abs()))
-        });
         let a_at = SpatialBody::of(joint.a).coordinates();
         macro_rules! add {
             ($r:literal) => {{

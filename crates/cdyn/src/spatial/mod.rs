@@ -31,4 +31,4 @@ pub mod rotation;
 pub use body::{Body, Rotation};
 pub use chain::chain;
 pub use joint::{Joint, JointKind};
-pub use mechanism::{Mechanism, SpatialBody};
+pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
