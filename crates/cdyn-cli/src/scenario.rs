@@ -36,13 +36,28 @@ pub struct Scenario {
     pub forces: Vec<Element<String>>,
     /// Axes of a parameter sweep (`cdyn sweep`): key → values.
     pub sweep: Option<toml::Table>,
+    /// The `[[bodies]]` and `[[joints]]` of a spatial mechanism (`kind =
+    /// "spatial"`), read by the spatial types instead of the planar ones.
+    #[serde(skip)]
+    pub spatial: Option<SpatialEntries>,
 }
 
-/// `gravity`: a magnitude for the pendulums, a vector for mechanisms.
+/// A spatial mechanism's entries, bodies named by the joints.
+#[derive(Debug, Deserialize, Clone, Default)]
+pub struct SpatialEntries {
+    #[serde(default)]
+    pub bodies: Vec<cdyn::spatial::Body>,
+    #[serde(default)]
+    pub joints: Vec<cdyn::spatial::Joint<String>>,
+}
+
+/// `gravity`: a magnitude for the pendulums, a vector for mechanisms
+/// (three components for spatial ones).
 #[derive(Debug, Clone, Copy)]
 pub enum GravitySpec {
     Magnitude(f64),
     Vector([f64; 2]),
+    Vector3([f64; 3]),
 }
 
 impl<'de> Deserialize<'de> for GravitySpec {
@@ -56,7 +71,12 @@ impl<'de> Deserialize<'de> for GravitySpec {
             toml::Value::Array(a) if a.len() == 2 && a.iter().all(|x| number(x).is_some()) => {
                 Ok(GravitySpec::Vector([number(&a[0]).unwrap_or_default(), number(&a[1]).unwrap_or_default()]))
             }
-            _ => Err(serde::de::Error::custom("expected a magnitude g (pendulums) or a vector [gx, gy] (mechanisms)")),
+            toml::Value::Array(a) if a.len() == 3 && a.iter().all(|x| number(x).is_some()) => {
+                Ok(GravitySpec::Vector3(std::array::from_fn(|i| number(&a[i]).unwrap_or_default())))
+            }
+            _ => Err(serde::de::Error::custom(
+                "expected a magnitude g (pendulums), a vector [gx, gy] (mechanisms) or [gx, gy, gz] (spatial mechanisms)",
+            )),
         }
     }
 }
@@ -144,10 +164,26 @@ pub fn parse(text: &str, file: &str) -> Result<(Scenario, toml::Table)> {
 pub fn from_table(table: toml::Table, file: &str) -> Result<(Scenario, toml::Table)> {
     // The library's types check every key; the path to a refused one names
     // the table, entry and key as the file writes them.
-    let scenario = serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
-        let place = locate(&[], &table, e.path());
-        anyhow!("{file}: {place}{}", reason(e.inner()))
-    })?;
+    fn read<T: serde::de::DeserializeOwned>(table: &toml::Table, file: &str) -> Result<T> {
+        serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(|e| {
+            let place = locate(&[], table, e.path());
+            anyhow!("{file}: {place}{}", reason(e.inner()))
+        })
+    }
+    // A spatial mechanism's bodies and joints have their own types.
+    let spatial = table.get("model").and_then(|m| m.get("kind")).and_then(|k| k.as_str()) == Some("spatial");
+    if spatial && (table.contains_key("drives") || table.contains_key("forces")) {
+        bail!("{file}: a spatial mechanism takes [[bodies]] and [[joints]] only (no [[drives]] or [[forces]] yet)");
+    }
+    let (mut scenario, entries): (Scenario, Option<SpatialEntries>) = if spatial {
+        let mut rest = table.clone();
+        let entries: toml::Table =
+            ["bodies", "joints"].into_iter().filter_map(|key| rest.remove(key).map(|v| (key.to_string(), v))).collect();
+        (read(&rest, file)?, Some(read(&entries, file)?))
+    } else {
+        (read(&table, file)?, None)
+    };
+    scenario.spatial = entries;
     Ok((scenario, table))
 }
 
@@ -299,7 +335,7 @@ impl Scenario {
                 default.clone_from(given);
             }
         }
-        let assembly = if init.assemble.unwrap_or(self.model.kind == Kind::Mechanism) {
+        let assembly = if init.assemble.unwrap_or(self.model.kind.is_described()) {
             let tolerance = settings.consistency_tolerance.unwrap_or(1e-9).min(1e-10);
             let Example { model, q0, v0, .. } = &mut example;
             Some(assemble_with(model, q0, v0, 0.0, tolerance, settings.dependent_rows).map_err(|e| {
@@ -345,7 +381,7 @@ impl Scenario {
             bail!("{file}: [[bodies]], [[joints]], [[drives]] and [[forces]] need [model] kind = \"mechanism\"");
         }
         let pendulum = matches!(m.kind, Kind::Pendulum | Kind::PendulumTheta);
-        if m.parameters.is_some() && (pendulum || m.kind == Kind::Mechanism) {
+        if m.parameters.is_some() && (pendulum || m.kind.is_described()) {
             bail!(
                 "{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none"
             );
@@ -363,7 +399,7 @@ impl Scenario {
                     Some(GravitySpec::Magnitude(g)) => {
                         parameters.insert("gravity".into(), toml::Value::Float(g));
                     }
-                    Some(GravitySpec::Vector(_)) => {
+                    Some(GravitySpec::Vector(_) | GravitySpec::Vector3(_)) => {
                         bail!("{file}: [model] gravity: the pendulum takes a magnitude (gravity acts along −Y)")
                     }
                 }
@@ -379,6 +415,11 @@ impl Scenario {
                     Some(GravitySpec::Magnitude(g)) => {
                         bail!("{file}: [model] gravity = {g}: a mechanism takes a finite vector [gx, gy]")
                     }
+                    Some(GravitySpec::Vector3(_)) => {
+                        bail!(
+                            "{file}: [model] gravity: a planar mechanism takes a vector [gx, gy]; kind = \"spatial\" takes [gx, gy, gz]"
+                        )
+                    }
                 };
                 if self.bodies.is_empty() {
                     bail!("{file}: a mechanism needs at least one [[bodies]] entry");
@@ -388,6 +429,32 @@ impl Scenario {
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
                 Ok((Example::from_mechanism(built, None), rows))
+            }
+            Kind::Spatial => {
+                let gravity = match m.gravity {
+                    None => [0.0; 3],
+                    Some(GravitySpec::Vector3(g)) if g.iter().all(|x| x.is_finite()) => g,
+                    _ => bail!("{file}: [model] gravity: a spatial mechanism takes a finite vector [gx, gy, gz]"),
+                };
+                let entries = self.spatial.clone().unwrap_or_default();
+                if entries.bodies.is_empty() {
+                    bail!("{file}: a spatial mechanism needs at least one [[bodies]] entry");
+                }
+                let part = |part: &Part| match part {
+                    Part::Body { index, name } => format!("bodies[{index}] ({name})"),
+                    Part::Element { index, kind } => format!("joints[{index}] ({kind})"),
+                    other => other.to_string(),
+                };
+                let mechanism = cdyn::spatial::Mechanism::named(entries.bodies, entries.joints, gravity);
+                let built = mechanism.and_then(|m| m.build().map(|b| (m, b))).map_err(|e| match e {
+                    cdyn::Error::InvalidModel { at: at @ (Part::Body { .. } | Part::Element { .. }), problem } => {
+                        anyhow!("{file}: {}: {problem}", part(&at))
+                    }
+                    other => anyhow!("{file}: {other}"),
+                })?;
+                let (mechanism, built) = built;
+                let rows = built.rows.iter().map(part).collect();
+                Ok((Example::from_spatial(&mechanism, built), rows))
             }
             built_in => {
                 if m.gravity.is_some() {

@@ -202,7 +202,8 @@ fn steps_do_not_allocate() {
     let angles = double_pendulum_angles(DoublePendulumParams::default()).unwrap();
     let four_bar =
         four_bar_angles(FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() }).unwrap();
-    let cdyn::spatial::Built { model: spatial, q0: sq0, v0: sv0, .. } = cdyn::spatial::chain(40, 0.3, 1.0).build().unwrap();
+    let cdyn::spatial::Built { model: spatial, q0: sq0, v0: sv0, .. } =
+        cdyn::spatial::chain(40, 0.3, 1.0).build().unwrap();
     assert!(spatial.mass_blocks().is_some());
     assert!(count() > before);
     for scheme in Scheme::ALL {

@@ -440,12 +440,23 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         let bodies = vec![Body::new("a", 1.0, [1.0; 3]), Body::new("b", 1.0, [1.0; 3])];
         Mechanism::named(bodies, vec![joint], [0.0; 3]).and_then(|m| m.build()).err().map(|e| e.to_string())
     };
-    let joint = |kind| Joint { kind, a: "a".to_string(), b: Some("b".to_string()), point: [0.0; 3], axis: None, axis_b: None, point_b: None };
+    let joint = |kind| Joint {
+        kind,
+        a: "a".to_string(),
+        b: Some("b".to_string()),
+        point: [0.0; 3],
+        axis: None,
+        axis_b: None,
+        point_b: None,
+    };
     let cases = [
         (Joint { axis: Some([0.0; 3]), ..joint(JointKind::Revolute) }, "element 0 (revolute): axis has zero length"),
         (joint(JointKind::Revolute), "element 0 (revolute): a revolute joint needs axis"),
         (Joint { axis: Some([1.0, 0.0, 0.0]), ..joint(JointKind::Spherical) }, "a spherical joint takes no axis"),
-        (Joint { axis: Some([1.0, 0.0, 0.0]), axis_b: Some([1.0, 1.0, 0.0]), ..joint(JointKind::Universal) }, "perpendicular"),
+        (
+            Joint { axis: Some([1.0, 0.0, 0.0]), axis_b: Some([1.0, 1.0, 0.0]), ..joint(JointKind::Universal) },
+            "perpendicular",
+        ),
         (Joint { point_b: Some([0.0; 3]), ..joint(JointKind::Distance) }, "point_b must differ from point"),
         (Joint { a: "c".to_string(), ..joint(JointKind::Spherical) }, "a = \"c\": no body of that name"),
         (Joint { b: Some("a".to_string()), ..joint(JointKind::Spherical) }, "connects a to itself"),

@@ -26,6 +26,10 @@ pub enum Kind {
     /// ([`Mechanism`](crate::planar::Mechanism)): not built from parameters,
     /// so [`Kind::example`] refuses it.
     Mechanism,
+    /// A spatial mechanism described body by body and joint by joint
+    /// ([`spatial::Mechanism`](crate::spatial::Mechanism)): not built from
+    /// parameters either.
+    Spatial,
     /// Andrews' squeezing mechanism at the test set's initial state:
     /// [`andrews`](super::andrews()), no parameters.
     Andrews,
@@ -53,10 +57,11 @@ pub enum Kind {
 
 impl Kind {
     /// Every kind, in declaration order.
-    pub const ALL: [Kind; 12] = [
+    pub const ALL: [Kind; 13] = [
         Kind::Pendulum,
         Kind::PendulumTheta,
         Kind::Mechanism,
+        Kind::Spatial,
         Kind::Andrews,
         Kind::DoublePendulum,
         Kind::DoublePendulumAngles,
@@ -67,6 +72,12 @@ impl Kind {
         Kind::MovingSupportPendulum,
         Kind::DampedPendulum,
     ];
+
+    /// Whether models of this kind are described body by body in the
+    /// scenario (`[[bodies]]`, `[[joints]]`) rather than built from parameters.
+    pub fn is_described(self) -> bool {
+        matches!(self, Kind::Mechanism | Kind::Spatial)
+    }
 
     /// The model of this kind, built from `parameters`: a map of the keys of
     /// its parameter struct, where unset keys keep the defaults and unknown
@@ -85,6 +96,9 @@ impl Kind {
             Kind::Mechanism => Err(D::Error::custom(
                 "a mechanism is built from its bodies, joints, drives and forces, not from parameters",
             )),
+            Kind::Spatial => {
+                Err(D::Error::custom("a spatial mechanism is built from its bodies and joints, not from parameters"))
+            }
             Kind::Andrews => build(parameters, |NoParameters {}| andrews()),
             Kind::DoublePendulum => build(parameters, double_pendulum),
             Kind::DoublePendulumAngles => build(parameters, double_pendulum_angles),
@@ -123,10 +137,10 @@ mod tests {
     }
 
     #[test]
-    fn every_kind_but_mechanism_builds_from_no_parameters() {
+    fn every_kind_but_the_described_ones_builds_from_no_parameters() {
         for kind in Kind::ALL {
             let built = kind.example(no_parameters());
-            if kind == Kind::Mechanism {
+            if kind.is_described() {
                 assert!(built.is_err());
             } else {
                 let example = built.unwrap().unwrap_or_else(|e| panic!("{kind:?}: {e}"));
@@ -140,7 +154,7 @@ mod tests {
         for kind in Kind::ALL {
             let map = MapDeserializer::<_, Error>::new([("no_such_key", 1.0)].into_iter());
             let e = kind.example(map).err().unwrap_or_else(|| panic!("{kind:?} accepted an unknown key"));
-            if kind != Kind::Mechanism {
+            if !kind.is_described() {
                 assert!(e.to_string().contains("no_such_key"), "{kind:?}: {e}");
             }
         }

@@ -94,6 +94,21 @@ impl Example {
         }
     }
 
+    /// A spatial mechanism as an example whose observables are its
+    /// coordinates (`name.x` … `name.e3` for each body), without reference or drawing.
+    pub fn from_spatial(mechanism: &crate::spatial::Mechanism, built: crate::spatial::Built) -> Self {
+        let n = built.model.n();
+        Example {
+            model: built.model,
+            q0: built.q0,
+            v0: built.v0,
+            observables: mechanism.bodies.iter().flat_map(|b| crate::spatial::coordinate_names(&b.name)).collect(),
+            observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
+            reference: None,
+            drawing: None,
+        }
+    }
+
     /// The observables of the state `(q, v)`.
     pub fn observe(&self, q: &[f64], v: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.observables.len()];

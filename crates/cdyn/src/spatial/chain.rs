@@ -26,8 +26,6 @@ pub fn chain(n: usize, theta0: f64, g: f64) -> Mechanism {
             ..Body::new(&format!("rod{i}"), mass, [1.0; 3])
         })
         .collect();
-    let joints = (0..n)
-        .map(|i| Joint::new(JointKind::Spherical, i, i.checked_sub(1), end(i)))
-        .collect();
+    let joints = (0..n).map(|i| Joint::new(JointKind::Spherical, i, i.checked_sub(1), end(i))).collect();
     Mechanism { bodies, joints, gravity: [0.0, 0.0, -g] }
 }

@@ -108,8 +108,8 @@ fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
 }
 
 impl Mechanism {
-    /// A mechanism whose joints name their bodies (`b` omitted or
-    /// `"ground"` for the ground), as scenario files do.
+    /// A mechanism whose joints name their bodies (`"ground"`, or `b`
+    /// omitted, for the ground), as scenario files do.
     pub fn named(bodies: Vec<Body>, joints: Vec<Joint<String>>, gravity: [f64; 3]) -> Result<Self> {
         let mut index = HashMap::new();
         for (i, body) in bodies.iter().enumerate() {
@@ -123,7 +123,7 @@ impl Mechanism {
         }
         let resolve = |key: &'static str, name: &str| match index.get(name) {
             Some(&i) => Ok(Some(i)),
-            None if name == crate::planar::GROUND && key == "b" => Ok(None),
+            None if name == crate::planar::GROUND => Ok(None),
             None => Err(Error::from(Problem::UnknownBody { key, name: name.to_string() })),
         };
         let joints = joints
@@ -131,14 +131,34 @@ impl Mechanism {
             .enumerate()
             .map(|(k, j)| {
                 let at = Part::Element { index: k, kind: j.kind.name() };
-                let a = resolve("a", &j.a).map_err(|e| e.at(at.clone()))?.ok_or_else(|| {
-                    Problem::UnknownBody { key: "a", name: j.a.clone() }.at(at.clone())
-                })?;
+                let a = resolve("a", &j.a).map_err(|e| e.at(at.clone()))?;
                 let b = match &j.b {
                     Some(name) => resolve("b", name).map_err(|e| e.at(at.clone()))?,
                     None => None,
                 };
-                Ok(Joint { kind: j.kind, a, b, point: j.point, axis: j.axis, axis_b: j.axis_b, point_b: j.point_b })
+                match (a, b) {
+                    (Some(a), b) => Ok(Joint {
+                        kind: j.kind,
+                        a,
+                        b,
+                        point: j.point,
+                        axis: j.axis,
+                        axis_b: j.axis_b,
+                        point_b: j.point_b,
+                    }),
+                    // `a = "ground"`: the same joint seen from `b`, each
+                    // side's point and axis going with its body.
+                    (None, Some(b)) => Ok(Joint {
+                        kind: j.kind,
+                        a: b,
+                        b: None,
+                        point: j.point_b.unwrap_or(j.point),
+                        axis: j.axis_b.or(j.axis),
+                        axis_b: j.axis_b.and(j.axis),
+                        point_b: j.point_b.and(Some(j.point)),
+                    }),
+                    (None, None) => Err(Problem::SameBody { body: crate::planar::GROUND.to_string() }.at(at)),
+                }
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(Self { bodies, joints, gravity })
