@@ -176,6 +176,11 @@ pub enum Part {
         /// What the block is: "a constraint", "a potential", "a force".
         what: &'static str,
     },
+    /// An element of a URDF file: `link "forearm"`, `joint "elbow"`.
+    Urdf {
+        /// Its kind and name.
+        element: String,
+    },
     /// The initial positions and velocities.
     InitialState,
     /// Projecting the initial state onto the constraints.
@@ -192,6 +197,7 @@ impl std::fmt::Display for Part {
             Part::Body { index, name } => write!(f, "body {index} ({name}): "),
             Part::Element { index, kind } => write!(f, "element {index} ({kind}): "),
             Part::Block { what } => write!(f, "{what}: "),
+            Part::Urdf { element } => write!(f, "{element}: "),
             Part::InitialState => write!(f, "initial state: "),
             Part::Assembly => write!(f, "assembly: "),
             Part::Support(axis) => write!(f, "support {axis}(t): "),
@@ -353,6 +359,12 @@ pub enum Problem {
         kind: &'static str,
         /// Whether the kind needs it.
         wanted: bool,
+    },
+    /// A URDF file that cdyn cannot take, and why.
+    #[error("{reason}")]
+    Urdf {
+        /// Why.
+        reason: String,
     },
     /// A joint axis of zero (or non-finite) length.
     #[error("{name} has zero length")]

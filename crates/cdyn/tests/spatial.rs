@@ -55,7 +55,7 @@ fn pair(joint: Joint, poses: [([f64; 3], [f64; 4]); 2]) -> Mechanism {
             ..Body::new(&format!("b{i}"), 1.0 + i as f64, [1.0; 3])
         })
         .collect();
-    Mechanism { bodies, joints: vec![joint], gravity: [0.0, 0.0, -9.81] }
+    Mechanism { bodies, joints: vec![joint], gravity: [0.0, 0.0, -9.81], dampers: vec![] }
 }
 
 fn phi(model: &Model, q: &[f64]) -> Vec<f64> {
@@ -215,7 +215,7 @@ fn free_body(turn: [f64; 4]) -> Mechanism {
         angular_velocity: rotate(turn, W0),
         ..Body::new("top", 2.0, J)
     };
-    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3] }
+    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3], dampers: vec![] }
 }
 
 /// Largest error of the spatial angular velocity against Euler's solution
@@ -274,7 +274,7 @@ fn heavy_top() -> Mechanism {
         ..Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
     };
     let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-    Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81] }
+    Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81], dampers: vec![] }
 }
 
 fn heavy_top_at(t_end: f64, h: f64, control: Control, solver: LinearSolver) -> (Vec<f64>, Vec<f64>) {
@@ -343,7 +343,7 @@ fn steady_precession(h: f64, t_end: f64, control: Control) -> (f64, f64, f64) {
         ..Body::new("top", m, [ac, ac, c])
     };
     let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-    let mechanism = Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -g] };
+    let mechanism = Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -g], dampers: vec![] };
     let Built { model, q0, v0, .. } = mechanism.build().unwrap();
     let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, control), &q0, &v0).unwrap();
     let (mut tilt, mut azimuth) = (0.0_f64, 0.0_f64);
@@ -418,7 +418,7 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         let mut b = Body::new("arm", 1.0, [1.0, 1.0, 1.0]);
         f(&mut b);
         let joint = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3] }.build().err().map(|e| e.to_string())
+        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3], dampers: vec![] }.build().err().map(|e| e.to_string())
     };
     let cases: [(&dyn Fn(&mut Body), &str); 7] = [
         (&|b| b.orientation = [0.0; 4], "body 0 (arm): orientation has length 0"),

@@ -2,6 +2,7 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation};
+use super::damper::{BodyDamper, Damper, GroundDamper};
 use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows, UnitNorm};
 use super::rotation::{rate_from_body, unrotate};
 use crate::error::{Error, Part, Problem, Result};
@@ -19,6 +20,8 @@ pub struct Mechanism {
     pub joints: Vec<Joint>,
     /// Gravitational acceleration, in space.
     pub gravity: [f64; 3],
+    /// Rotary dampers (a URDF joint's `damping`), placed at the initial pose.
+    pub dampers: Vec<Damper>,
 }
 
 /// A mechanism's model, its initial state (as given, not yet projected
@@ -161,7 +164,7 @@ impl Mechanism {
                 }
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { bodies, joints, gravity })
+        Ok(Self { bodies, joints, gravity, dampers: Vec::new() })
     }
 
     /// The model, its initial state and the part behind each row.
@@ -202,7 +205,26 @@ impl Mechanism {
             builder = self.add_joint(builder, joint, &poses).map_err(|e| e.at(at.clone()))?;
             rows.extend(std::iter::repeat_n(at, joint.kind.rows()));
         }
+        for damper in &self.dampers {
+            builder = self.add_damper(builder, damper, &poses)?;
+        }
         Ok(Built { model: builder.build()?, q0, v0, rows })
+    }
+
+    fn add_damper(&self, builder: ModelBuilder, d: &Damper, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
+        crate::error::non_negative("damping", d.c)?;
+        let axis = unit("axis", d.axis)?;
+        let (_, pa) = *poses.get(d.a).ok_or(Error::from(Problem::NoSuchBody { index: d.a }))?;
+        let a = SpatialBody::of(d.a).euler_parameters();
+        Ok(match d.b {
+            Some(b) => {
+                poses.get(b).ok_or(Error::from(Problem::NoSuchBody { index: b }))?;
+                let b = SpatialBody::of(b).euler_parameters();
+                let at: [usize; 8] = std::array::from_fn(|i| if i < 4 { a[i] } else { b[i - 4] });
+                builder.force(BodyDamper { axis: unrotate(pa, axis), c: d.c }, at)
+            }
+            None => builder.force(GroundDamper { axis, c: d.c }, a),
+        })
     }
 
     fn add_joint(&self, builder: ModelBuilder, joint: &Joint, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {

@@ -24,11 +24,17 @@
 
 mod body;
 mod chain;
+mod damper;
 mod joint;
 mod mechanism;
 pub mod rotation;
+#[cfg(feature = "urdf")]
+mod urdf;
 
 pub use body::{Body, Rotation};
 pub use chain::chain;
+pub use damper::Damper;
 pub use joint::{Joint, JointKind};
+#[cfg(feature = "urdf")]
+pub use urdf::from_urdf;
 pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
