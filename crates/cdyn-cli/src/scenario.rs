@@ -139,7 +139,22 @@ pub fn load(path: &Path) -> Result<Scenario> {
 /// Reads and checks a scenario file; also returns the parsed table, which
 /// identifies the scenario by content (`cdyn merge`), whatever its path.
 pub fn load_with_table(path: &Path) -> Result<(Scenario, toml::Table)> {
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) {
+        return from_table(urdf_scenario(path), &path.display().to_string());
+    }
     parse(&read_bounded(path)?, &path.display().to_string())
+}
+
+/// `cdyn run robot.urdf`: the robot falling from its zero pose under
+/// gravity −z for 1 s, RK-4 at h = 1e-3, `robust`; a scenario file with
+/// `[model] kind = "spatial"` and `urdf = "…"` chooses otherwise.
+fn urdf_scenario(path: &Path) -> toml::Table {
+    let text = format!(
+        "[model]\nkind = \"spatial\"\nurdf = {}\ngravity = [0.0, 0.0, -9.81]\n[integrator]\nscheme = \"rk4\"\nh = 1e-3\nt_end = 1.0\n[output]\nevery = 10\n",
+        // Read relative to the file's own folder, as a scenario's `urdf` is.
+        toml::Value::String(path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()))
+    );
+    toml::from_str(&text).expect("a valid scenario")
 }
 
 /// Reads and checks the scenario `text`; `file` names it in errors (the
@@ -386,7 +401,8 @@ impl Scenario {
                 "{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none"
             );
         }
-        if !pendulum && let Some(key) = m.pendulum_keys.keys().next() {
+        let own_keys = |key: &String| pendulum || (m.kind == Kind::Spatial && key == "urdf");
+        if let Some(key) = m.pendulum_keys.keys().find(|k| !own_keys(k)) {
             bail!(
                 "{file}: [model] {key}: only the pendulum models take parameters in [model]; the other built-in models take theirs in [model.parameters]"
             );
@@ -437,15 +453,15 @@ impl Scenario {
                     _ => bail!("{file}: [model] gravity: a spatial mechanism takes a finite vector [gx, gy, gz]"),
                 };
                 let entries = self.spatial.clone().unwrap_or_default();
-                if entries.bodies.is_empty() {
-                    bail!("{file}: a spatial mechanism needs at least one [[bodies]] entry");
-                }
+                let (mechanism, (robot_bodies, robot_joints)) = self.spatial_mechanism(file, entries, gravity)?;
+                // The robot's parts by their URDF names, the scenario's by entry.
                 let part = |part: &Part| match part {
-                    Part::Body { index, name } => format!("bodies[{index}] ({name})"),
-                    Part::Element { index, kind } => format!("joints[{index}] ({kind})"),
+                    Part::Body { index, name } if *index < robot_bodies => format!("urdf link {name:?}"),
+                    Part::Body { index, name } => format!("bodies[{}] ({name})", index - robot_bodies),
+                    Part::Element { index, kind } if *index < robot_joints => format!("urdf joint {index} ({kind})"),
+                    Part::Element { index, kind } => format!("joints[{}] ({kind})", index - robot_joints),
                     other => other.to_string(),
                 };
-                let mechanism = cdyn::spatial::Mechanism::named(entries.bodies, entries.joints, gravity);
                 let built = mechanism.and_then(|m| m.build().map(|b| (m, b))).map_err(|e| match e {
                     cdyn::Error::InvalidModel { at: at @ (Part::Body { .. } | Part::Element { .. }), problem } => {
                         anyhow!("{file}: {}: {problem}", part(&at))
@@ -464,6 +480,56 @@ impl Scenario {
                 Ok((builtin(file, built_in, "model.parameters", parameters)?, Vec::new()))
             }
         }
+    }
+
+    /// The spatial mechanism of the `urdf` file named in `[model]` (relative
+    /// to the scenario's folder), if any, and of the `[[bodies]]` and
+    /// `[[joints]]` entries, which may name the robot's links; with the
+    /// numbers of bodies and joints that come from the robot (first).
+    fn spatial_mechanism(
+        &self,
+        file: &str,
+        entries: SpatialEntries,
+        gravity: [f64; 3],
+    ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, (usize, usize))> {
+        let mut robot = cdyn::spatial::Mechanism::default();
+        match self.model.pendulum_keys.get("urdf") {
+            None => {}
+            Some(toml::Value::String(name)) => {
+                let path = Path::new(file).parent().unwrap_or(Path::new("")).join(name);
+                let text = read_bounded(&path).map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
+                robot = cdyn::spatial::from_urdf(&text, gravity)
+                    .map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
+            }
+            Some(other) => bail!("{file}: [model] urdf = {other}: expected the path of a URDF file"),
+        }
+        if robot.bodies.is_empty() && entries.bodies.is_empty() {
+            bail!("{file}: a spatial mechanism needs at least one [[bodies]] entry or a urdf file");
+        }
+        // The robot's joints by name, then the scenario's: one list, so that
+        // errors name joints[k] counting the scenario's own from 0 after the robot's.
+        let name = |i: usize| robot.bodies[i].name.clone();
+        let mut joints: Vec<cdyn::spatial::Joint<String>> = robot
+            .joints
+            .iter()
+            .map(|j| cdyn::spatial::Joint {
+                kind: j.kind,
+                a: name(j.a),
+                b: Some(j.b.map_or(cdyn::planar::GROUND.to_string(), name)),
+                point: j.point,
+                axis: j.axis,
+                axis_b: j.axis_b,
+                point_b: j.point_b,
+            })
+            .collect();
+        let counts = (robot.bodies.len(), joints.len());
+        joints.extend(entries.joints);
+        let mut bodies = robot.bodies;
+        bodies.extend(entries.bodies);
+        let dampers = robot.dampers;
+        let mechanism =
+            cdyn::spatial::Mechanism::named(bodies, joints, gravity).map(|m| cdyn::spatial::Mechanism { dampers, ..m });
+        Ok((mechanism, counts))
     }
 
     /// The element lists in the order the mechanism takes them.

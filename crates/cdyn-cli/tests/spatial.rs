@@ -118,3 +118,76 @@ fn bad_spatial_entries_get_one_line_naming_the_entry() {
         assert!(!dir.join("out").join("bad.csv").exists(), "output written for a refused scenario");
     }
 }
+
+#[test]
+fn a_urdf_robot_runs_alone_and_with_a_loop_closure_from_the_scenario() {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("alone");
+    let result = cdyn(&["run", path_str(&examples.join("arm.urdf")), "--out", path_str(&out)]);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    let (header, rows) = table(&out.join("arm.csv"));
+    assert_eq!(&header[1..4], ["upper.x", "upper.y", "upper.z"]);
+    assert_eq!(rows.last().unwrap()[0], 1.0);
+    // The tethered arm: the scenario's distance rod holds the hand's point at 1 m from its anchor.
+    let out = dir.path().join("tethered");
+    let result = cdyn(&["run", path_str(&examples.join("arm_tethered.toml")), "--out", path_str(&out)]);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["cases"][0]["max_abs_phi"].as_f64().unwrap() < 1e-10, "{summary}");
+    let (_, tethered) = table(&out.join("arm_tethered.csv"));
+    let (_, alone) = table(&dir.path().join("alone/arm.csv"));
+    // Held up, the hand falls less far in the first second than alone.
+    let z = 17; // hand.z: t, then 7 coordinates per body, the hand third
+    let drop = |rows: &[Vec<f64>]| {
+        rows[0][z] - rows.iter().filter(|r| r[0] <= 1.0).map(|r| r[z]).fold(f64::INFINITY, f64::min)
+    };
+    assert!(drop(&tethered) < drop(&alone) && drop(&alone) > 0.05, "{} vs {}", drop(&tethered), drop(&alone));
+}
+
+#[test]
+fn bad_urdf_references_get_one_line_naming_the_file_and_element() {
+    let arm = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/arm.urdf")).unwrap();
+    let scenario_text = example("arm_tethered.toml");
+    let cases: Vec<(&str, String, String, &[&str])> = vec![
+        (
+            "missing",
+            arm.clone(),
+            scenario_text.replace("urdf = \"arm.urdf\"", "urdf = \"nowhere.urdf\""),
+            &["[model] urdf = \"nowhere.urdf\"", "cannot read"],
+        ),
+        (
+            "malformed",
+            "<robot name=\"x\"><link".into(),
+            scenario_text.clone(),
+            &["[model] urdf = \"arm.urdf\"", "not a valid URDF"],
+        ),
+        (
+            "planar",
+            arm.replace("type=\"continuous\"", "type=\"planar\""),
+            scenario_text.clone(),
+            &["joint \"wrist\": type planar is not supported"],
+        ),
+        (
+            "link",
+            arm.clone(),
+            scenario_text.replace("a = \"hand\"", "a = \"palm\""),
+            &["joints[0] (distance): a = \"palm\": no body of that name"],
+        ),
+        (
+            "key",
+            arm.clone(),
+            scenario_text.replace("urdf = \"arm.urdf\"", "urdf = \"arm.urdf\"\nscale = 2.0"),
+            &["[model] scale"],
+        ),
+    ];
+    for (name, urdf, text, expected) in cases {
+        let (dir, path) = scenario("bad.toml", &text);
+        std::fs::write(dir.join("arm.urdf"), urdf).unwrap();
+        let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+        for e in expected {
+            assert!(line.contains(e), "{name}: {line:?} should contain {e:?}");
+        }
+    }
+}

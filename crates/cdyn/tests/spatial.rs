@@ -418,7 +418,10 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         let mut b = Body::new("arm", 1.0, [1.0, 1.0, 1.0]);
         f(&mut b);
         let joint = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3], dampers: vec![] }.build().err().map(|e| e.to_string())
+        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3], dampers: vec![] }
+            .build()
+            .err()
+            .map(|e| e.to_string())
     };
     let cases: [(&dyn Fn(&mut Body), &str); 7] = [
         (&|b| b.orientation = [0.0; 4], "body 0 (arm): orientation has length 0"),

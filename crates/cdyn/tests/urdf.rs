@@ -145,7 +145,15 @@ impl Force<1> for ElbowDamping {
 }
 
 /// The hand's centre of mass over time, every 10 ms up to `t_end`.
-fn hand_path(model: &Model, q0: &[f64], v0: &[f64], h: f64, t_end: f64, control: Control, hand: impl Fn(&[f64]) -> [f64; 3]) -> Vec<[f64; 3]> {
+fn hand_path(
+    model: &Model,
+    q0: &[f64],
+    v0: &[f64],
+    h: f64,
+    t_end: f64,
+    control: Control,
+    hand: impl Fn(&[f64]) -> [f64; 3],
+) -> Vec<[f64; 3]> {
     let mut sim = Simulation::new(model, Settings::new(Scheme::RungeKutta4, h, control), q0, v0).unwrap();
     let mut path = Vec::new();
     sim.run::<Error>(t_end, (0.01 / h).round() as u64, |s| {
@@ -177,7 +185,9 @@ fn the_urdf_arm_in_redundant_coordinates_follows_its_joint_space_dynamics() {
         assert!((0..3).all(|k| (r[k] - c[k]).abs() < 1e-14), "link {i}: {r:?} vs {c:?}");
     }
     let (t_end, h) = (1.0, 1e-3);
-    let redundant = |h, control| hand_path(&built.model, &built.q0, &built.v0, h, t_end, control, |q| SpatialBody::of(2).position(q));
+    let redundant = |h, control| {
+        hand_path(&built.model, &built.q0, &built.v0, h, t_end, control, |q| SpatialBody::of(2).position(q))
+    };
     let joints = hand_path(&joint_space, &[0.0; 3], &[0.0; 3], h, t_end, Control::none(), |q| {
         kinematics([q[0], q[1], q[2]], [0.0; 3])[2].0
     });
@@ -215,12 +225,30 @@ fn bad_urdf_files_are_refused_naming_the_element() {
     let cases = [
         ("<robot name=\"x\"><link name=\"a\"/>", "not a valid URDF"),
         (&*ARM.replace("type=\"continuous\"", "type=\"planar\""), "joint \"wrist\": type planar is not supported"),
-        (&*ARM.replace("<dynamics damping=\"0.1\" friction=\"0\"/>", "<dynamics damping=\"0.1\" friction=\"0.5\"/>"), "joint \"shoulder_pitch\": friction = 0.5"),
-        (&*ARM.replace("<child link=\"fore\"/>", "<child link=\"elbow\"/>"), "joint \"shoulder_pitch\": link \"elbow\" does not exist"),
-        (&*ARM.replace("<mass value=\"0.8\"/>", "<mass value=\"0\"/>"), "link \"hand\": has no mass but joint \"wrist\" moves it"),
+        (
+            &*ARM.replace("<dynamics damping=\"0.1\" friction=\"0\"/>", "<dynamics damping=\"0.1\" friction=\"0.5\"/>"),
+            "joint \"shoulder_pitch\": friction = 0.5",
+        ),
+        (
+            &*ARM.replace("<child link=\"fore\"/>", "<child link=\"elbow\"/>"),
+            "joint \"shoulder_pitch\": link \"elbow\" does not exist",
+        ),
+        (
+            &*ARM.replace("<mass value=\"0.8\"/>", "<mass value=\"0\"/>"),
+            "link \"hand\": has no mass but joint \"wrist\" moves it",
+        ),
         (&*ARM.replace("<mass value=\"0.8\"/>", "<mass value=\"-0.8\"/>"), "body 2 (hand): mass = -0.8"),
-        (&*ARM.replace("ixx=\"0.001\" ixy=\"0\" ixz=\"0\" iyy=\"0.008\"", "ixx=\"0.001\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\""), "body 2 (hand): inertia is not physical"),
-        (&*ARM.replace("<link name=\"tool\"/>", "<link name=\"tool\"/><link name=\"spare\"/>"), "2 root links (base_link, spare)"),
+        (
+            &*ARM.replace(
+                "ixx=\"0.001\" ixy=\"0\" ixz=\"0\" iyy=\"0.008\"",
+                "ixx=\"0.001\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\"",
+            ),
+            "body 2 (hand): inertia is not physical",
+        ),
+        (
+            &*ARM.replace("<link name=\"tool\"/>", "<link name=\"tool\"/><link name=\"spare\"/>"),
+            "2 root links (base_link, spare)",
+        ),
         (&*ARM.replace("<axis xyz=\"0 1 0\"/>", "<axis xyz=\"0 0 0\"/>"), "axis has zero length"),
     ];
     for (text, expected) in cases {

@@ -35,6 +35,6 @@ pub use body::{Body, Rotation};
 pub use chain::chain;
 pub use damper::Damper;
 pub use joint::{Joint, JointKind};
+pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
 #[cfg(feature = "urdf")]
 pub use urdf::from_urdf;
-pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};

@@ -67,7 +67,10 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
         [] => return Err(Problem::Urdf { reason: "no root link (the joints form a loop)".into() }.into()),
         many => {
             let names: Vec<&str> = many.iter().map(|&i| robot.links[i].name.as_str()).collect();
-            return Err(Problem::Urdf { reason: format!("{} root links ({}): one is the fixed base", names.len(), names.join(", ")) }.into());
+            return Err(Problem::Urdf {
+                reason: format!("{} root links ({}): one is the fixed base", names.len(), names.join(", ")),
+            }
+            .into());
         }
     };
     // Link poses at zero joint positions, parents first.
@@ -85,7 +88,10 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
         }
     }
     if order.len() < robot.links.len() {
-        return Err(Problem::Urdf { reason: "some links are not connected to the root (the joints form a loop)".into() }.into());
+        return Err(Problem::Urdf {
+            reason: "some links are not connected to the root (the joints form a loop)".into(),
+        }
+        .into());
     }
     // Bodies: the massive links but the root.
     let mut body_of: Vec<Option<usize>> = vec![None; robot.links.len()];
@@ -128,7 +134,11 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
             T::Fixed => Some(JointKind::Fixed),
             T::Floating => None,
             T::Planar | T::Spherical => {
-                return Err(refused("joint", &j.name, format!("type {:?} is not supported", j.joint_type).to_lowercase()));
+                return Err(refused(
+                    "joint",
+                    &j.name,
+                    format!("type {:?} is not supported", j.joint_type).to_lowercase(),
+                ));
             }
         };
         if damping != 0.0 && kind != Some(JointKind::Revolute) {
@@ -139,7 +149,11 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
                 carrier[l] = parent;
                 continue;
             }
-            return Err(refused("link", &robot.links[l].name, format!("has no mass but joint {:?} moves it: give it an <inertial>", j.name)));
+            return Err(refused(
+                "link",
+                &robot.links[l].name,
+                format!("has no mass but joint {:?} moves it: give it an <inertial>", j.name),
+            ));
         };
         carrier[l] = Some(child);
         if let Some(kind) = kind {
