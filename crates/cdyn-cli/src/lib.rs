@@ -21,4 +21,5 @@ pub mod suite;
 pub mod suite_plot;
 pub mod sweep;
 pub mod terminal;
+pub mod view3d;
 pub mod viewer;

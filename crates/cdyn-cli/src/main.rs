@@ -4,7 +4,8 @@
 use anyhow::{Context, Result, bail};
 use cdyn_cli::terminal::print;
 use cdyn_cli::{
-    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal, viewer,
+    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal, view3d,
+    viewer,
 };
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -226,6 +227,9 @@ fn run(cli: Cli) -> Result<Ended> {
             });
             report::write_summary(&out, &results, extra)?;
             report::write_figures(&out, &results[0].name, &results, report::RUN_FIGURES)?;
+            if let Some(sketch) = &case.example.sketch {
+                view3d::write(&out, &results[0].name, sketch, &results[0].frames)?;
+            }
             viewer.write(&out, &results[0].name, std::slice::from_ref(&case), &results)?;
             print(&report::table(&results))?;
             print(&format!("wrote {}\n", out.display()))?;

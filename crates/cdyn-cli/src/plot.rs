@@ -41,7 +41,7 @@ pub struct Figure<'a> {
 }
 
 const FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 const SIZE: (u32, u32) = (1200, 800);
 /// Upper bound on tick labels per axis; also sets how many decimals a label needs.
 const TICKS: usize = 10;

@@ -31,7 +31,8 @@ pub fn file_names(cases: &[Case], stems: Stems) -> Vec<String> {
     let figures = stems.iter().flat_map(|s| ["png", "svg"].map(|ext| format!("{s}.{ext}")));
     // The viewer's files too: a run without --html leaves no page of an earlier run.
     let viewer = ["summary.json", crate::viewer::FILE, crate::viewer::GIF].map(String::from);
-    csv.chain(figures).chain(viewer).collect()
+    let view3d = ["png", "svg"].map(|ext| format!("{}.{ext}", crate::view3d::STEM));
+    csv.chain(figures).chain(viewer).chain(view3d).collect()
 }
 
 /// Writes `dir/summary.json` with every case; `interrupted` says whether a

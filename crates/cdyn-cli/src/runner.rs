@@ -308,7 +308,7 @@ fn simulate<K: Sink>(
 ) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     let mut frames = match watch {
-        Watch::Interrupts(_) if ex.drawing.is_some() => Frames::of(ex.model.n()),
+        Watch::Interrupts(_) if ex.drawing.is_some() || ex.sketch.is_some() => Frames::of(ex.model.n()),
         _ => Frames::none(),
     };
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {

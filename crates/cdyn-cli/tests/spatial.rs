@@ -33,6 +33,12 @@ fn table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 #[test]
 fn the_heavy_top_example_ends_on_the_published_euler_parameters() {
     let out = run("heavy_top", &example("heavy_top.toml"));
+    // The 3-D view at four instants, besides the figures of every run.
+    for file in ["mechanism.png", "mechanism.svg", "phi.png", "psi.svg"] {
+        assert!(out.join(file).metadata().is_ok_and(|m| m.len() > 1000), "{file}");
+    }
+    let svg = std::fs::read_to_string(out.join("mechanism.svg")).unwrap();
+    assert!(svg.contains("t = 0.0000 s") && svg.contains("t = 0.2000 s"), "the first and last instants");
     let (header, rows) = table(&out.join("heavy_top.csv"));
     let last = rows.last().unwrap();
     assert_eq!(last[0], 0.2);

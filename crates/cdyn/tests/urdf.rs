@@ -87,9 +87,17 @@ fn links() -> [Link; 3] {
     ]
 }
 
-/// For each link at `θ` (with rates `θ̇`): centre of mass, its velocity,
-/// the angular velocity and the inertia tensor in space.
-fn kinematics<D: Scalar>(theta: [D; 3], rate: [D; 3]) -> [([D; 3], [D; 3], [D; 3], M3<D>); 3] {
+/// A link at one state, in space: centre of mass, its velocity, the
+/// angular velocity and the inertia tensor.
+struct LinkState<D> {
+    c: [D; 3],
+    vc: [D; 3],
+    w: [D; 3],
+    inertia: M3<D>,
+}
+
+/// Each link at `θ` (with rates `θ̇`).
+fn kinematics<D: Scalar>(theta: [D; 3], rate: [D; 3]) -> [LinkState<D>; 3] {
     let (mut r, mut o, mut w, mut v) = (constant::<D>(rpy([0.0; 3])), [D::zero(); 3], [D::zero(); 3], [D::zero(); 3]);
     let links = links();
     std::array::from_fn(|i| {
@@ -112,7 +120,7 @@ fn kinematics<D: Scalar>(theta: [D; 3], rate: [D; 3]) -> [([D; 3], [D; 3], [D; 3
         let rc = mat_mul(&r, &constant(rpy(l.com_rpy)));
         let rt: M3<D> = std::array::from_fn(|a| std::array::from_fn(|b| rc[b][a]));
         let inertia = mat_mul(&rc, &mat_mul(&constant(l.inertia), &rt));
-        (c, std::array::from_fn(|k| v[k] + vc[k]), w, inertia)
+        LinkState { c, vc: std::array::from_fn(|k| v[k] + vc[k]), w, inertia }
     })
 }
 
@@ -120,8 +128,8 @@ struct ArmKinetic;
 impl Kinetic<3> for ArmKinetic {
     fn energy<D: Scalar>(&self, theta: [D; 3], rate: [D; 3]) -> D {
         let links = links();
-        kinematics(theta, rate).iter().zip(&links).fold(D::zero(), |t, ((_, vc, w, j), l)| {
-            let jw = mat_vec(j, w);
+        kinematics(theta, rate).iter().zip(&links).fold(D::zero(), |t, (LinkState { vc, w, inertia, .. }, l)| {
+            let jw = mat_vec(inertia, w);
             let trans = (vc[0] * vc[0] + vc[1] * vc[1] + vc[2] * vc[2]) * (0.5 * l.mass);
             t + trans + (w[0] * jw[0] + w[1] * jw[1] + w[2] * jw[2]) * 0.5
         })
@@ -132,7 +140,7 @@ struct ArmWeight;
 impl Potential<3> for ArmWeight {
     fn energy<D: Scalar>(&self, theta: [D; 3]) -> D {
         let links = links();
-        kinematics(theta, [D::zero(); 3]).iter().zip(&links).fold(D::zero(), |v, ((c, ..), l)| v + c[2] * (l.mass * G))
+        kinematics(theta, [D::zero(); 3]).iter().zip(&links).fold(D::zero(), |v, (s, l)| v + s.c[2] * (l.mass * G))
     }
 }
 
@@ -180,7 +188,7 @@ fn the_urdf_arm_in_redundant_coordinates_follows_its_joint_space_dynamics() {
         .unwrap();
     // The same pose at θ = 0: every centre of mass where the URDF puts it.
     let start = kinematics([0.0; 3], [0.0; 3]);
-    for (i, (c, ..)) in start.iter().enumerate() {
+    for (i, LinkState { c, .. }) in start.iter().enumerate() {
         let r = SpatialBody::of(i).position(&built.q0);
         assert!((0..3).all(|k| (r[k] - c[k]).abs() < 1e-14), "link {i}: {r:?} vs {c:?}");
     }
@@ -189,10 +197,10 @@ fn the_urdf_arm_in_redundant_coordinates_follows_its_joint_space_dynamics() {
         hand_path(&built.model, &built.q0, &built.v0, h, t_end, control, |q| SpatialBody::of(2).position(q))
     };
     let joints = hand_path(&joint_space, &[0.0; 3], &[0.0; 3], h, t_end, Control::none(), |q| {
-        kinematics([q[0], q[1], q[2]], [0.0; 3])[2].0
+        kinematics([q[0], q[1], q[2]], [0.0; 3])[2].c
     });
     let fine = hand_path(&joint_space, &[0.0; 3], &[0.0; 3], h / 4.0, t_end, Control::none(), |q| {
-        kinematics([q[0], q[1], q[2]], [0.0; 3])[2].0
+        kinematics([q[0], q[1], q[2]], [0.0; 3])[2].c
     });
     let gap = |a: &[[f64; 3]], b: &[[f64; 3]]| {
         a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max)

@@ -189,5 +189,6 @@ pub fn andrews() -> Result<Example> {
         observe: Box::new(|q, _v, out| out.copy_from_slice(&test_set_angles(body_angles(q)))),
         reference: None,
         drawing: Some(built.drawing),
+        sketch: None,
     })
 }

@@ -171,5 +171,6 @@ pub fn double_pendulum_angles(p: DoublePendulumParams) -> Result<Example> {
         }),
         reference: None,
         drawing: None,
+        sketch: None,
     })
 }

@@ -430,6 +430,7 @@ pub fn four_bar_angles(p: FourBarParams) -> Result<Example> {
         }),
         reference: Some(reference),
         drawing: None,
+        sketch: None,
     })
 }
 

@@ -77,6 +77,8 @@ pub struct Example {
     /// (angles) have none, since a drawing places bodies by their
     /// Cartesian coordinates.
     pub drawing: Option<crate::planar::Drawing>,
+    /// The same for a spatial mechanism: what its 3-D figures draw.
+    pub sketch: Option<crate::spatial::Sketch>,
 }
 
 impl Example {
@@ -91,6 +93,7 @@ impl Example {
             observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
             reference,
             drawing: Some(built.drawing),
+            sketch: None,
         }
     }
 
@@ -106,6 +109,7 @@ impl Example {
             observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
             reference: None,
             drawing: None,
+            sketch: Some(mechanism.sketch()),
         }
     }
 

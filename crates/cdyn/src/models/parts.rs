@@ -66,7 +66,7 @@ pub(super) fn example(
         out[k..k + n].copy_from_slice(&q[..n]);
     });
     let drawing = Some(built.drawing);
-    Example { model: built.model, q0: built.q0, v0: built.v0, observables, observe, reference, drawing }
+    Example { model: built.model, q0: built.q0, v0: built.v0, observables, observe, reference, drawing, sketch: None }
 }
 
 // ---------------------------------------------------------------------------

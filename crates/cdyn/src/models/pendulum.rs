@@ -116,6 +116,7 @@ pub fn cartesian_pendulum(p: PendulumParams) -> Result<Example> {
         observe: Box::new(|q, v, out| out.copy_from_slice(&[q[0], q[1], v[0], v[1]])),
         reference,
         drawing: Some(bob_on_a_rod()),
+        sketch: None,
     })
 }
 
@@ -177,5 +178,6 @@ pub fn theta_pendulum(p: PendulumParams) -> Result<Example> {
         observe: Box::new(move |q, v, out| out.copy_from_slice(&tip(length, q[0], v[0]))),
         reference,
         drawing: None,
+        sketch: None,
     })
 }

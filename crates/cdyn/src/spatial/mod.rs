@@ -28,6 +28,7 @@ mod damper;
 mod joint;
 mod mechanism;
 pub mod rotation;
+mod sketch;
 #[cfg(feature = "urdf")]
 mod urdf;
 
@@ -36,5 +37,6 @@ pub use chain::chain;
 pub use damper::Damper;
 pub use joint::{Joint, JointKind};
 pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
+pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]
 pub use urdf::from_urdf;
