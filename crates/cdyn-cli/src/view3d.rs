@@ -32,13 +32,17 @@ fn project(p: [f64; 3]) -> (f64, f64) {
     (dot(right), dot(up))
 }
 
+/// A point on the screen, and a line between two.
+type Point = (f64, f64);
+type Segment = (Point, Point);
+
 /// The segments and markers of one frame, projected.
 struct Scene {
     /// Body lines, by body.
-    limbs: Vec<Vec<((f64, f64), (f64, f64))>>,
-    rods: Vec<((f64, f64), (f64, f64))>,
-    joints: Vec<(f64, f64)>,
-    ground: Vec<(f64, f64)>,
+    limbs: Vec<Vec<Segment>>,
+    rods: Vec<Segment>,
+    joints: Vec<Point>,
+    ground: Vec<Point>,
 }
 
 fn scene(sketch: &Sketch, q: &[f64]) -> Scene {

@@ -111,6 +111,13 @@ fn run(text: &str) -> Ran {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("mutated.toml");
     std::fs::write(&file, text).unwrap();
+    // The robots the examples name (`urdf = "arm.urdf"`), next to the scenario as there.
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    for entry in std::fs::read_dir(&examples).unwrap().flatten() {
+        if entry.path().extension().is_some_and(|e| e == "urdf") {
+            std::fs::copy(entry.path(), dir.path().join(entry.file_name())).unwrap();
+        }
+    }
     let mut child = Command::new(env!("CARGO_BIN_EXE_cdyn"))
         .args(["run", file.to_str().unwrap(), "--out", dir.path().join("out").to_str().unwrap()])
         .stdout(Stdio::piped())
