@@ -49,6 +49,8 @@ pub struct SpatialEntries {
     pub bodies: Vec<cdyn::spatial::Body>,
     #[serde(default)]
     pub joints: Vec<cdyn::spatial::Joint<String>>,
+    #[serde(default)]
+    pub forces: Vec<cdyn::spatial::Load<String>>,
 }
 
 /// `gravity`: a magnitude for the pendulums, a vector for mechanisms
@@ -187,13 +189,15 @@ pub fn from_table(table: toml::Table, file: &str) -> Result<(Scenario, toml::Tab
     }
     // A spatial mechanism's bodies and joints have their own types.
     let spatial = table.get("model").and_then(|m| m.get("kind")).and_then(|k| k.as_str()) == Some("spatial");
-    if spatial && (table.contains_key("drives") || table.contains_key("forces")) {
-        bail!("{file}: a spatial mechanism takes [[bodies]] and [[joints]] only (no [[drives]] or [[forces]] yet)");
+    if spatial && table.contains_key("drives") {
+        bail!("{file}: a spatial mechanism has no [[drives]]: a joint is driven by its angle or displacement key");
     }
     let (mut scenario, entries): (Scenario, Option<SpatialEntries>) = if spatial {
         let mut rest = table.clone();
-        let entries: toml::Table =
-            ["bodies", "joints"].into_iter().filter_map(|key| rest.remove(key).map(|v| (key.to_string(), v))).collect();
+        let entries: toml::Table = ["bodies", "joints", "forces"]
+            .into_iter()
+            .filter_map(|key| rest.remove(key).map(|v| (key.to_string(), v)))
+            .collect();
         (read(&rest, file)?, Some(read(&entries, file)?))
     } else {
         (read(&table, file)?, None)
@@ -453,15 +457,8 @@ impl Scenario {
                     _ => bail!("{file}: [model] gravity: a spatial mechanism takes a finite vector [gx, gy, gz]"),
                 };
                 let entries = self.spatial.clone().unwrap_or_default();
-                let (mechanism, (robot_bodies, robot_joints)) = self.spatial_mechanism(file, entries, gravity)?;
-                // The robot's parts by their URDF names, the scenario's by entry.
-                let part = |part: &Part| match part {
-                    Part::Body { index, name } if *index < robot_bodies => format!("urdf link {name:?}"),
-                    Part::Body { index, name } => format!("bodies[{}] ({name})", index - robot_bodies),
-                    Part::Element { index, kind } if *index < robot_joints => format!("urdf joint {index} ({kind})"),
-                    Part::Element { index, kind } => format!("joints[{}] ({kind})", index - robot_joints),
-                    other => other.to_string(),
-                };
+                let (mechanism, counts) = self.spatial_mechanism(file, entries, gravity)?;
+                let part = |part: &Part| counts.entry(part);
                 let built = mechanism.and_then(|m| m.build().map(|b| (m, b))).map_err(|e| match e {
                     cdyn::Error::InvalidModel { at: at @ (Part::Body { .. } | Part::Element { .. }), problem } => {
                         anyhow!("{file}: {}: {problem}", part(&at))
@@ -491,7 +488,7 @@ impl Scenario {
         file: &str,
         entries: SpatialEntries,
         gravity: [f64; 3],
-    ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, (usize, usize))> {
+    ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, Counts)> {
         let mut robot = cdyn::spatial::Mechanism::default();
         match self.model.pendulum_keys.get("urdf") {
             None => {}
@@ -520,15 +517,34 @@ impl Scenario {
                 axis: j.axis,
                 axis_b: j.axis_b,
                 point_b: j.point_b,
+                angle: j.angle.clone(),
+                displacement: j.displacement.clone(),
             })
             .collect();
-        let counts = (robot.bodies.len(), joints.len());
+        let robot_loads: Vec<cdyn::spatial::Load<String>> = robot
+            .loads
+            .iter()
+            .map(|l| match l {
+                cdyn::spatial::Load::RotaryDamper { a, b, axis, damping } => cdyn::spatial::Load::RotaryDamper {
+                    a: name(*a),
+                    b: Some(b.map_or(cdyn::planar::GROUND.to_string(), name)),
+                    axis: *axis,
+                    damping: *damping,
+                },
+                other => unreachable!("a URDF gives rotary dampers only, not {}", other.kind()),
+            })
+            .collect();
+        let counts = Counts {
+            robot_bodies: robot.bodies.len(),
+            robot_joints: joints.len(),
+            joints: joints.len() + entries.joints.len(),
+            robot_loads: robot_loads.len(),
+        };
         joints.extend(entries.joints);
         let mut bodies = robot.bodies;
         bodies.extend(entries.bodies);
-        let dampers = robot.dampers;
-        let mechanism =
-            cdyn::spatial::Mechanism::named(bodies, joints, gravity).map(|m| cdyn::spatial::Mechanism { dampers, ..m });
+        let loads = robot_loads.into_iter().chain(entries.forces).collect();
+        let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, loads, gravity);
         Ok((mechanism, counts))
     }
 
@@ -559,6 +575,36 @@ impl Scenario {
             }
         }
         Ok(m)
+    }
+}
+
+/// How many of a spatial mechanism's parts come from its URDF robot,
+/// which come first in each list: bodies, joints, then the loads (after
+/// every joint in the numbering of `Part::Element`).
+struct Counts {
+    robot_bodies: usize,
+    robot_joints: usize,
+    joints: usize,
+    robot_loads: usize,
+}
+
+impl Counts {
+    /// The part as the scenario or the robot names it: `bodies[0] (top)`,
+    /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`.
+    fn entry(&self, part: &Part) -> String {
+        match part {
+            Part::Body { index, name } if *index < self.robot_bodies => format!("urdf link {name:?}"),
+            Part::Body { index, name } => format!("bodies[{}] ({name})", index - self.robot_bodies),
+            Part::Element { index, kind } if *index < self.robot_joints => format!("urdf joint {index} ({kind})"),
+            Part::Element { index, kind } if *index < self.joints => {
+                format!("joints[{}] ({kind})", index - self.robot_joints)
+            }
+            Part::Element { index, kind } if *index < self.joints + self.robot_loads => {
+                format!("urdf joint damping {} ({kind})", index - self.joints)
+            }
+            Part::Element { index, kind } => format!("forces[{}] ({kind})", index - self.joints - self.robot_loads),
+            other => other.to_string(),
+        }
     }
 }
 

@@ -197,3 +197,96 @@ fn bad_urdf_references_get_one_line_naming_the_file_and_element() {
         }
     }
 }
+
+/// A crank driven in angle about a revolute joint, a rod on a spherical
+/// joint at its end pulled back by a damped spring, and a torque on the rod.
+const DRIVEN: &str = r#"
+[model]
+kind = "spatial"
+gravity = [0.0, 0.0, -9.81]
+
+[integrator]
+scheme = "rk4"
+h = 1e-3
+t_end = 1.0
+
+[[bodies]]
+name = "crank"
+mass = 1.0
+inertia = [0.01, 0.1, 0.1]
+position = [0.25, 0.0, 0.0]
+
+[[bodies]]
+name = "rod"
+mass = 0.5
+inertia = [0.002, 0.04, 0.04]
+position = [0.75, 0.0, 0.0]
+
+[[joints]]
+kind = "revolute"
+a = "crank"
+point = [0.0, 0.0, 0.0]
+axis = [0.0, 1.0, 0.0]
+angle = { polynomial = [0.0, 3.0] }
+
+[[joints]]
+kind = "spherical"
+a = "crank"
+b = "rod"
+point = [0.5, 0.0, 0.0]
+
+[[forces]]
+kind = "spring"
+a = "rod"
+b = "ground"
+point = [1.0, 0.0, 0.0]
+point_b = [1.0, 0.0, 1.0]
+stiffness = 20.0
+damping = 0.5
+
+[[forces]]
+kind = "torque"
+body = "rod"
+torque = [0.0, 0.0, 0.1]
+"#;
+
+#[test]
+fn driven_joints_springs_and_torques_run_from_a_scenario() {
+    let out = run("driven", DRIVEN);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let case = &summary["cases"][0];
+    assert!(case["max_abs_phi"].as_f64().unwrap() < 1e-10, "{case}");
+    // The assembly set the crank turning at the drive's 3 rad/s; the
+    // crank's angle at 1 s is the drive's 3 rad: its x axis points (cos 3, 0, −sin 3).
+    let (header, rows) = table(&out.join("driven.csv"));
+    let last = rows.last().unwrap();
+    let at = |k: &str| last[header.iter().position(|h| h == k).unwrap()];
+    let (e0, e2) = (at("crank.e0"), at("crank.e2"));
+    let angle = 2.0 * e2.atan2(e0);
+    assert!((angle - 3.0).abs() < 1e-9, "crank angle {angle}");
+    let cases: Vec<(String, &[&str])> = vec![
+        (DRIVEN.replace("stiffness = 20.0", "stiffness = -20.0"), &["forces[0] (spring): stiffness = -20"]),
+        (
+            DRIVEN.replace("body = \"rod\"", "body = \"bar\""),
+            &["forces[1] (torque): body = \"bar\": no body of that name"],
+        ),
+        (DRIVEN.replace("kind = \"torque\"", "kind = \"twist\""), &["forces[1]", "twist"]),
+        (
+            DRIVEN.replace("torque = [0.0, 0.0, 0.1]", "torque = [0.0, 0.0, 0.1]\npoint = [0.0, 0.0, 0.0]"),
+            &["forces[1]", "point"],
+        ),
+        (
+            DRIVEN.replace("point = [0.5, 0.0, 0.0]", "point = [0.5, 0.0, 0.0]\nangle = 1.0"),
+            &["joints[1] (spherical): a spherical joint takes no angle"],
+        ),
+        (DRIVEN.to_string() + "\n[[drives]]\nkind = \"angle\"\n", &["no [[drives]]", "angle or displacement"]),
+    ];
+    for (text, expected) in cases {
+        let (dir, path) = scenario("bad.toml", &text);
+        let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+        for e in expected {
+            assert!(line.contains(e), "{line:?} should contain {e:?}");
+        }
+    }
+}

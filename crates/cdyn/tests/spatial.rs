@@ -7,6 +7,7 @@ use cdyn::dynamics::{Dynamics, LinearSolver};
 use cdyn::reference::elliptic::jacobi;
 use cdyn::spatial::rotation::{about, body_rate, compose, rate_from_body, rotate, space_rate};
 use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
+use cdyn::timefn::TimeFn;
 use cdyn::{Control, Error, Model, Scheme, Settings, Simulation, methods};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -38,6 +39,19 @@ fn joints(point: [f64; 3], axis: [f64; 3], point_b: [f64; 3], b: Option<usize>) 
         (at(JointKind::Prismatic).axis(axis), 1),
         (at(JointKind::Fixed).axis(axis), 0),
         (at(JointKind::Distance).point_b(point_b), 5),
+        // Driven: nothing is left free at a given time.
+        (
+            at(JointKind::Revolute)
+                .axis(axis)
+                .angle(TimeFn { polynomial: vec![0.0, 0.5], sines: vec![[0.3, 2.0, 0.0]] }),
+            0,
+        ),
+        (
+            at(JointKind::Prismatic)
+                .axis(axis)
+                .displacement(TimeFn { polynomial: vec![0.0, 0.2, -0.4], sines: vec![] }),
+            0,
+        ),
     ]
 }
 
@@ -55,12 +69,16 @@ fn pair(joint: Joint, poses: [([f64; 3], [f64; 4]); 2]) -> Mechanism {
             ..Body::new(&format!("b{i}"), 1.0 + i as f64, [1.0; 3])
         })
         .collect();
-    Mechanism { bodies, joints: vec![joint], gravity: [0.0, 0.0, -9.81], dampers: vec![] }
+    Mechanism { bodies, joints: vec![joint], gravity: [0.0, 0.0, -9.81], loads: vec![] }
 }
 
 fn phi(model: &Model, q: &[f64]) -> Vec<f64> {
+    phi_at(model, q, 0.0)
+}
+
+fn phi_at(model: &Model, q: &[f64], t: f64) -> Vec<f64> {
     let mut out = vec![0.0; model.m()];
-    model.constraint_values(q, 0.0, &mut out);
+    model.constraint_values(q, t, &mut out);
     out
 }
 
@@ -99,21 +117,23 @@ proptest! {
             let n = model.n();
             let q: Vec<f64> = q0.iter().zip(&dq).map(|(q, d)| q + d).collect();
             let v = &v[..n];
+            let t0 = 0.3;
             let mut d = Dynamics::new(&model);
-            d.evaluate(&model, &q, v, 0.0).unwrap();
+            d.evaluate(&model, &q, v, t0).unwrap();
             let jac = dense_jacobian(&model, &d);
             let h = 1e-6;
             for c in 0..n {
                 let (mut qp, mut qm) = (q.clone(), q.clone());
                 qp[c] += h;
                 qm[c] -= h;
-                let (p, m) = (phi(&model, &qp), phi(&model, &qm));
+                let (p, m) = (phi_at(&model, &qp, t0), phi_at(&model, &qm, t0));
                 for r in 0..model.m() {
                     let fd = (p[r] - m[r]) / (2.0 * h);
                     prop_assert!(close(jac[(r, c)], fd, 1e-7), "{kind:?} Φ_q[{r},{c}]: AD {} vs FD {fd}", jac[(r, c)]);
                 }
             }
-            let along = |s: f64| phi(&model, &q.iter().zip(v).map(|(q, v)| q + s * v).collect::<Vec<_>>());
+            // Along s ↦ (q + s v, t0 + s): Φ̇ = Φ_q v + Φ_t, and −γ the second derivative.
+            let along = |s: f64| phi_at(&model, &q.iter().zip(v).map(|(q, v)| q + s * v).collect::<Vec<_>>(), t0 + s);
             // Φ along the line is a quartic in s (A(p) is quadratic in p): a
             // shorter step for the first difference keeps its truncation
             // error (h²/6 times the third derivative) below the tolerance.
@@ -150,7 +170,7 @@ proptest! {
             d.evaluate(&model, &q, &[0.0; 14], 0.0).unwrap();
             let jac = dense_jacobian(&model, &d);
             let rank = jac.clone().svd(false, false).rank(1e-9);
-            prop_assert_eq!(rank, kind.rows() + 2, "{:?}: rank of Φ_q", kind);
+            prop_assert_eq!(rank, model.m(), "{:?}: rank of Φ_q", kind);
             prop_assert_eq!(14 - rank - 6, freedom, "{:?}: freedom left to body b", kind);
             // Body b moving, body a still: rotations about axes through a
             // point, and translations.
@@ -167,6 +187,7 @@ proptest! {
             let z = [0.0; 3];
             let allowed: Vec<Vec<f64>> = match kind {
                 JointKind::Spherical => (0..3).map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point, z)).collect(),
+                _ if freedom == 0 => vec![],
                 JointKind::Revolute => vec![motion(axis, point, z)],
                 JointKind::Universal => vec![motion(axis, point, z), motion(axis_b, point, z)],
                 JointKind::Cylindrical => vec![motion(axis, point, z), motion(z, point, axis)],
@@ -215,7 +236,7 @@ fn free_body(turn: [f64; 4]) -> Mechanism {
         angular_velocity: rotate(turn, W0),
         ..Body::new("top", 2.0, J)
     };
-    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3], dampers: vec![] }
+    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3], loads: vec![] }
 }
 
 /// Largest error of the spatial angular velocity against Euler's solution
@@ -274,7 +295,7 @@ fn heavy_top() -> Mechanism {
         ..Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
     };
     let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-    Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81], dampers: vec![] }
+    Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81], loads: vec![] }
 }
 
 fn heavy_top_at(t_end: f64, h: f64, control: Control, solver: LinearSolver) -> (Vec<f64>, Vec<f64>) {
@@ -343,7 +364,7 @@ fn steady_precession(h: f64, t_end: f64, control: Control) -> (f64, f64, f64) {
         ..Body::new("top", m, [ac, ac, c])
     };
     let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-    let mechanism = Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -g], dampers: vec![] };
+    let mechanism = Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -g], loads: vec![] };
     let Built { model, q0, v0, .. } = mechanism.build().unwrap();
     let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, control), &q0, &v0).unwrap();
     let (mut tilt, mut azimuth) = (0.0_f64, 0.0_f64);
@@ -418,7 +439,7 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         let mut b = Body::new("arm", 1.0, [1.0, 1.0, 1.0]);
         f(&mut b);
         let joint = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3], dampers: vec![] }
+        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3], loads: vec![] }
             .build()
             .err()
             .map(|e| e.to_string())
@@ -441,7 +462,7 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
 
     let two = |joint: Joint<String>| {
         let bodies = vec![Body::new("a", 1.0, [1.0; 3]), Body::new("b", 1.0, [1.0; 3])];
-        Mechanism::named(bodies, vec![joint], [0.0; 3]).and_then(|m| m.build()).err().map(|e| e.to_string())
+        Mechanism::named(bodies, vec![joint], vec![], [0.0; 3]).and_then(|m| m.build()).err().map(|e| e.to_string())
     };
     let joint = |kind| Joint {
         kind,
@@ -451,8 +472,14 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         axis: None,
         axis_b: None,
         point_b: None,
+        angle: None,
+        displacement: None,
     };
     let cases = [
+        (
+            Joint { angle: Some(TimeFn::linear(0.0, 1.0)), ..joint(JointKind::Spherical) },
+            "a spherical joint takes no angle",
+        ),
         (Joint { axis: Some([0.0; 3]), ..joint(JointKind::Revolute) }, "element 0 (revolute): axis has zero length"),
         (joint(JointKind::Revolute), "element 0 (revolute): a revolute joint needs axis"),
         (Joint { axis: Some([1.0, 0.0, 0.0]), ..joint(JointKind::Spherical) }, "a spherical joint takes no axis"),
@@ -471,7 +498,8 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
     }
     // The ground is `b` omitted or named; duplicate and reserved body names are refused.
     assert_eq!(two(Joint { b: Some("ground".to_string()), ..joint(JointKind::Spherical) }), None);
-    let dup = Mechanism::named(vec![Body::new("a", 1.0, [1.0; 3]), Body::new("a", 1.0, [1.0; 3])], vec![], [0.0; 3]);
+    let dup =
+        Mechanism::named(vec![Body::new("a", 1.0, [1.0; 3]), Body::new("a", 1.0, [1.0; 3])], vec![], vec![], [0.0; 3]);
     assert!(dup.unwrap_err().to_string().contains("body 1 (a): a body with this name already exists"));
 }
 
@@ -513,7 +541,7 @@ fn spatial_slider_crank(on_axis: bool, h: f64, times: &[f64]) -> Vec<(f64, f64)>
             .axis_b(unit([0.0, -2.0, 1.0])),
         Joint::new(JointKind::Prismatic, 2, None, [0.2, 0.0, 0.0]).axis([1.0, 0.0, 0.0]),
     ];
-    let mechanism = Mechanism { bodies: vec![crank, rod, slider], joints, gravity: [0.0, 0.0, -9.81], dampers: vec![] };
+    let mechanism = Mechanism { bodies: vec![crank, rod, slider], joints, gravity: [0.0, 0.0, -9.81], loads: vec![] };
     let Built { model, q0, v0, .. } = mechanism.build().unwrap();
     let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, methods::robust()), &q0, &v0).unwrap();
     let (mut angle, mut last) = (0.0_f64, 0.0_f64);
@@ -574,4 +602,94 @@ fn the_iftomm_spatial_slider_crank_against_the_published_solutions() {
     // with it on the axis the motion is another one (0.014 m off at 5 s).
     assert!(worst < 1e-4, "mid-crank: {worst:e} from González's solution");
     assert!((on_axis[5].0 - gonzalez[5]).abs() > 1e-3);
+}
+
+/// Largest `|Ψ|` (the energy balance: `T + V − E₀ − ∫Ė`) and the final
+/// state of a run without control, RK-4.
+fn uncontrolled(mechanism: &Mechanism, h: f64, t_end: f64) -> (f64, Vec<f64>, Vec<f64>) {
+    let Built { model, q0, v0, .. } = mechanism.build().unwrap();
+    let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, Control::none()), &q0, &v0).unwrap();
+    let mut psi = 0.0_f64;
+    sim.run::<Error>(t_end, 1, |s| {
+        psi = psi.max(s.measure().psi.abs());
+        Ok(())
+    })
+    .unwrap();
+    (psi, sim.q().to_vec(), sim.v().to_vec())
+}
+
+#[test]
+fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
+    use cdyn::spatial::Load;
+    let (m, k, c) = (2.0, 50.0, 1.5);
+    // A body hanging on a damped spring from the origin, stretched 0.1
+    // beyond its length 0.9, no gravity: z(t) = −0.9 − 0.1 e^{−ζωt}(cos ω_d t + ζω/ω_d sin ω_d t).
+    let bob = Body { position: [0.0, 0.0, -1.0], ..Body::new("bob", m, [0.1, 0.1, 0.1]) };
+    let spring = Load::Spring {
+        a: 0,
+        b: None,
+        point: [0.0, 0.0, -1.0],
+        point_b: [0.0; 3],
+        stiffness: k,
+        damping: c,
+        length: Some(0.9),
+    };
+    let hanging = Mechanism { bodies: vec![bob], joints: vec![], gravity: [0.0; 3], loads: vec![spring] };
+    let (psi, q, _) = uncontrolled(&hanging, 1e-3, 2.0);
+    let (w, zeta) = ((k / m).sqrt(), c / (2.0 * (k * m).sqrt()));
+    let wd = w * (1.0 - zeta * zeta).sqrt();
+    let exact = -0.9 - 0.1 * (-zeta * w * 2.0).exp() * ((wd * 2.0).cos() + zeta * w / wd * (wd * 2.0).sin());
+    println!("damped spring: z(2) = {} vs {exact}, max |Ψ| {psi:.1e}", q[2]);
+    assert!((q[2] - exact).abs() < 1e-9, "z(2) = {} vs {exact}", q[2]);
+    // The damper's power is in the energy balance: Ψ stays at the integrator's error.
+    assert!(psi < 1e-9, "|Ψ| = {psi:e}");
+
+    // A free body under a constant torque about its second principal axis,
+    // from rest: ω = n t / J₂; and a force at an offset point: the centre
+    // accelerates as F/m and the body turns under (s × F) / J.
+    let torqued = Body::new("wheel", 3.0, [0.5, 0.8, 1.1]);
+    let loads = vec![
+        Load::Torque { body: 0, torque: [0.0, 0.4, 0.0] },
+        Load::Force { body: 0, force: [0.0, 0.0, 0.6], point: Some([0.0, 0.0, 0.0]) },
+    ];
+    let free = Mechanism { bodies: vec![torqued], joints: vec![], gravity: [0.0; 3], loads };
+    let (psi, q, v) = uncontrolled(&free, 1e-3, 1.0);
+    let w = body_rate(SpatialBody::of(0).orientation(&q), SpatialBody::of(0).orientation(&v));
+    println!("torque: ω(1) = {w:?}, v_z = {}, max |Ψ| {psi:.1e}", v[2]);
+    assert!((w[1] - 0.4 / 0.8).abs() < 1e-12 && w[0].abs() < 1e-12 && w[2].abs() < 1e-12, "{w:?}");
+    assert!((v[2] - 0.6 / 3.0).abs() < 1e-12 && (q[2] - 0.5 * 0.6 / 3.0).abs() < 1e-12, "{v:?}");
+    assert!(psi < 1e-12, "|Ψ| = {psi:e}");
+
+    // A wheel spinning on a damped revolute axle: ω = ω₀ e^{−c t / J}.
+    let spinning = Body { angular_velocity: [0.0, 0.0, 5.0], ..Body::new("wheel", 1.0, [0.3, 0.3, 0.5]) };
+    let axle = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).axis([0.0, 0.0, 1.0]);
+    let damper = Load::RotaryDamper { a: 0, b: None, axis: [0.0, 0.0, 1.0], damping: 0.2 };
+    let wheel = Mechanism { bodies: vec![spinning], joints: vec![axle], gravity: [0.0; 3], loads: vec![damper] };
+    let (psi, q, v) = uncontrolled(&wheel, 1e-3, 2.0);
+    let w = space_rate(SpatialBody::of(0).orientation(&q), SpatialBody::of(0).orientation(&v));
+    let exact = 5.0 * (-0.2 * 2.0 / 0.5_f64).exp();
+    println!("rotary damper: ω(2) = {} vs {exact}, max |Ψ| {psi:.1e}", w[2]);
+    assert!((w[2] - exact).abs() < 1e-10 && psi < 1e-10, "ω = {w:?} vs {exact}, |Ψ| {psi:e}");
+
+    // A crank driven at θ = 3t + 0.2 sin 5t about a revolute joint, under
+    // gravity: its angle follows the drive, and the drive's work (λᵀΦ_t)
+    // is in the energy balance.
+    // Started at the drive's rate θ̇(0) = 4 (v = ω × r).
+    let crank = Body {
+        position: [0.5, 0.0, 0.0],
+        velocity: [0.0, 0.0, -2.0],
+        angular_velocity: [0.0, 4.0, 0.0],
+        ..Body::new("crank", 1.0, [0.01, 0.1, 0.1])
+    };
+    let drive = TimeFn { polynomial: vec![0.0, 3.0], sines: vec![[0.2, 5.0, 0.0]] };
+    let pivot = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).axis([0.0, 1.0, 0.0]).angle(drive.clone());
+    let driven = Mechanism { bodies: vec![crank], joints: vec![pivot], gravity: [0.0, 0.0, -9.81], loads: vec![] };
+    let (psi, q, _) = uncontrolled(&driven, 1e-3, 1.0);
+    let p = SpatialBody::of(0).orientation(&q);
+    // Turned about +y by θ: p = (cos θ/2, 0, sin θ/2, 0); compare the crank's direction.
+    let x = rotate(p, [1.0, 0.0, 0.0]);
+    let theta: f64 = drive.eval(1.0);
+    println!("driven crank: direction {x:?} vs angle {theta}, max |Ψ| {psi:.1e}");
+    assert!((x[0] - theta.cos()).abs() < 1e-10 && (x[2] + theta.sin()).abs() < 1e-10, "{x:?} vs {theta}");
+    assert!(psi < 1e-8, "|Ψ| = {psi:e}");
 }

@@ -178,7 +178,7 @@ fn the_urdf_arm_in_redundant_coordinates_follows_its_joint_space_dynamics() {
     let names: Vec<&str> = mechanism.bodies.iter().map(|b| b.name.as_str()).collect();
     assert_eq!(names, ["upper", "fore", "hand"], "the massless base and tool are no bodies");
     assert_eq!(mechanism.joints.len(), 3);
-    assert_eq!(mechanism.dampers.len(), 1);
+    assert_eq!(mechanism.loads.len(), 1);
     let built = mechanism.build().unwrap();
     let joint_space = Model::builder(vec![0.0; 3])
         .kinetic(ArmKinetic, [0, 1, 2])

@@ -22,6 +22,7 @@
 use super::rotation::rotate;
 use crate::constraint::Constraint;
 use crate::scalar::Scalar;
+use crate::timefn::TimeFn;
 
 /// What a joint allows (its `kind` in scenario files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -106,12 +107,22 @@ pub struct Joint<B = usize> {
     /// A distance joint's end on body `b`, in space.
     #[cfg_attr(feature = "serde", serde(default))]
     pub point_b: Option<[f64; 3]>,
+    /// A drive of a revolute or cylindrical joint: the angle of `a`
+    /// relative to `b` (the ground when `b` is omitted) about the axis,
+    /// right-handed, from the initial pose, as a function of time (one
+    /// more row).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub angle: Option<TimeFn>,
+    /// A drive of a prismatic or cylindrical joint: the displacement of `a`
+    /// relative to `b` along the axis, from the initial pose.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub displacement: Option<TimeFn>,
 }
 
 impl Joint {
     /// A joint of `kind` between `a` and `b` (`None`: the ground) at `point`, without axes.
     pub fn new(kind: JointKind, a: usize, b: Option<usize>, point: [f64; 3]) -> Self {
-        Self { kind, a, b, point, axis: None, axis_b: None, point_b: None }
+        Self { kind, a, b, point, axis: None, axis_b: None, point_b: None, angle: None, displacement: None }
     }
     /// With its axis.
     pub fn axis(self, axis: [f64; 3]) -> Self {
@@ -124,6 +135,21 @@ impl Joint {
     /// With a distance joint's second point.
     pub fn point_b(self, point_b: [f64; 3]) -> Self {
         Self { point_b: Some(point_b), ..self }
+    }
+    /// Driven in angle.
+    pub fn angle(self, angle: TimeFn) -> Self {
+        Self { angle: Some(angle), ..self }
+    }
+    /// Driven in displacement.
+    pub fn displacement(self, displacement: TimeFn) -> Self {
+        Self { displacement: Some(displacement), ..self }
+    }
+}
+
+impl<B> Joint<B> {
+    /// Its constraint rows: the kind's and one per drive.
+    pub fn rows(&self) -> usize {
+        self.kind.rows() + self.angle.is_some() as usize + self.displacement.is_some() as usize
     }
 }
 
@@ -168,17 +194,39 @@ const G: usize = 1;
 const H: usize = 2;
 
 /// The rows of a joint of `R` rows, with its frames on both sides.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct JointRows<const R: usize> {
     pub kind: JointKind,
     pub a: Frame,
     pub b: Frame,
     /// Squared length of a distance joint.
     pub length2: f64,
+    /// Drives: angle about, displacement along the axis.
+    pub angle: Option<TimeFn>,
+    pub displacement: Option<TimeFn>,
 }
 
 impl<const R: usize> JointRows<R> {
-    fn rows<D: Scalar>(&self, a: Side<'_, D>, b: Side<'_, D>) -> [D; R] {
+    fn rows<D: Scalar>(&self, a: Side<'_, D>, b: Side<'_, D>, t: D) -> [D; R] {
+        let mut out = self.kinematic_rows(&a, &b);
+        let mut next = self.kind.rows();
+        // At the initial pose both sides' frames coincide, so a's f axis
+        // turned by θ about h relative to b is f cos θ + g sin θ in b's
+        // frame: the row is sin(θ − f(t)).
+        if let Some(angle) = &self.angle {
+            let (fa, theta) = (a.axis(F), angle.eval(t));
+            out[next] = dot(fa, b.axis(G)) * theta.cos() - dot(fa, b.axis(F)) * theta.sin();
+            next += 1;
+        }
+        if let Some(displacement) = &self.displacement {
+            let (pa, pb) = (a.point(), b.point());
+            let d: [D; 3] = std::array::from_fn(|i| pa[i] - pb[i]);
+            out[next] = dot(d, b.axis(H)) - displacement.eval(t);
+        }
+        out
+    }
+
+    fn kinematic_rows<D: Scalar>(&self, a: &Side<'_, D>, b: &Side<'_, D>) -> [D; R] {
         let mut out = [D::zero(); R];
         let (pa, pb) = (a.point(), b.point());
         let d: [D; 3] = std::array::from_fn(|i| pb[i] - pa[i]);
@@ -201,7 +249,7 @@ impl<const R: usize> JointRows<R> {
                 put(1, dot(ga, hb));
                 put(2, dot(fa, d));
                 put(3, dot(ga, d));
-                if R == 5 {
+                if self.kind == JointKind::Prismatic {
                     put(4, dot(fa, b.axis(G)));
                 }
             }
@@ -218,11 +266,11 @@ impl<const R: usize> JointRows<R> {
 }
 
 /// A joint between two bodies: reads `(r_a, p_a, r_b, p_b)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BodyToBody<const R: usize>(pub JointRows<R>);
 
 /// A joint between a body and the ground: reads `(r_a, p_a)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BodyToGround<const R: usize>(pub JointRows<R>);
 
 fn pose<D: Copy, const K: usize>(x: &[D; K], at: usize) -> ([D; 3], [D; 4]) {
@@ -230,16 +278,16 @@ fn pose<D: Copy, const K: usize>(x: &[D; K], at: usize) -> ([D; 3], [D; 4]) {
 }
 
 impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
-    fn eval<D: Scalar>(&self, x: [D; 14], _t: D) -> [D; R] {
+    fn eval<D: Scalar>(&self, x: [D; 14], t: D) -> [D; R] {
         let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
-        self.0.rows(Side::Body { r: ra, p: pa, frame: &self.0.a }, Side::Body { r: rb, p: pb, frame: &self.0.b })
+        self.0.rows(Side::Body { r: ra, p: pa, frame: &self.0.a }, Side::Body { r: rb, p: pb, frame: &self.0.b }, t)
     }
 }
 
 impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
-    fn eval<D: Scalar>(&self, x: [D; 7], _t: D) -> [D; R] {
+    fn eval<D: Scalar>(&self, x: [D; 7], t: D) -> [D; R] {
         let (r, p) = pose(&x, 0);
-        self.0.rows(Side::Body { r, p, frame: &self.0.a }, Side::Ground(&self.0.b))
+        self.0.rows(Side::Body { r, p, frame: &self.0.a }, Side::Ground(&self.0.b), t)
     }
 }
 

@@ -2,8 +2,8 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation};
-use super::damper::{BodyDamper, Damper, GroundDamper};
 use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows, UnitNorm};
+use super::load::{BodyRotaryDamper, BodyTorque, GroundRotaryDamper, LineDamper, Load, PointForce, SpringEnergy};
 use super::rotation::{rate_from_body, unrotate};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::Potential;
@@ -20,8 +20,8 @@ pub struct Mechanism {
     pub joints: Vec<Joint>,
     /// Gravitational acceleration, in space.
     pub gravity: [f64; 3],
-    /// Rotary dampers (a URDF joint's `damping`), placed at the initial pose.
-    pub dampers: Vec<Damper>,
+    /// Springs, dampers, forces and torques, placed at the initial pose.
+    pub loads: Vec<Load>,
 }
 
 /// A mechanism's model, its initial state (as given, not yet projected
@@ -113,7 +113,12 @@ fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
 impl Mechanism {
     /// A mechanism whose joints name their bodies (`"ground"`, or `b`
     /// omitted, for the ground), as scenario files do.
-    pub fn named(bodies: Vec<Body>, joints: Vec<Joint<String>>, gravity: [f64; 3]) -> Result<Self> {
+    pub fn named(
+        bodies: Vec<Body>,
+        joints: Vec<Joint<String>>,
+        loads: Vec<Load<String>>,
+        gravity: [f64; 3],
+    ) -> Result<Self> {
         let mut index = HashMap::new();
         for (i, body) in bodies.iter().enumerate() {
             let at = || Part::Body { index: i, name: body.name.clone() };
@@ -139,32 +144,57 @@ impl Mechanism {
                     Some(name) => resolve("b", name).map_err(|e| e.at(at.clone()))?,
                     None => None,
                 };
+                let Joint { kind, point, axis, axis_b, point_b, angle, displacement, .. } = j;
                 match (a, b) {
-                    (Some(a), b) => Ok(Joint {
-                        kind: j.kind,
-                        a,
-                        b,
-                        point: j.point,
-                        axis: j.axis,
-                        axis_b: j.axis_b,
-                        point_b: j.point_b,
-                    }),
+                    (Some(a), b) => Ok(Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement }),
                     // `a = "ground"`: the same joint seen from `b`, each
-                    // side's point and axis going with its body.
+                    // side's point and axis going with its body, and the
+                    // drives turned round.
                     (None, Some(b)) => Ok(Joint {
-                        kind: j.kind,
+                        kind,
                         a: b,
                         b: None,
-                        point: j.point_b.unwrap_or(j.point),
-                        axis: j.axis_b.or(j.axis),
-                        axis_b: j.axis_b.and(j.axis),
-                        point_b: j.point_b.and(Some(j.point)),
+                        point: point_b.unwrap_or(point),
+                        axis: axis_b.or(axis),
+                        axis_b: axis_b.and(axis),
+                        point_b: point_b.and(Some(point)),
+                        angle: angle.map(negated),
+                        displacement: displacement.map(negated),
                     }),
                     (None, None) => Err(Problem::SameBody { body: crate::planar::GROUND.to_string() }.at(at)),
                 }
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { bodies, joints, gravity, dampers: Vec::new() })
+        let ground = || Problem::SameBody { body: crate::planar::GROUND.to_string() };
+        let loads = loads
+            .into_iter()
+            .enumerate()
+            .map(|(k, load)| {
+                let at = Part::Element { index: joints.len() + k, kind: load.kind() };
+                let body = |key, name: &str| resolve(key, name).map_err(|e| e.at(at.clone()));
+                let pair = |a: &str, b: &Option<String>| -> Result<(Option<usize>, Option<usize>)> {
+                    Ok((body("a", a)?, b.as_deref().map(|b| body("b", b)).transpose()?.flatten()))
+                };
+                let one = |name: &str| body("body", name)?.ok_or_else(|| Problem::OnGround("loaded").at(at.clone()));
+                Ok(match load {
+                    Load::Spring { a, b, point, point_b, stiffness, damping, length } => match pair(&a, &b)? {
+                        (Some(a), b) => Load::Spring { a, b, point, point_b, stiffness, damping, length },
+                        (None, Some(b)) => {
+                            Load::Spring { a: b, b: None, point: point_b, point_b: point, stiffness, damping, length }
+                        }
+                        (None, None) => return Err(ground().at(at)),
+                    },
+                    Load::RotaryDamper { a, b, axis, damping } => match pair(&a, &b)? {
+                        (Some(a), b) => Load::RotaryDamper { a, b, axis, damping },
+                        (None, Some(b)) => Load::RotaryDamper { a: b, b: None, axis, damping },
+                        (None, None) => return Err(ground().at(at)),
+                    },
+                    Load::Force { body, force, point } => Load::Force { body: one(&body)?, force, point },
+                    Load::Torque { body, torque } => Load::Torque { body: one(&body)?, torque },
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self { bodies, joints, gravity, loads })
     }
 
     /// The model, its initial state and the part behind each row.
@@ -203,28 +233,13 @@ impl Mechanism {
         for (index, joint) in self.joints.iter().enumerate() {
             let at = Part::Element { index, kind: joint.kind.name() };
             builder = self.add_joint(builder, joint, &poses).map_err(|e| e.at(at.clone()))?;
-            rows.extend(std::iter::repeat_n(at, joint.kind.rows()));
+            rows.extend(std::iter::repeat_n(at, joint.rows()));
         }
-        for damper in &self.dampers {
-            builder = self.add_damper(builder, damper, &poses)?;
+        for (k, load) in self.loads.iter().enumerate() {
+            let at = Part::Element { index: self.joints.len() + k, kind: load.kind() };
+            builder = add_load(builder, load, &poses).map_err(|e| e.at(at))?;
         }
         Ok(Built { model: builder.build()?, q0, v0, rows })
-    }
-
-    fn add_damper(&self, builder: ModelBuilder, d: &Damper, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
-        crate::error::non_negative("damping", d.c)?;
-        let axis = unit("axis", d.axis)?;
-        let (_, pa) = *poses.get(d.a).ok_or(Error::from(Problem::NoSuchBody { index: d.a }))?;
-        let a = SpatialBody::of(d.a).euler_parameters();
-        Ok(match d.b {
-            Some(b) => {
-                poses.get(b).ok_or(Error::from(Problem::NoSuchBody { index: b }))?;
-                let b = SpatialBody::of(b).euler_parameters();
-                let at: [usize; 8] = std::array::from_fn(|i| if i < 4 { a[i] } else { b[i - 4] });
-                builder.force(BodyDamper { axis: unrotate(pa, axis), c: d.c }, at)
-            }
-            None => builder.force(GroundDamper { axis, c: d.c }, a),
-        })
     }
 
     fn add_joint(&self, builder: ModelBuilder, joint: &Joint, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
@@ -243,6 +258,21 @@ impl Mechanism {
         ] {
             if wanted != given {
                 return Err(Problem::JointKey { key, kind, wanted }.into());
+            }
+        }
+        let drives = match joint.kind {
+            JointKind::Revolute => [true, false],
+            JointKind::Prismatic => [false, true],
+            JointKind::Cylindrical => [true, true],
+            _ => [false, false],
+        };
+        for (key, allowed, drive) in
+            [("angle", drives[0], &joint.angle), ("displacement", drives[1], &joint.displacement)]
+        {
+            match drive {
+                Some(_) if !allowed => return Err(Problem::JointKey { key, kind, wanted: false }.into()),
+                Some(f) if !f.is_finite() => return Err(Problem::NonFiniteFunction.into()),
+                _ => {}
             }
         }
         let given = joint.point.iter().chain(joint.point_b.iter().flatten());
@@ -292,7 +322,14 @@ impl Mechanism {
         let a_at = SpatialBody::of(joint.a).coordinates();
         macro_rules! add {
             ($r:literal) => {{
-                let rows = JointRows::<$r> { kind: joint.kind, a: fa, b: fb, length2 };
+                let rows = JointRows::<$r> {
+                    kind: joint.kind,
+                    a: fa,
+                    b: fb,
+                    length2,
+                    angle: joint.angle.clone(),
+                    displacement: joint.displacement.clone(),
+                };
                 match joint.b {
                     Some(jb) => {
                         let b_at = SpatialBody::of(jb).coordinates();
@@ -303,7 +340,7 @@ impl Mechanism {
                 }
             }};
         }
-        Ok(match joint.kind.rows() {
+        Ok(match joint.rows() {
             1 => add!(1),
             3 => add!(3),
             4 => add!(4),
@@ -311,4 +348,94 @@ impl Mechanism {
             _ => add!(6),
         })
     }
+}
+
+/// `−f(t)`: a drive seen from the other body.
+fn negated(f: crate::timefn::TimeFn) -> crate::timefn::TimeFn {
+    crate::timefn::TimeFn {
+        polynomial: f.polynomial.iter().map(|c| -c).collect(),
+        sines: f.sines.iter().map(|&[a, w, phase]| [-a, w, phase]).collect(),
+    }
+}
+
+/// A body point given in space at the initial pose, in the body's axes.
+fn in_body((r, p): ([f64; 3], [f64; 4]), point: [f64; 3]) -> [f64; 3] {
+    unrotate(p, std::array::from_fn(|i| point[i] - r[i]))
+}
+
+/// Adds the elements of one load.
+fn add_load(builder: ModelBuilder, load: &Load, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
+    let pose = |i: usize| poses.get(i).copied().ok_or(Error::from(Problem::NoSuchBody { index: i }));
+    let finite = |name: &'static str, x: &[f64]| match x.iter().find(|x| !x.is_finite()) {
+        Some(&value) => Err(Error::from(Problem::Parameter { name, value, reason: "must be finite" })),
+        None => Ok(()),
+    };
+    Ok(match *load {
+        Load::Spring { a, b, point, point_b, stiffness, damping, length } => {
+            crate::error::non_negative("stiffness", stiffness)?;
+            crate::error::non_negative("damping", damping)?;
+            finite("point", &point)?;
+            finite("point_b", &point_b)?;
+            let initial = (0..3).map(|i| (point_b[i] - point[i]).powi(2)).sum::<f64>().sqrt();
+            let length = match length {
+                Some(l) => crate::error::non_negative("length", l)?,
+                None => initial,
+            };
+            if initial == 0.0 {
+                let reason = "must differ from point: a spring needs a line";
+                return Err(Problem::Parameter { name: "point_b", value: 0.0, reason }.into());
+            }
+            let sa = in_body(pose(a)?, point);
+            let a_at = SpatialBody::of(a).coordinates();
+            match b {
+                Some(b) => {
+                    let sb = in_body(pose(b)?, point_b);
+                    let b_at = SpatialBody::of(b).coordinates();
+                    let at: [usize; 14] = std::array::from_fn(|i| if i < 7 { a_at[i] } else { b_at[i - 7] });
+                    let builder = builder.potential(SpringEnergy { sa, sb, ground: false, k: stiffness, length }, at);
+                    if damping > 0.0 {
+                        builder.force(LineDamper { sa, sb, ground: false, c: damping }, at)
+                    } else {
+                        builder
+                    }
+                }
+                None => {
+                    let spring = SpringEnergy { sa, sb: point_b, ground: true, k: stiffness, length };
+                    let builder = builder.potential(spring, a_at);
+                    if damping > 0.0 {
+                        builder.force(LineDamper { sa, sb: point_b, ground: true, c: damping }, a_at)
+                    } else {
+                        builder
+                    }
+                }
+            }
+        }
+        Load::RotaryDamper { a, b, axis, damping } => {
+            crate::error::non_negative("damping", damping)?;
+            let axis = unit("axis", axis)?;
+            let (_, pa) = pose(a)?;
+            let a_at = SpatialBody::of(a).euler_parameters();
+            match b {
+                Some(b) => {
+                    pose(b)?;
+                    let b_at = SpatialBody::of(b).euler_parameters();
+                    let at: [usize; 8] = std::array::from_fn(|i| if i < 4 { a_at[i] } else { b_at[i - 4] });
+                    builder.force(BodyRotaryDamper { axis: unrotate(pa, axis), c: damping }, at)
+                }
+                None => builder.force(GroundRotaryDamper { axis, c: damping }, a_at),
+            }
+        }
+        Load::Force { body, force, point } => {
+            finite("force", &force)?;
+            let (r, p) = pose(body)?;
+            let point = point.unwrap_or(r);
+            finite("point", &point)?;
+            builder.force(PointForce { s: in_body((r, p), point), f: force }, SpatialBody::of(body).coordinates())
+        }
+        Load::Torque { body, torque } => {
+            finite("torque", &torque)?;
+            pose(body)?;
+            builder.force(BodyTorque { n: torque }, SpatialBody::of(body).euler_parameters())
+        }
+    })
 }

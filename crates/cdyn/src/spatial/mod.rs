@@ -24,8 +24,8 @@
 
 mod body;
 mod chain;
-mod damper;
 mod joint;
+mod load;
 mod mechanism;
 pub mod rotation;
 mod sketch;
@@ -34,8 +34,8 @@ mod urdf;
 
 pub use body::{Body, Rotation};
 pub use chain::chain;
-pub use damper::Damper;
 pub use joint::{Joint, JointKind};
+pub use load::Load;
 pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
 pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]

@@ -19,8 +19,8 @@
 //! the scenario to add.
 
 use super::body::Body;
-use super::damper::Damper;
 use super::joint::{Joint, JointKind};
+use super::load::Load;
 use super::mechanism::Mechanism;
 use super::rotation::{about, compose, rotate};
 use crate::error::{Error, Part, Problem, Result};
@@ -114,7 +114,7 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
     }
     // What carries a link: itself if massive, else its parent's carrier through a fixed joint.
     let mut carrier: Vec<Option<usize>> = vec![None; robot.links.len()];
-    let (mut joints, mut dampers) = (Vec::new(), Vec::new());
+    let (mut joints, mut loads) = (Vec::new(), Vec::new());
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
         let parent = carrier[link_index[j.parent.link.as_str()]];
@@ -161,8 +161,8 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
             joints.push(if kind == JointKind::Spherical { joint } else { joint.axis(axis) });
         }
         if damping != 0.0 {
-            dampers.push(Damper { a: child, b: parent, axis, c: damping });
+            loads.push(Load::RotaryDamper { a: child, b: parent, axis, damping });
         }
     }
-    Ok(Mechanism { bodies, joints, gravity, dampers })
+    Ok(Mechanism { bodies, joints, gravity, loads })
 }
