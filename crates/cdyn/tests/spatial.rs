@@ -435,7 +435,7 @@ fn every_method_holds_the_heavy_tops_normalization_and_robust_is_no_worse() {
 /// Every refused input is one error naming the part and the reason.
 #[test]
 fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
-    let body = |f: &dyn Fn(&mut Body)| {
+    let body = |f: fn(&mut Body)| {
         let mut b = Body::new("arm", 1.0, [1.0, 1.0, 1.0]);
         f(&mut b);
         let joint = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
@@ -444,21 +444,21 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
             .err()
             .map(|e| e.to_string())
     };
-    let cases: [(&dyn Fn(&mut Body), &str); 7] = [
-        (&|b| b.orientation = [0.0; 4], "body 0 (arm): orientation has length 0"),
-        (&|b| b.orientation = [0.9, 0.1, 0.0, 0.0], "unit quaternion"),
-        (&|b| b.orientation[1] = f64::NAN, "orientation has length NaN"),
-        (&|b| b.inertia[2][2] = -1.0, "body 0 (arm): inertia must be positive definite"),
-        (&|b| b.inertia = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 3.0]], "not physical"),
-        (&|b| b.inertia[0][1] = 0.5, "symmetric"),
-        (&|b| b.mass = 0.0, "body 0 (arm): mass = 0"),
+    let cases: [(fn(&mut Body), &str); 7] = [
+        (|b| b.orientation = [0.0; 4], "body 0 (arm): orientation has length 0"),
+        (|b| b.orientation = [0.9, 0.1, 0.0, 0.0], "unit quaternion"),
+        (|b| b.orientation[1] = f64::NAN, "orientation has length NaN"),
+        (|b| b.inertia[2][2] = -1.0, "body 0 (arm): inertia must be positive definite"),
+        (|b| b.inertia = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 3.0]], "not physical"),
+        (|b| b.inertia[0][1] = 0.5, "symmetric"),
+        (|b| b.mass = 0.0, "body 0 (arm): mass = 0"),
     ];
     for (change, expected) in cases {
         let message = body(change).expect("refused");
         assert!(message.contains(expected), "{message:?} should contain {expected:?}");
     }
     // A unit quaternion typed to 7 digits is normalized, not refused.
-    assert_eq!(body(&|b| b.orientation = [0.7071068, 0.7071068, 0.0, 0.0]), None);
+    assert_eq!(body(|b| b.orientation = [0.7071068, 0.7071068, 0.0, 0.0]), None);
 
     let two = |joint: Joint<String>| {
         let bodies = vec![Body::new("a", 1.0, [1.0; 3]), Body::new("b", 1.0, [1.0; 3])];
