@@ -19,7 +19,7 @@
 
 use crate::constraint::seeded;
 use crate::scalar::Scalar;
-use num_dual::HyperDual64;
+use num_dual::{Dual64, HyperDual64};
 use std::any::Any;
 
 /// Kinetic energy `T(x, ẋ)` of `K` coordinates, quadratic in `ẋ`.
@@ -67,6 +67,97 @@ pub fn local<T: Kinetic<K>, const K: usize>(t: &T, x: [f64; K], xd: [f64; K]) ->
     Local { energy, mass, grad_q, mdot_v }
 }
 
+/// A kinetic energy `T = ½ wᵀ J w` of `V` velocities `w = B(x) ẋ`, linear
+/// in `ẋ`, with a constant symmetric `J` — a rigid body's rotation in
+/// Euler parameters (`w = (2 G(p) ṗ, pᵀṗ)`), any body whose velocities are
+/// a linear map of the coordinates' rates. The user writes the map once,
+/// generic over the scalar; being linear in `ẋ` lets the library take `M`,
+/// `Ṁ ẋ` and `∂T/∂x` by `2K` dual passes of the map instead of
+/// `K(K + 1)/2 + 2K` hyper-dual passes of `T` (see [`local_map`]).
+pub trait VelocityMap<const K: usize, const V: usize>: Send + Sync + 'static {
+    /// `w = B(x) ẋ`, linear in `ẋ`, for any scalar type.
+    fn velocities<D: Scalar>(&self, x: [D; K], xd: [D; K]) -> [D; V];
+    /// `J`, symmetric.
+    fn inertia(&self) -> [[f64; V]; V];
+}
+
+/// Differentiates a [`VelocityMap`] element at `(x, ẋ)`:
+///
+/// * `B` and `Ḃ = dB/ds (x + s ẋ)` column by column: `w(x + s ẋ, e_j)` with
+///   a dual `s` (K passes);
+/// * `M = Bᵀ J B`, `Ṁ ẋ = Ḃᵀ J w + Bᵀ J Ḃ ẋ`, `T = ½ wᵀ J w`, `w = B ẋ`;
+/// * `∂T/∂x_k = wᵀ J ∂w/∂x_k`, `∂w/∂x_k` from `w(x + ε e_k, ẋ)` (K passes).
+pub fn local_map<T: VelocityMap<K, V>, const K: usize, const V: usize>(t: &T, x: [f64; K], xd: [f64; K]) -> Local<K> {
+    let j = t.inertia();
+    let unit = |i: usize| -> [Dual64; K] { std::array::from_fn(|k| Dual64::from(if k == i { 1.0 } else { 0.0 })) };
+    let moving: [Dual64; K] = std::array::from_fn(|k| Dual64::new(x[k], xd[k]));
+    // Columns of B and Ḃ.
+    let (mut b, mut bdot) = ([[0.0; K]; V], [[0.0; K]; V]);
+    for c in 0..K {
+        let col = t.velocities(moving, unit(c));
+        for r in 0..V {
+            (b[r][c], bdot[r][c]) = (col[r].re, col[r].eps);
+        }
+    }
+    let times =
+        |m: &[[f64; K]; V], v: &[f64; K]| -> [f64; V] { std::array::from_fn(|r| (0..K).map(|c| m[r][c] * v[c]).sum()) };
+    let jv = |v: &[f64; V]| -> [f64; V] { std::array::from_fn(|r| (0..V).map(|c| j[r][c] * v[c]).sum()) };
+    let w = times(&b, &xd);
+    let (jw, jbdot_xd) = (jv(&w), jv(&times(&bdot, &xd)));
+    let jb: [[f64; K]; V] = std::array::from_fn(|r| std::array::from_fn(|c| (0..V).map(|m| j[r][m] * b[m][c]).sum()));
+    let mass = std::array::from_fn(|a| std::array::from_fn(|c| (0..V).map(|r| b[r][a] * jb[r][c]).sum()));
+    let mdot_v = std::array::from_fn(|a| (0..V).map(|r| bdot[r][a] * jw[r] + b[r][a] * jbdot_xd[r]).sum());
+    let xd_fixed = xd.map(Dual64::from);
+    let grad_q = std::array::from_fn(|k| {
+        let dw = t.velocities(seeded(&x, k), xd_fixed);
+        (0..V).map(|r| jw[r] * dw[r].eps).sum()
+    });
+    let energy = 0.5 * (0..V).map(|r| w[r] * jw[r]).sum::<f64>();
+    Local { energy, mass, grad_q, mdot_v }
+}
+
+/// What the model needs of a kinetic element, whichever way it is
+/// differentiated: by hyper-dual passes of `T` ([`ByEnergy`]) or by dual
+/// passes of its velocity map ([`ByMap`]).
+pub(crate) trait KineticElement<const K: usize>: Send + Sync + 'static {
+    fn local(&self, x: [f64; K], xd: [f64; K]) -> Local<K>;
+    /// `T`, and `∂T/∂x` when asked.
+    fn energy(&self, x: [f64; K], xd: [f64; K], grad: Option<&mut [f64; K]>) -> f64;
+}
+
+/// A [`Kinetic`] element.
+pub(crate) struct ByEnergy<T>(pub T);
+
+impl<T: Kinetic<K>, const K: usize> KineticElement<K> for ByEnergy<T> {
+    #[inline(always)]
+    fn local(&self, x: [f64; K], xd: [f64; K]) -> Local<K> {
+        local(&self.0, x, xd)
+    }
+    fn energy(&self, x: [f64; K], xd: [f64; K], grad: Option<&mut [f64; K]>) -> f64 {
+        if let Some(g) = grad {
+            *g = std::array::from_fn(|j| self.0.energy(seeded(&x, j), xd.map(Into::into)).eps);
+        }
+        self.0.energy(x, xd)
+    }
+}
+
+/// A [`VelocityMap`] element.
+pub(crate) struct ByMap<T, const V: usize>(pub T);
+
+impl<T: VelocityMap<K, V>, const K: usize, const V: usize> KineticElement<K> for ByMap<T, V> {
+    #[inline(always)]
+    fn local(&self, x: [f64; K], xd: [f64; K]) -> Local<K> {
+        local_map(&self.0, x, xd)
+    }
+    fn energy(&self, x: [f64; K], xd: [f64; K], grad: Option<&mut [f64; K]>) -> f64 {
+        let l = local_map(&self.0, x, xd);
+        if let Some(g) = grad {
+            *g = l.grad_q;
+        }
+        l.energy
+    }
+}
+
 /// A run of kinetic-energy elements of one type (object-safe face).
 pub(crate) trait KineticBlock: Send + Sync {
     /// Adds `M(q)` into the row-major `n × n` matrix `mass`, `∂T/∂q` into
@@ -91,12 +182,12 @@ pub(crate) struct KineticGroup<T, const K: usize> {
     pub items: Vec<(T, [usize; K])>,
 }
 
-impl<T: Kinetic<K>, const K: usize> KineticBlock for KineticGroup<T, K> {
+impl<T: KineticElement<K>, const K: usize> KineticBlock for KineticGroup<T, K> {
     fn add_all(&self, q: &[f64], v: &[f64], mass: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64 {
         let n = grad_q.len();
         let mut total = 0.0;
         for (t, idx) in &self.items {
-            let l = local(t, idx.map(|i| q[i]), idx.map(|i| v[i]));
+            let l = t.local(idx.map(|i| q[i]), idx.map(|i| v[i]));
             total += l.energy;
             for a in 0..K {
                 grad_q[idx[a]] += l.grad_q[a];
@@ -112,7 +203,7 @@ impl<T: Kinetic<K>, const K: usize> KineticBlock for KineticGroup<T, K> {
     fn add_blocks(&self, q: &[f64], v: &[f64], blocks: &mut [f64], grad_q: &mut [f64], mdot_v: &mut [f64]) -> f64 {
         let mut total = 0.0;
         for ((t, idx), block) in self.items.iter().zip(blocks.chunks_exact_mut(K * K)) {
-            let l = local(t, idx.map(|i| q[i]), idx.map(|i| v[i]));
+            let l = t.local(idx.map(|i| q[i]), idx.map(|i| v[i]));
             total += l.energy;
             for a in 0..K {
                 grad_q[idx[a]] += l.grad_q[a];
@@ -135,20 +226,17 @@ impl<T: Kinetic<K>, const K: usize> KineticBlock for KineticGroup<T, K> {
         self.items.iter().map(|(_, idx)| idx.iter().map(|&i| i as u32).collect()).collect()
     }
 
-    fn energy(&self, q: &[f64], v: &[f64], grad_q: Option<&mut [f64]>) -> f64 {
+    fn energy(&self, q: &[f64], v: &[f64], mut grad_q: Option<&mut [f64]>) -> f64 {
         let mut total = 0.0;
-        match grad_q {
-            None => {
-                for (t, idx) in &self.items {
-                    total += t.energy(idx.map(|i| q[i]), idx.map(|i| v[i]));
-                }
-            }
-            Some(g) => {
-                for (t, idx) in &self.items {
-                    let (x, xd) = (idx.map(|i| q[i]), idx.map(|i| v[i]));
-                    total += t.energy(x, xd);
+        for (t, idx) in &self.items {
+            let (x, xd) = (idx.map(|i| q[i]), idx.map(|i| v[i]));
+            match grad_q.as_deref_mut() {
+                None => total += t.energy(x, xd, None),
+                Some(g) => {
+                    let mut local = [0.0; K];
+                    total += t.energy(x, xd, Some(&mut local));
                     for j in 0..K {
-                        g[idx[j]] += t.energy(seeded(&x, j), xd.map(Into::into)).eps;
+                        g[idx[j]] += local[j];
                     }
                 }
             }

@@ -5,7 +5,7 @@
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
-use crate::kinetic::{Kinetic, KineticBlock, KineticGroup};
+use crate::kinetic::{ByEnergy, ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
@@ -124,10 +124,21 @@ impl ModelBuilder {
     /// coordinates whose inertia comes from such terms. `M(q)` must be
     /// positive definite wherever the motion goes; where it is not, the
     /// evaluation fails with [`Breakdown::Mass`](crate::dynamics::Breakdown::Mass).
-    pub fn kinetic<T: Kinetic<K>, const K: usize>(mut self, t: T, at: [usize; K]) -> Self {
+    pub fn kinetic<T: Kinetic<K>, const K: usize>(self, t: T, at: [usize; K]) -> Self {
+        self.kinetic_element(ByEnergy(t), at)
+    }
+
+    /// Adds a kinetic energy given by its velocity map `w = B(x) ẋ` and
+    /// inertia `J` (see [`VelocityMap`]): the same as [`kinetic`](Self::kinetic)
+    /// with `T = ½ wᵀ J w`, differentiated by cheaper passes.
+    pub fn kinetic_map<T: VelocityMap<K, V>, const K: usize, const V: usize>(self, t: T, at: [usize; K]) -> Self {
+        self.kinetic_element(ByMap::<T, V>(t), at)
+    }
+
+    fn kinetic_element<E: KineticElement<K>, const K: usize>(mut self, e: E, at: [usize; K]) -> Self {
         if self.check_indices("a kinetic energy", &at) {
-            let item = (t, at);
-            match self.kinetic.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<KineticGroup<T, K>>()) {
+            let item = (e, at);
+            match self.kinetic.last_mut().and_then(|b| b.as_any_mut().downcast_mut::<KineticGroup<E, K>>()) {
                 Some(g) => g.items.push(item),
                 None => self.kinetic.push(Box::new(KineticGroup { items: vec![item] })),
             }

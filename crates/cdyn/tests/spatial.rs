@@ -693,3 +693,32 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
     assert!((x[0] - theta.cos()).abs() < 1e-10 && (x[2] + theta.sin()).abs() < 1e-10, "{x:?} vs {theta}");
     assert!(psi < 1e-8, "|Ψ| = {psi:e}");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// A body's rotational energy differentiated as a velocity map (what
+    /// spatial bodies use) and as a plain kinetic energy by hyper-dual
+    /// numbers give the same `M`, `Ṁ ẋ`, `∂T/∂x` and `T`, also off the
+    /// normalization.
+    #[test]
+    fn the_velocity_map_and_the_kinetic_energy_agree(
+        p in prop::array::uniform4(-1.2..1.2f64),
+        pd in prop::array::uniform4(-3.0..3.0f64),
+        j in prop::array::uniform3(0.5..2.0f64),
+        off in -0.3..0.3f64,
+    ) {
+        let inertia = [[j[0] + j[1], off, 0.1], [off, j[1] + j[2], -0.2], [0.1, -0.2, j[0] + j[2]]];
+        let body = cdyn::spatial::Rotation::new(inertia);
+        let (a, b) = (cdyn::kinetic::local(&body, p, pd), cdyn::kinetic::local_map(&body, p, pd));
+        let scale = 1.0 + a.energy.abs();
+        prop_assert!((a.energy - b.energy).abs() < 1e-13 * scale);
+        for r in 0..4 {
+            prop_assert!((a.grad_q[r] - b.grad_q[r]).abs() < 1e-12 * scale, "∂T/∂x {:?} vs {:?}", a.grad_q, b.grad_q);
+            prop_assert!((a.mdot_v[r] - b.mdot_v[r]).abs() < 1e-12 * scale, "Ṁẋ {:?} vs {:?}", a.mdot_v, b.mdot_v);
+            for c in 0..4 {
+                prop_assert!((a.mass[r][c] - b.mass[r][c]).abs() < 1e-13 * scale, "M {:?} vs {:?}", a.mass, b.mass);
+            }
+        }
+    }
+}

@@ -3,7 +3,7 @@
 
 use super::rotation::body_rate;
 use crate::error::{Problem, Result, positive};
-use crate::kinetic::Kinetic;
+use crate::kinetic::{Kinetic, VelocityMap};
 use crate::scalar::Scalar;
 
 /// A rigid body as the user describes it, at the initial instant; in a
@@ -136,6 +136,32 @@ impl Rotation {
     /// The element for inertia `J′`.
     pub fn new(inertia: [[f64; 3]; 3]) -> Self {
         Self { inertia, k: 4.0 * (inertia[0][0] + inertia[1][1] + inertia[2][2]) / 3.0 }
+    }
+}
+
+/// The same energy as a velocity map: `w = (ω′, pᵀṗ)`, `J = diag(J′, k)`,
+/// which the spatial bodies use (cheaper passes; `tests/spatial.rs`
+/// checks it against the [`Kinetic`] form).
+impl VelocityMap<4, 4> for Rotation {
+    #[inline(always)]
+    fn velocities<D: Scalar>(&self, p: [D; 4], pd: [D; 4]) -> [D; 4] {
+        let w = body_rate(p, pd);
+        [w[0], w[1], w[2], p[0] * pd[0] + p[1] * pd[1] + p[2] * pd[2] + p[3] * pd[3]]
+    }
+
+    fn inertia(&self) -> [[f64; 4]; 4] {
+        let j = &self.inertia;
+        std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                if r < 3 && c < 3 {
+                    j[r][c]
+                } else if r == 3 && c == 3 {
+                    self.k
+                } else {
+                    0.0
+                }
+            })
+        })
     }
 }
 

@@ -19,7 +19,7 @@
 //! where `(f, g, h)` is the joint's frame, `h` its axis, carried into each
 //! body at the initial pose (so every joint starts assembled).
 
-use super::rotation::rotate;
+use super::rotation::rotate_fixed;
 use crate::constraint::Constraint;
 use crate::scalar::Scalar;
 use crate::timefn::TimeFn;
@@ -171,7 +171,7 @@ impl<D: Scalar> Side<'_, D> {
     fn point(&self) -> [D; 3] {
         match self {
             Side::Body { r, p, frame } => {
-                let x = rotate(*p, frame.s.map(D::from));
+                let x = rotate_fixed(*p, frame.s);
                 std::array::from_fn(|i| r[i] + x[i])
             }
             Side::Ground(frame) => frame.s.map(D::from),
@@ -179,7 +179,7 @@ impl<D: Scalar> Side<'_, D> {
     }
     fn axis(&self, k: usize) -> [D; 3] {
         match self {
-            Side::Body { p, frame, .. } => rotate(*p, frame.axes[k].map(D::from)),
+            Side::Body { p, frame, .. } => rotate_fixed(*p, frame.axes[k]),
             Side::Ground(frame) => frame.axes[k].map(D::from),
         }
     }

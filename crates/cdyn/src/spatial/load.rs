@@ -6,7 +6,7 @@
 //! are potentials (their energy is part of `V`); dampers, forces and
 //! torques are forces.
 
-use super::rotation::{e_matrix, rotate};
+use super::rotation::{e_matrix, rotate_fixed};
 use crate::force::{Force, Potential};
 use crate::scalar::Scalar;
 
@@ -115,7 +115,7 @@ struct End<D> {
 /// The end at body point `s` of the body whose `(r, p)` start at `x[at]`.
 fn body_end<D: Scalar, const K: usize>(x: &[D; K], xd: &[D; K], at: usize, s: [f64; 3]) -> End<D> {
     let p: [D; 4] = std::array::from_fn(|i| x[at + 3 + i]);
-    let arm = rotate(p, s.map(D::from));
+    let arm = rotate_fixed(p, s);
     let w = rate(p, std::array::from_fn(|i| xd[at + 3 + i]));
     let spin = cross(w, arm);
     End {
@@ -232,7 +232,7 @@ impl Force<8> for BodyRotaryDamper {
     fn force<D: Scalar>(&self, x: [D; 8], xd: [D; 8], _t: D) -> [D; 8] {
         let (pa, pb): ([D; 4], [D; 4]) = (std::array::from_fn(|i| x[i]), std::array::from_fn(|i| x[4 + i]));
         let (va, vb): ([D; 4], [D; 4]) = (std::array::from_fn(|i| xd[i]), std::array::from_fn(|i| xd[4 + i]));
-        let h = rotate(pa, self.axis.map(D::from));
+        let h = rotate_fixed(pa, self.axis);
         let (wa, wb) = (rate(pa, va), rate(pb, vb));
         let rel = (0..3).fold(D::zero(), |s, i| s + (wb[i] - wa[i]) * h[i]);
         let n: [D; 3] = std::array::from_fn(|i| -(rel * h[i]) * self.c);

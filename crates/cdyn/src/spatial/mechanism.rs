@@ -222,7 +222,7 @@ impl Mechanism {
         for (i, body) in self.bodies.iter().enumerate() {
             let b = SpatialBody::of(i);
             builder = builder
-                .kinetic(Rotation::new(body.inertia), b.euler_parameters())
+                .kinetic_map(Rotation::new(body.inertia), b.euler_parameters())
                 .constrain(UnitNorm, b.euler_parameters());
             rows.push(Part::Body { index: i, name: body.name.clone() });
             if self.gravity != [0.0; 3] {

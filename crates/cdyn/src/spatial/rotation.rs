@@ -27,6 +27,19 @@ pub fn rotate<D: Scalar>(p: [D; 4], s: [D; 3]) -> [D; 3] {
     std::array::from_fn(|i| s[i] * scale + e[i] * es * 2.0 + e0 * cross[i] * 2.0)
 }
 
+/// `A(p) s` for a constant `s` (a body-fixed point or axis): the same
+/// arithmetic as [`rotate`] with the products by `s` in plain `f64`,
+/// which for dual numbers costs a third less than products of two duals.
+#[inline(always)]
+pub fn rotate_fixed<D: Scalar>(p: [D; 4], s: [f64; 3]) -> [D; 3] {
+    let [e0, e1, e2, e3] = p;
+    let e = [e1, e2, e3];
+    let scale = e0 * e0 - (e1 * e1 + e2 * e2 + e3 * e3);
+    let es = e1 * s[0] + e2 * s[1] + e3 * s[2];
+    let cross = [e2 * s[2] - e3 * s[1], e3 * s[0] - e1 * s[2], e1 * s[1] - e2 * s[0]];
+    std::array::from_fn(|i| scale * s[i] + e[i] * es * 2.0 + e0 * cross[i] * 2.0)
+}
+
 /// `A(p)ᵀ x`: a space vector in body axes (`|p| = 1`).
 pub fn unrotate(p: [f64; 4], x: [f64; 3]) -> [f64; 3] {
     rotate([p[0], -p[1], -p[2], -p[3]], x)
