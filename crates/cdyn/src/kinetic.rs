@@ -117,7 +117,7 @@ pub fn local_map<T: VelocityMap<K, V>, const K: usize, const V: usize>(t: &T, x:
 }
 
 /// What the model needs of a kinetic element, whichever way it is
-/// differentiated: by hyper-dual passes of `T` ([`ByEnergy`]) or by dual
+/// differentiated: by hyper-dual passes of `T` (every [`Kinetic`]) or by dual
 /// passes of its velocity map ([`ByMap`]).
 pub(crate) trait KineticElement<const K: usize>: Send + Sync + 'static {
     fn local(&self, x: [f64; K], xd: [f64; K]) -> Local<K>;
@@ -125,19 +125,17 @@ pub(crate) trait KineticElement<const K: usize>: Send + Sync + 'static {
     fn energy(&self, x: [f64; K], xd: [f64; K], grad: Option<&mut [f64; K]>) -> f64;
 }
 
-/// A [`Kinetic`] element.
-pub(crate) struct ByEnergy<T>(pub T);
-
-impl<T: Kinetic<K>, const K: usize> KineticElement<K> for ByEnergy<T> {
+/// Every [`Kinetic`] element, differentiated by hyper-dual passes of `T`.
+impl<T: Kinetic<K>, const K: usize> KineticElement<K> for T {
     #[inline(always)]
     fn local(&self, x: [f64; K], xd: [f64; K]) -> Local<K> {
-        local(&self.0, x, xd)
+        local(self, x, xd)
     }
     fn energy(&self, x: [f64; K], xd: [f64; K], grad: Option<&mut [f64; K]>) -> f64 {
         if let Some(g) = grad {
-            *g = std::array::from_fn(|j| self.0.energy(seeded(&x, j), xd.map(Into::into)).eps);
+            *g = std::array::from_fn(|j| Kinetic::energy(self, seeded(&x, j), xd.map(Into::into)).eps);
         }
-        self.0.energy(x, xd)
+        Kinetic::energy(self, x, xd)
     }
 }
 

@@ -5,7 +5,7 @@
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
-use crate::kinetic::{ByEnergy, ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
+use crate::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
@@ -125,7 +125,7 @@ impl ModelBuilder {
     /// positive definite wherever the motion goes; where it is not, the
     /// evaluation fails with [`Breakdown::Mass`](crate::dynamics::Breakdown::Mass).
     pub fn kinetic<T: Kinetic<K>, const K: usize>(self, t: T, at: [usize; K]) -> Self {
-        self.kinetic_element(ByEnergy(t), at)
+        self.kinetic_element(t, at)
     }
 
     /// Adds a kinetic energy given by its velocity map `w = B(x) ẋ` and
