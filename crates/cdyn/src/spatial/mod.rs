@@ -16,11 +16,17 @@
 //! energy balance of the library are written, and its mass is
 //! block-diagonal, which the sparse solver factors block by block
 //! ([`BlockMass`](crate::mass::BlockMass)) at a cost linear in the number
-//! of bodies. The price is the AD of the 4 × 4 block at every evaluation.
+//! of bodies. The price is the AD of the 4 × 4 block at every evaluation,
+//! kept small by giving the energy as a velocity map
+//! ([`VelocityMap`](crate::kinetic::VelocityMap)).
 //!
-//! Joints are placed by a point and axes in space at the initial pose, and
-//! carried into each body's frame there, so that a joint is always
-//! assembled where it is defined.
+//! Joints ([`Joint`]: spherical, revolute, universal, cylindrical,
+//! prismatic, fixed, distance; revolute, prismatic and cylindrical ones
+//! optionally driven) and loads ([`Load`]: spring-dampers, rotary dampers,
+//! forces, torques) are placed by points and axes in space at the initial
+//! pose, and carried into each body's frame there, so that a mechanism is
+//! always assembled where it is defined. `from_urdf` (feature `urdf`)
+//! reads a robot; [`Sketch`] is what figures draw.
 
 mod body;
 mod chain;
