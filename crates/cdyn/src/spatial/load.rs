@@ -6,7 +6,7 @@
 //! are potentials (their energy is part of `V`); dampers, forces and
 //! torques are forces.
 
-use super::rotation::{e_matrix, rotate_fixed};
+use super::rotation::{cross, rotate_fixed, space_rate as rate, torque_on_parameters as on_parameters};
 use crate::force::{Force, Potential};
 use crate::scalar::Scalar;
 
@@ -85,22 +85,6 @@ impl<B> Load<B> {
             Load::Torque { .. } => "torque",
         }
     }
-}
-
-/// `ω = 2 E(p) ṗ`
-fn rate<D: Scalar>(p: [D; 4], pd: [D; 4]) -> [D; 3] {
-    let e = e_matrix(p);
-    std::array::from_fn(|i| (e[i][0] * pd[0] + e[i][1] * pd[1] + e[i][2] * pd[2] + e[i][3] * pd[3]) * 2.0)
-}
-
-/// `2 E(p)ᵀ n`
-fn on_parameters<D: Scalar>(p: [D; 4], n: [D; 3]) -> [D; 4] {
-    let e = e_matrix(p);
-    std::array::from_fn(|j| (e[0][j] * n[0] + e[1][j] * n[1] + e[2][j] * n[2]) * 2.0)
-}
-
-fn cross<D: Scalar>(a: [D; 3], b: [D; 3]) -> [D; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// One end of a two-point load at a state: a body point (its arm `A s`

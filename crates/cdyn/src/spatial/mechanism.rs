@@ -4,7 +4,7 @@
 use super::body::{Body, Rotation};
 use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows, UnitNorm};
 use super::load::{BodyRotaryDamper, BodyTorque, GroundRotaryDamper, LineDamper, Load, PointForce, SpringEnergy};
-use super::rotation::{rate_from_body, unrotate};
+use super::rotation::{cross, rate_from_body, unrotate};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::Potential;
 use crate::model::{Model, ModelBuilder};
@@ -93,10 +93,6 @@ fn unit(name: &'static str, x: [f64; 3]) -> Result<[f64; 3]> {
         return Err(Problem::ZeroAxis { name }.into());
     }
     Ok(x.map(|x| x / norm))
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// A right-handed frame `(f, g, h)` with axis `h`.

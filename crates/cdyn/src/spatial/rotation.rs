@@ -58,9 +58,21 @@ pub fn body_rate<D: Scalar>(p: [D; 4], pd: [D; 4]) -> [D; 3] {
 }
 
 /// The spatial angular velocity `ω = 2 E(p) ṗ`.
-pub fn space_rate(p: [f64; 4], pd: [f64; 4]) -> [f64; 3] {
+pub fn space_rate<D: Scalar>(p: [D; 4], pd: [D; 4]) -> [D; 3] {
     let e = e_matrix(p);
-    std::array::from_fn(|i| 2.0 * (0..4).map(|j| e[i][j] * pd[j]).sum::<f64>())
+    std::array::from_fn(|i| (e[i][0] * pd[0] + e[i][1] * pd[1] + e[i][2] * pd[2] + e[i][3] * pd[3]) * 2.0)
+}
+
+/// The generalized force `2 E(p)ᵀ n` of a torque `n` (space axes) on the
+/// Euler parameters: its power `(2 Eᵀ n) · ṗ = n · ω`.
+pub fn torque_on_parameters<D: Scalar>(p: [D; 4], n: [D; 3]) -> [D; 4] {
+    let e = e_matrix(p);
+    std::array::from_fn(|j| (e[0][j] * n[0] + e[1][j] * n[1] + e[2][j] * n[2]) * 2.0)
+}
+
+/// `a × b`
+pub fn cross<D: Scalar>(a: [D; 3], b: [D; 3]) -> [D; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// The unit quaternion of a rotation by `angle` about the unit `axis`.
