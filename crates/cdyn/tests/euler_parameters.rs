@@ -8,28 +8,14 @@
 //! spatial issue has to weigh; the numbers here are its first measurement.
 
 use cdyn::kinetic::Kinetic;
-use cdyn::reference::elliptic::jacobi;
+use cdyn::reference::torque_free_rate;
+use cdyn::spatial::rotation::{body_rate, e_matrix, g_matrix};
 use cdyn::{Constraint, Control, Error, Model, Scalar, Scheme, Settings, Simulation, methods};
 
 /// Principal moments of inertia, `J₁ < J₂ < J₃`.
 const J: [f64; 3] = [1.0, 2.0, 3.0];
 /// Initial body angular velocity `(a, 0, c)`: the motion about the third axis.
 const W0: [f64; 3] = [1.0, 0.0, 1.0];
-
-/// `G(p)`, with `ω = 2 G ṗ` the body angular velocity (Haug's convention).
-fn g_matrix<D: Scalar>([e0, e1, e2, e3]: [D; 4]) -> [[D; 4]; 3] {
-    [[-e1, e0, e3, -e2], [-e2, -e3, e0, e1], [-e3, e2, -e1, e0]]
-}
-
-/// `E(p)`, with `A = E Gᵀ` the rotation from body to space axes.
-fn e_matrix([e0, e1, e2, e3]: [f64; 4]) -> [[f64; 4]; 3] {
-    [[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]]
-}
-
-fn body_rate<D: Scalar>(p: [D; 4], pd: [D; 4]) -> [D; 3] {
-    let g = g_matrix(p);
-    std::array::from_fn(|i| (0..4).fold(D::zero(), |s, j| s + g[i][j] * pd[j]) * 2.0)
-}
 
 /// The body's kinetic energy, plus `½ k (pᵀṗ)²`, which vanishes with its
 /// derivatives on the constraint (`pᵀṗ = 0`) and makes `M` invertible.
@@ -55,15 +41,9 @@ impl Constraint<4, 1> for UnitNorm {
     }
 }
 
-/// Euler's torque-free motion from `ω(0) = (a, 0, c)`:
-/// `ω = (a cn, b sn, c dn)(s t; k)`, with `s`, `b` and `k` from Euler's equations.
+/// Euler's torque-free motion from `ω(0) = (a, 0, c)` ([`torque_free_rate`]).
 fn euler_exact(t: f64) -> [f64; 3] {
-    let ([j1, j2, j3], [a, _, c]) = (J, W0);
-    let s = ((j3 - j2) * (j3 - j1) / (j1 * j2)).sqrt() * c;
-    let b = j1 * a * s / ((j3 - j2) * c);
-    let k = ((j2 - j1) * a * b / (j3 * c * s)).sqrt();
-    let (sn, cn, dn, _) = jacobi(s * t, k);
-    [a * cn, b * sn, c * dn]
+    torque_free_rate(J, [W0[0], W0[2]], t)
 }
 
 fn model() -> (Model, Vec<f64>, Vec<f64>) {

@@ -4,7 +4,7 @@
 //! torque-free motion, the heavy top benchmark).
 
 use cdyn::dynamics::{Dynamics, LinearSolver};
-use cdyn::reference::elliptic::jacobi;
+use cdyn::reference::torque_free_rate;
 use cdyn::spatial::rotation::{about, body_rate, compose, rate_from_body, rotate, space_rate};
 use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
 use cdyn::timefn::TimeFn;
@@ -211,15 +211,9 @@ const J: [f64; 3] = [1.0, 2.0, 3.0];
 /// Initial body angular velocity `(a, 0, c)` in principal axes.
 const W0: [f64; 3] = [1.0, 0.0, 1.0];
 
-/// Euler's torque-free motion from `ω(0) = (a, 0, c)`:
-/// `ω = (a cn, b sn, c dn)(s t; k)`.
+/// Euler's torque-free motion from `ω(0) = (a, 0, c)` ([`torque_free_rate`]).
 fn euler_exact(t: f64) -> [f64; 3] {
-    let ([j1, j2, j3], [a, _, c]) = (J, W0);
-    let s = ((j3 - j2) * (j3 - j1) / (j1 * j2)).sqrt() * c;
-    let b = j1 * a * s / ((j3 - j2) * c);
-    let k = ((j2 - j1) * a * b / (j3 * c * s)).sqrt();
-    let (sn, cn, dn, _) = jacobi(s * t, k);
-    [a * cn, b * sn, c * dn]
+    torque_free_rate(J, [W0[0], W0[2]], t)
 }
 
 /// A free body whose body axes are turned by `turn` from its principal
