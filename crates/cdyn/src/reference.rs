@@ -411,6 +411,19 @@ pub(crate) mod fine_ode {
     }
 }
 
+/// Euler's torque-free motion of a rigid body with principal moments
+/// `J₁ < J₂ < J₃` from the body angular velocity `ω(0) = (a, 0, c)` (the
+/// motion about the third axis): `ω(t) = (a cn, b sn, c dn)(s t; k)`, with
+/// `s`, `b` and `k` from Euler's equations. The shared reference of the
+/// rigid-body tests.
+pub fn torque_free_rate([j1, j2, j3]: [f64; 3], [a, c]: [f64; 2], t: f64) -> [f64; 3] {
+    let s = ((j3 - j2) * (j3 - j1) / (j1 * j2)).sqrt() * c;
+    let b = j1 * a * s / ((j3 - j2) * c);
+    let k = ((j2 - j1) * a * b / (j3 * c * s)).sqrt();
+    let (sn, cn, dn, _) = elliptic::jacobi(s * t, k);
+    [a * cn, b * sn, c * dn]
+}
+
 #[cfg(test)]
 mod tests {
     use super::elliptic::{Modulus, complete_k, incomplete_f, jacobi};
@@ -867,17 +880,4 @@ mod tests {
         assert_eq!(ode.at(0.4), early);
         assert!(ode.at(-1.0)[0].is_nan());
     }
-}
-
-/// Euler's torque-free motion of a rigid body with principal moments
-/// `J₁ < J₂ < J₃` from the body angular velocity `ω(0) = (a, 0, c)` (the
-/// motion about the third axis): `ω(t) = (a cn, b sn, c dn)(s t; k)`, with
-/// `s`, `b` and `k` from Euler's equations. The shared reference of the
-/// rigid-body tests.
-pub fn torque_free_rate([j1, j2, j3]: [f64; 3], [a, c]: [f64; 2], t: f64) -> [f64; 3] {
-    let s = ((j3 - j2) * (j3 - j1) / (j1 * j2)).sqrt() * c;
-    let b = j1 * a * s / ((j3 - j2) * c);
-    let k = ((j2 - j1) * a * b / (j3 * c * s)).sqrt();
-    let (sn, cn, dn, _) = elliptic::jacobi(s * t, k);
-    [a * cn, b * sn, c * dn]
 }
