@@ -13,6 +13,7 @@ pub mod error;
 pub mod force;
 pub mod gains;
 pub mod integrate;
+mod jet;
 #[cfg(feature = "serde")]
 pub mod json_float;
 pub mod kinetic;
