@@ -116,6 +116,16 @@ pub fn table(cases: &[CaseResult]) -> String {
             c.error.as_ref().map_or(String::new(), |e| format!("  FAILED: {e}")),
         );
     }
+    for c in cases {
+        if let Some(t) = c.tuning.filter(|t| t.energy_left_out) {
+            out += &format!(
+                "note: {}: energy term left out, the damping is stiff against the step (h λ_d = {:.3}, above {})\n",
+                c.name,
+                t.dissipation_h,
+                cdyn::gains::STIFF_DISSIPATION_H
+            );
+        }
+    }
     out
 }
 

@@ -8,7 +8,7 @@ use crate::control::Control;
 use crate::diagnostics::Measures;
 use crate::dynamics::{DependentRows, LinearSolver};
 use crate::error::{Error, Part, Problem, Result, positive};
-use crate::gains::{Tuning, resolve};
+use crate::gains::{Operators, Tuning, resolve};
 use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
 use crate::projection::{Failure, OnFailure};
@@ -148,12 +148,12 @@ impl<S: System> Stepper<S> {
         // Automatic gains, and the rate × h every control term runs at.
         // A state the dynamics cannot evaluate fails the first step, which
         // reports it with the run's record; the gains are then moot.
-        let (mu, max_row_norm2) = if settings.control.is_active() {
-            system.coupling(x.as_slice(), 0.0).unwrap_or((1.0, 0.0))
+        let operators = if settings.control.is_active() {
+            system.operators(x.as_slice(), 0.0).unwrap_or(Operators { coupling: 1.0, ..Operators::default() })
         } else {
-            (0.0, 0.0)
+            Operators::default()
         };
-        let (control, tuning) = resolve(settings.control, settings.scheme, settings.h, mu, max_row_norm2);
+        let (control, tuning) = resolve(settings.control, settings.scheme, settings.h, operators);
         system.set_control(control);
         let settings = Settings { control, ..settings };
         let integrator = Integrator::with_zero(settings.scheme, settings.control.application, system.zero_state());

@@ -17,6 +17,7 @@ use crate::diagnostics::Measures;
 use crate::energy;
 use crate::error::{Error, Result};
 use crate::force::{Force, Potential, energy_and_gradient};
+use crate::gains::Operators;
 use crate::integrate::{Buffer, Rhs};
 use crate::linalg::{Breakdown, DependentRows, inverse_pivot};
 use crate::mass::{DiagonalMass, MassMatrix};
@@ -25,6 +26,7 @@ use crate::projection::{Failure, Projection};
 use crate::scalar::Scalar;
 use crate::simulate::{Settings, Stepper, check_initial_state};
 use crate::system::{EvalError, System};
+use num_dual::Dual64;
 use std::sync::Arc;
 
 /// A whole system of `N` coordinates with a constant diagonal mass matrix
@@ -415,11 +417,22 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         let columns = &SmallDynamics::<N, M>::COLUMNS;
         Measures::of(psi, &grad, &l.phi, &l.phi_dot, |r| (l.jac[r].as_slice(), columns.as_slice()))
     }
-    fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError> {
+    fn operators(&mut self, x: &[f64], t: f64) -> Result<Operators, EvalError> {
         let (q, v, _) = split(x);
         self.d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
         let rows = self.d.jac.iter().map(|row| row.iter().map(|j| j * j).sum::<f64>());
-        Ok((crate::gains::coupling(&self.d, N), rows.fold(0.0, f64::max)))
+        let system = &self.system;
+        // −∂Q/∂v · w, one directional dual pass.
+        let damping = |w: &[f64], out: &mut [f64]| {
+            let along: [Dual64; N] = std::array::from_fn(|i| Dual64::new(v[i], w[i]));
+            let f = system.force(q.map(Dual64::from), along, Dual64::from(t));
+            out.iter_mut().zip(f).for_each(|(o, f)| *o = -f.eps);
+        };
+        Ok(Operators {
+            coupling: crate::gains::coupling(&self.d, N),
+            max_row_norm2: rows.fold(0.0, f64::max),
+            dissipation: crate::gains::dissipation_rate(&self.d, N, damping),
+        })
     }
     fn set_control(&mut self, control: Control) {
         self.control = control;

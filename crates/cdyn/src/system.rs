@@ -5,6 +5,7 @@ use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::energy;
+use crate::gains::Operators;
 use crate::integrate::{Buffer, Rhs};
 use crate::mass::{MassAt, MassMatrix};
 use crate::model::Model;
@@ -67,7 +68,7 @@ pub trait System: Rhs<Error = EvalError> {
     /// At the state `x`, time `t`: the largest mode `μ_max` of the paper's
     /// CVSGF operator and the largest `|∇Φᵢ|²`, for automatic gains
     /// ([`crate::gains`]). Not counted as an evaluation.
-    fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError>;
+    fn operators(&mut self, x: &[f64], t: f64) -> Result<Operators, EvalError>;
     /// Replaces the control law (once its automatic gains are chosen).
     fn set_control(&mut self, control: Control);
     /// Projects the state `x` at time `t` onto the invariants (the
@@ -216,12 +217,28 @@ impl System for ControlledSystem<'_> {
         let (q, v, e) = split_state(x, self.model.n());
         self.probe.measure(self.model, q, v, e, t, self.e0)
     }
-    fn coupling(&mut self, x: &[f64], t: f64) -> Result<(f64, f64), EvalError> {
+    fn operators(&mut self, x: &[f64], t: f64) -> Result<Operators, EvalError> {
         let (q, v, _) = split_state(x, self.model.n());
-        self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let d = Evaluated { model: self.model, dynamics: &self.dynamics, mass: &self.dynamics.mass(self.model) };
-        let rows = (0..self.model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
-        Ok((crate::gains::coupling(&d, self.model.n()), rows.fold(0.0, f64::max)))
+        let (model, n) = (self.model, self.model.n());
+        self.dynamics.evaluate(model, q, v, t).map_err(|b| EvalError::at(b, t))?;
+        let d = Evaluated { model, dynamics: &self.dynamics, mass: &self.dynamics.mass(model) };
+        let rows = (0..model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
+        let (mut vp, mut fp, mut fm) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let damping = |w: &[f64], out: &mut [f64]| {
+            // −∂Q/∂v · w by central differences (exact for linear dampers).
+            let scale = 1e-6 * (1.0 + v.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
+            for (sign, f) in [(1.0, &mut fp), (-1.0, &mut fm)] {
+                vp.iter_mut().zip(v).zip(w).for_each(|((p, v), w)| *p = v + sign * scale * w);
+                f.fill(0.0);
+                model.add_forces(q, &vp, t, f);
+            }
+            out.iter_mut().zip(fp.iter().zip(&fm)).for_each(|(o, (p, m))| *o = -(p - m) / (2.0 * scale));
+        };
+        Ok(Operators {
+            coupling: crate::gains::coupling(&d, n),
+            max_row_norm2: rows.fold(0.0, f64::max),
+            dissipation: crate::gains::dissipation_rate(&d, n, damping),
+        })
     }
     fn set_control(&mut self, control: Control) {
         self.control = control;

@@ -948,17 +948,22 @@ fn the_stiff_flyball_governor_keeps_its_steady_state_momentum_and_energy_balance
         gap(&coarse)
     );
     assert!(momentum < 1e-10 && psi < 1e-6 && phi < 1e-9 && gap(&coarse) < 1e-9);
-    // Stabilized without its energy term, robust is no worse than none.
-    let without_energy = Control { energy: cdyn::Energy::None, ..methods::robust() };
-    let (geometric, g_momentum, _, g_phi) = run(1e-4, without_energy);
-    println!("robust without energy: {g_momentum:.1e}, |Φ| {g_phi:.1e}, to h/2 {:.1e}", gap(&geometric));
-    assert!(g_momentum <= momentum && g_phi < 1e-12 && gap(&geometric) <= gap(&coarse));
-    // With it, robust and projection are worse than none here (printed,
-    // not asserted): they hold T + V to E₀ minus the dampers' work as the
-    // scheme integrated it, and with c = 4e4 N s/m (hλ ≈ 1) that integral
-    // carries more error than the state does (|Ψ| of none above), which
-    // the energy term then moves into the state.
-    for (name, control) in [("robust", methods::robust()), ("projection", methods::projection())] {
+    // Its dampers are stiff against the step (h λ_d = 0.81): robust
+    // leaves out its energy term (gains::STIFF_DISSIPATION_H) and is closer
+    // than none.
+    let (robust, r_momentum, _, r_phi) = run(1e-4, methods::robust());
+    println!("robust: |ΔL_z|/L_z {r_momentum:.1e}, |Φ| {r_phi:.1e}, to h/2 {:.1e}", gap(&robust));
+    assert!(r_momentum <= momentum && r_phi < 1e-12 && gap(&robust) <= gap(&coarse));
+    // With the energy term (robust's, at its automatic rate, or the
+    // projection's), the state is held to E₀ minus the dampers' work as
+    // the scheme integrated it, which carries more error than the state
+    // (none's |Ψ| above against its state's energy error, about 4e-9 J):
+    // printed, not asserted.
+    let with_energy = Control {
+        energy: cdyn::Energy::Projected { alpha_e: cdyn::Rate::Given(1.0 / 1e-4), position_weight: 16.0 },
+        ..methods::robust()
+    };
+    for (name, control) in [("robust with its energy term", with_energy), ("projection", methods::projection())] {
         let (q, m, p, f) = run(1e-4, control);
         println!("{name}: {m:.1e}, |Ψ| {p:.1e}, |Φ| {f:.1e}, to h/2 {:.1e}", gap(&q));
     }

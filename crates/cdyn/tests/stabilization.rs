@@ -13,8 +13,8 @@ use cdyn::gains;
 use cdyn::integrate::Rhs;
 use cdyn::methods::{self, MethodGains};
 use cdyn::models::{
-    FourBarParams, LoadPendulum, PendulumParams, SliderCrankParams, cartesian_pendulum, four_bar, slider_crank,
-    small_pendulum,
+    DampedPendulumParams, FourBarParams, LoadPendulum, PendulumParams, SliderCrankParams, cartesian_pendulum,
+    damped_pendulum, four_bar, slider_crank, small_pendulum,
 };
 use cdyn::planar::{BodyId, Element, Mechanism};
 use cdyn::projection::{OnFailure, Projection};
@@ -577,6 +577,30 @@ fn automatic_cvsgf_gain_sees_the_coupling_of_the_rows() {
                 }
                 other => panic!("{case}: resolved to {other:?}"),
             }
+        }
+    }
+}
+
+/// The automatic energy term is left out where the damping is stiff
+/// against the step (`gains::STIFF_DISSIPATION_H`), and only there. The
+/// damped pendulum's only damping is the rotary damper: `λ_d = c /
+/// I_pivot` exactly, on the one motion its pin allows.
+#[test]
+fn the_automatic_energy_term_is_left_out_where_the_damping_is_stiff() {
+    for (damping, h) in [(0.1, 0.01), (5.0, 0.01), (0.0, 0.01), (50.0, 1e-4)] {
+        let params = DampedPendulumParams { damping, ..Default::default() };
+        let ex = damped_pendulum(params).unwrap();
+        let rate = damping / params.pivot_inertia();
+        for (name, control) in [("robust", methods::robust()), ("cvsgf_energy", MethodGains::paper().cvsgf_energy())] {
+            let sim =
+                Simulation::new(&ex.model, Settings::new(Scheme::RungeKutta4, h, control), &ex.q0, &ex.v0).unwrap();
+            let tuning = *sim.tuning();
+            let case = format!("c = {damping}, h = {h}, {name}: {tuning:?}");
+            assert!((tuning.dissipation_h - rate * h).abs() <= 1e-6 * (rate * h).max(1e-12), "{case}: λ_d = {rate}");
+            // Only robust's automatic term is dropped; the paper's stays as given.
+            let left_out = name == "robust" && rate * h > gains::STIFF_DISSIPATION_H;
+            assert_eq!(tuning.energy_left_out, left_out, "{case}");
+            assert_eq!(sim.settings().control.energy == Energy::None, left_out, "{case}");
         }
     }
 }
