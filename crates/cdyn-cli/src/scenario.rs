@@ -187,6 +187,11 @@ pub fn from_table(table: toml::Table, file: &str) -> Result<(Scenario, toml::Tab
             anyhow!("{file}: {place}{}", reason(e.inner()))
         })
     }
+    // Without [model] the kind is unknown, and its entries (a spatial
+    // body's inertia tensor, say) would be refused as the wrong kind's.
+    if !table.contains_key("model") {
+        bail!("{file}: missing field model: a scenario needs a [model] table with its kind");
+    }
     // A spatial mechanism's bodies and joints have their own types.
     let spatial = table.get("model").and_then(|m| m.get("kind")).and_then(|k| k.as_str()) == Some("spatial");
     if spatial && table.contains_key("drives") {
