@@ -495,13 +495,15 @@ impl Scenario {
         gravity: [f64; 3],
     ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, Counts)> {
         let mut robot = cdyn::spatial::Mechanism::default();
+        let (mut joint_names, mut load_names) = (Vec::new(), Vec::new());
         match self.model.pendulum_keys.get("urdf") {
             None => {}
             Some(toml::Value::String(name)) => {
                 let path = Path::new(file).parent().unwrap_or(Path::new("")).join(name);
                 let text = read_bounded(&path).map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
-                robot = cdyn::spatial::from_urdf(&text, gravity)
+                let read = cdyn::spatial::read_urdf(&text, gravity)
                     .map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
+                (robot, joint_names, load_names) = (read.mechanism, read.joint_names, read.load_names);
             }
             Some(other) => bail!("{file}: [model] urdf = {other}: expected the path of a URDF file"),
         }
@@ -541,9 +543,9 @@ impl Scenario {
             .collect();
         let counts = Counts {
             robot_bodies: robot.bodies.len(),
-            robot_joints: joints.len(),
             joints: joints.len() + entries.joints.len(),
-            robot_loads: robot_loads.len(),
+            robot_joints: joint_names,
+            robot_loads: load_names,
         };
         joints.extend(entries.joints);
         let mut bodies = robot.bodies;
@@ -588,26 +590,33 @@ impl Scenario {
 /// every joint in the numbering of `Part::Element`).
 struct Counts {
     robot_bodies: usize,
-    robot_joints: usize,
+    /// Every joint, the robot's and the scenario's.
     joints: usize,
-    robot_loads: usize,
+    /// The URDF joint behind each of the robot's joints, and behind each of
+    /// its loads (a joint's damping).
+    robot_joints: Vec<String>,
+    robot_loads: Vec<String>,
 }
 
 impl Counts {
     /// The part as the scenario or the robot names it: `bodies[0] (top)`,
-    /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`.
+    /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`,
+    /// `urdf joint "elbow" (revolute)`.
     fn entry(&self, part: &Part) -> String {
+        let (robot_joints, robot_loads) = (self.robot_joints.len(), self.robot_loads.len());
         match part {
             Part::Body { index, name } if *index < self.robot_bodies => format!("urdf link {name:?}"),
             Part::Body { index, name } => format!("bodies[{}] ({name})", index - self.robot_bodies),
-            Part::Element { index, kind } if *index < self.robot_joints => format!("urdf joint {index} ({kind})"),
+            Part::Element { index, kind } if *index < robot_joints => {
+                format!("urdf joint {:?} ({kind})", self.robot_joints[*index])
+            }
             Part::Element { index, kind } if *index < self.joints => {
-                format!("joints[{}] ({kind})", index - self.robot_joints)
+                format!("joints[{}] ({kind})", index - robot_joints)
             }
-            Part::Element { index, kind } if *index < self.joints + self.robot_loads => {
-                format!("urdf joint damping {} ({kind})", index - self.joints)
+            Part::Element { index, kind } if *index < self.joints + robot_loads => {
+                format!("urdf joint {:?} damping ({kind})", self.robot_loads[index - self.joints])
             }
-            Part::Element { index, kind } => format!("forces[{}] ({kind})", index - self.joints - self.robot_loads),
+            Part::Element { index, kind } => format!("forces[{}] ({kind})", index - self.joints - robot_loads),
             other => other.to_string(),
         }
     }
@@ -634,4 +643,28 @@ fn worst_entry(example: &Example, rows: &[String]) -> String {
     model.constraint_values(&example.q0, 0.0, &mut phi);
     let worst = (0..phi.len()).max_by(|&a, &b| phi[a].abs().total_cmp(&phi[b].abs()));
     worst.and_then(|r| rows.get(r)).map_or(String::new(), |e| format!(" (worst: {e})"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_robots_parts_are_named_as_its_urdf_names_them() {
+        // A robot of two links, joints "shoulder" and "elbow" (damped), then
+        // the scenario's one body, two joints and one force.
+        let counts = Counts {
+            robot_bodies: 2,
+            joints: 4,
+            robot_joints: vec!["shoulder".into(), "elbow".into()],
+            robot_loads: vec!["elbow".into()],
+        };
+        let element = |index, kind| counts.entry(&Part::Element { index, kind });
+        assert_eq!(counts.entry(&Part::Body { index: 1, name: "fore".into() }), "urdf link \"fore\"");
+        assert_eq!(counts.entry(&Part::Body { index: 2, name: "weight".into() }), "bodies[0] (weight)");
+        assert_eq!(element(1, "revolute"), "urdf joint \"elbow\" (revolute)");
+        assert_eq!(element(3, "distance"), "joints[1] (distance)");
+        assert_eq!(element(4, "rotary_damper"), "urdf joint \"elbow\" damping (rotary_damper)");
+        assert_eq!(element(5, "spring"), "forces[0] (spring)");
+    }
 }

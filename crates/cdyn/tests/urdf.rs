@@ -257,7 +257,10 @@ fn bad_urdf_files_are_refused_naming_the_element() {
             &*ARM.replace("<link name=\"tool\"/>", "<link name=\"tool\"/><link name=\"spare\"/>"),
             "2 root links (base_link, spare)",
         ),
-        (&*ARM.replace("<axis xyz=\"0 1 0\"/>", "<axis xyz=\"0 0 0\"/>"), "axis has zero length"),
+        (
+            &*ARM.replace("<axis xyz=\"0 1 0\"/>", "<axis xyz=\"0 0 0\"/>"),
+            "joint \"shoulder_pitch\": axis [0.0, 0.0, 0.0] has zero length",
+        ),
     ];
     for (text, expected) in cases {
         let error = from_urdf(text, [0.0, 0.0, -G]).and_then(|m| m.build().map(|_| ())).unwrap_err().to_string();

@@ -45,4 +45,4 @@ pub use load::Load;
 pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
 pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]
-pub use urdf::from_urdf;
+pub use urdf::{UrdfRobot, from_urdf, read_urdf};

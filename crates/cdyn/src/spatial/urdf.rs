@@ -46,6 +46,23 @@ fn refused(what: &str, name: &str, reason: String) -> Error {
 
 /// The mechanism of the URDF `text` under `gravity`.
 pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
+    read_urdf(text, gravity).map(|robot| robot.mechanism)
+}
+
+/// A URDF robot as a mechanism, with the URDF's names of its parts (the
+/// bodies carry their links' names themselves).
+#[derive(Debug, Clone)]
+pub struct UrdfRobot {
+    /// The mechanism.
+    pub mechanism: Mechanism,
+    /// The URDF joint behind each of the mechanism's joints.
+    pub joint_names: Vec<String>,
+    /// The URDF joint whose damping each of the mechanism's loads is.
+    pub load_names: Vec<String>,
+}
+
+/// [`from_urdf`], keeping the URDF joints' names for messages.
+pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
     let robot = urdf_rs::read_from_string(text)
         .map_err(|e| Error::from(Problem::Urdf { reason: format!("not a valid URDF: {e}") }))?;
     let link_index: HashMap<&str, usize> = robot.links.iter().enumerate().map(|(i, l)| (l.name.as_str(), i)).collect();
@@ -115,11 +132,17 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
     // What carries a link: itself if massive, else its parent's carrier through a fixed joint.
     let mut carrier: Vec<Option<usize>> = vec![None; robot.links.len()];
     let (mut joints, mut loads) = (Vec::new(), Vec::new());
+    let (mut joint_names, mut load_names) = (Vec::new(), Vec::new());
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
         let parent = carrier[link_index[j.parent.link.as_str()]];
         let (origin, frame) = pose[l].expect("every link reached");
         let axis = rotate(frame, j.axis.xyz.0);
+        let moves = !matches!(j.joint_type, urdf_rs::JointType::Fixed | urdf_rs::JointType::Floating);
+        let length = j.axis.xyz.0.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if moves && !(length > 0.0 && length.is_finite()) {
+            return Err(refused("joint", &j.name, format!("axis {:?} has zero length", j.axis.xyz.0)));
+        }
         if j.mimic.is_some() {
             return Err(refused("joint", &j.name, "<mimic> is not supported".into()));
         }
@@ -159,10 +182,12 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
         if let Some(kind) = kind {
             let joint = Joint::new(kind, child, parent, origin);
             joints.push(if kind == JointKind::Spherical { joint } else { joint.axis(axis) });
+            joint_names.push(j.name.clone());
         }
         if damping != 0.0 {
             loads.push(Load::RotaryDamper { a: child, b: parent, axis, damping });
+            load_names.push(j.name.clone());
         }
     }
-    Ok(Mechanism { bodies, joints, gravity, loads })
+    Ok(UrdfRobot { mechanism: Mechanism { bodies, joints, gravity, loads }, joint_names, load_names })
 }
