@@ -26,7 +26,18 @@ def check_against_csv(result, csv_path):
 
 
 @pytest.mark.parametrize(
-    "name", ["cvsgf_energy.toml", "four_bar.toml", "theta_energy.toml", "double_pendulum.toml", "baumgarte.toml"]
+    "name",
+    [
+        "cvsgf_energy.toml",
+        "four_bar.toml",
+        "theta_energy.toml",
+        "double_pendulum.toml",
+        "baumgarte.toml",
+        # Spatial: bodies in Euler parameters, and a URDF robot found
+        # relative to the scenario file.
+        "heavy_top.toml",
+        "arm_tethered.toml",
+    ],
 )
 def test_run_matches_cli_bit_for_bit(cli, tmp_path, name):
     path = EXAMPLES / name
