@@ -26,6 +26,11 @@ impl ViewerArgs {
     /// frames are kept for nothing.
     pub fn prepare(self, cases: &mut [Case]) -> Result<()> {
         if self.gif && cases.iter().all(|c| c.example.drawing.is_none()) {
+            if cases.iter().any(|c| c.example.sketch.is_some()) {
+                anyhow::bail!(
+                    "--gif: the animation is for planar mechanisms; a spatial run's figure is mechanism.png/.svg (four instants)"
+                );
+            }
             anyhow::bail!(
                 "--gif: this model has no drawing (models in independent angles have none; their Cartesian twins do)"
             );
@@ -86,6 +91,7 @@ pub fn page(title: &str, cases: &[Case], results: &[CaseResult], info: &Value) -
         "title": title,
         "version": env!("CARGO_PKG_VERSION"),
         "drawing": drawing,
+        "spatial": cases.iter().any(|c| c.example.sketch.is_some()),
         "cases": runs,
         "info": info,
     });

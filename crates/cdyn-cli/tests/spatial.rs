@@ -52,6 +52,19 @@ fn the_heavy_top_example_ends_on_the_published_euler_parameters() {
 }
 
 #[test]
+fn a_spatial_runs_page_says_where_its_figure_is_and_gif_is_refused_saying_why() {
+    let (dir, path) = scenario("top.toml", &example("heavy_top.toml"));
+    let out = dir.join("out");
+    let html = cdyn(&["run", path_str(&path), "--out", path_str(&out), "--html"]);
+    assert!(html.status.success(), "{}", String::from_utf8_lossy(&html.stderr));
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("\"spatial\":true") && page.contains("its figure is mechanism.png"));
+    let gif = cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("gif")), "--gif"]);
+    let line = one_error_line(&gif);
+    assert!(line.contains("--gif: the animation is for planar mechanisms"), "{line}");
+}
+
+#[test]
 fn bricards_redundant_mechanism_moves_and_keeps_its_energy_without_control() {
     // The example as shipped (projection), and without any control.
     let text = example("bricard.toml");
