@@ -66,8 +66,9 @@ pub trait System: Rhs<Error = EvalError> {
     /// Violations at the state `x`, time `t`.
     fn measure(&mut self, x: &[f64], t: f64) -> Measures;
     /// At the state `x`, time `t`: the largest mode `μ_max` of the paper's
-    /// CVSGF operator and the largest `|∇Φᵢ|²`, for automatic gains
-    /// ([`crate::gains`]). Not counted as an evaluation.
+    /// CVSGF operator, the largest `|∇Φᵢ|²` and the fastest damping rate
+    /// `λ_d`, for automatic gains ([`crate::gains`]). Not counted as an
+    /// evaluation.
     fn operators(&mut self, x: &[f64], t: f64) -> Result<Operators, EvalError>;
     /// Replaces the control law (once its automatic gains are chosen).
     fn set_control(&mut self, control: Control);
