@@ -604,3 +604,45 @@ fn the_automatic_energy_term_is_left_out_where_the_damping_is_stiff() {
         }
     }
 }
+
+/// Robust is no worse than no control on the damped pendulum from light
+/// to heavy damping (released at 0.5 rad, h = 2e-3, 5 s, against its fine
+/// reference), at AB-3 and RK-4: below `gains::STIFF_DISSIPATION_H` with
+/// its energy term, above it without. Kept at every damping, the term made
+/// AB-3 worse than none from `h λ_d` = 0.018 on (printed): the threshold
+/// 0.01 sits between 0.006, where the term still helps, and 0.018.
+#[test]
+fn robust_is_no_worse_than_none_from_light_to_heavy_damping() {
+    let h = 2e-3;
+    let error = |ex: &cdyn::models::Example, scheme: Scheme, control: Control| {
+        let mut sim = Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
+        let reference = ex.reference.as_ref().unwrap();
+        let (mut q, mut v) = (vec![0.0; ex.model.n()], vec![0.0; ex.model.n()]);
+        let mut worst = 0.0_f64;
+        sim.run::<Error>(5.0, 5, |s| {
+            reference(s.t(), &mut q, &mut v);
+            worst = worst.max(s.q().iter().zip(&q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max));
+            Ok(())
+        })
+        .unwrap();
+        (worst, *sim.tuning())
+    };
+    for scheme in [Scheme::AdamsBashforth3, Scheme::RungeKutta4] {
+        for damping in [0.1, 0.5, 1.0, 3.0, 10.0, 30.0] {
+            let ex = damped_pendulum(DampedPendulumParams { damping, theta0: 0.5, ..Default::default() }).unwrap();
+            let (none, _) = error(&ex, scheme, Control::none());
+            let (robust, tuning) = error(&ex, scheme, methods::robust());
+            let kept = Control {
+                energy: Energy::Projected { alpha_e: Rate::Given(1.0 / h), position_weight: POSITION_WEIGHT },
+                ..methods::robust()
+            };
+            let (with_energy, _) = error(&ex, scheme, kept);
+            println!(
+                "{scheme:?} c = {damping}: h λ_d = {:.4}, none {none:.2e}, robust {robust:.2e} (energy term {}), with the energy term kept {with_energy:.2e}",
+                tuning.dissipation_h,
+                if tuning.energy_left_out { "left out" } else { "on" }
+            );
+            assert!(robust <= none, "{scheme:?} c = {damping}: robust {robust:e} worse than none {none:e}");
+        }
+    }
+}
