@@ -96,6 +96,12 @@ pub fn target(scheme: Scheme, application: Application) -> f64 {
     }
 }
 
+/// A start for power iteration with no symmetry, so that it is not
+/// orthogonal to the top mode.
+fn power_iteration_start(len: usize) -> Vec<f64> {
+    (0..len).map(|i| 1.0 + 0.5 * ((i as f64) * 0.618_033_988_75).fract()).collect()
+}
+
 /// `μ_max` of `D^{-1/2} Φ_q Φ_qᵀ D^{-1/2}` by power iteration (the
 /// operator is symmetric positive semi-definite, so the Rayleigh quotient
 /// converges from below). Allocates: called once per simulation.
@@ -110,8 +116,7 @@ pub(crate) fn coupling<E: Evaluation>(d: &E, n: usize) -> f64 {
             if g2 > 0.0 { 1.0 / g2.sqrt() } else { 0.0 }
         })
         .collect();
-    // A start with no symmetry, so that it is not orthogonal to the top mode.
-    let mut x: Vec<f64> = (0..m).map(|r| 1.0 + 0.5 * ((r as f64) * 0.618_033_988_75).fract()).collect();
+    let mut x = power_iteration_start(m);
     let mut y = vec![0.0; n];
     let mut mu = 0.0;
     for _ in 0..60 {
@@ -157,8 +162,8 @@ pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, mut damping: impl
         d.jac_mul(w, &mut b);
         d.add_constraint_response(&mut b, w);
     };
-    let mut w: Vec<f64> = (0..n).map(|i| 1.0 + 0.5 * ((i as f64) * 0.618_033_988_75).fract()).collect();
-    let start = w.clone();
+    let start = power_iteration_start(n);
+    let mut w = vec![0.0; n];
     constrained(&start, &mut w);
     let mut rate = 0.0;
     for _ in 0..60 {

@@ -84,18 +84,16 @@ where
     }
 }
 
-impl<T: DualNum, D: Dim> Div<&Jet<T, D>> for &Jet<T, D>
+/// `a / b = a · b⁻¹`, the reciprocal's chain rule being the macros'.
+impl<T: DualNum<Primitive = F>, F: DualNumFloat, D: Dim> Div<&Jet<T, D>> for &Jet<T, D>
 where
     DefaultAllocator: Allocator<D>,
 {
     type Output = Jet<T, D>;
     #[inline]
+    #[allow(clippy::suspicious_arithmetic_impl)] // a quotient is a product by the reciprocal
     fn div(self, other: &Jet<T, D>) -> Jet<T, D> {
-        let inv = other.re.recip();
-        Jet::new(
-            self.re.clone() * inv.clone(),
-            (self.eps.clone() * other.re.clone() - &(other.eps.clone() * self.re.clone())) * (inv.clone() * inv),
-        )
+        self * &other.recip()
     }
 }
 
