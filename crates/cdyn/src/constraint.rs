@@ -15,6 +15,18 @@ use std::any::Any;
 pub trait Constraint<const K: usize, const R: usize>: Send + Sync + 'static {
     /// The constraint values; written once for every scalar type.
     fn eval<D: Scalar>(&self, x: [D; K], t: D) -> [D; R];
+
+    /// `∂Φ_r/∂x_j` at `(x, t)`, row by row. The default differentiates
+    /// [`eval`](Self::eval) ([`jacobian_of`]); an element whose parts each
+    /// read a few of its coordinates (a spatial joint's two bodies) may
+    /// compose narrower dual passes of its own.
+    #[inline(always)]
+    fn jacobian(&self, x: [f64; K], t: f64) -> [[f64; K]; R]
+    where
+        Self: Sized,
+    {
+        jacobian_of(self, x, t)
+    }
 }
 
 /// Where one evaluation of the constraints goes: per row `Φ`, `Φ̇`, `Φ_t`,
@@ -182,13 +194,29 @@ pub(crate) fn local<C: Constraint<K, R>, const K: usize, const R: usize>(
     // acceleration, which is −γ.
     let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], v[j], 0.0));
     let along = c.eval(path, Dual2_64::new(t, 1.0, 0.0));
-    // The Jacobian: for an element of a few coordinates, one scalar dual
-    // pass per coordinate is cheapest (planar chain, K = 4: num-dual's
-    // vector dual was ten times dearer). For a spatial joint between two
-    // bodies (K = 14) one pass of a `Jet`, whose derivative is a plain
-    // array, is cheaper: 1.98 M instructions per step of the 100-body
-    // spatial chain with scalar passes, 1.73 M with num-dual's vector
-    // dual, 1.62 M with the jet.
+    let jac = c.jacobian(x, t);
+    let dot = |row: &[f64; K], y: &[f64; K]| row.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let jv: [f64; R] = std::array::from_fn(|r| dot(&jac[r], &v));
+    let ja: [f64; R] = std::array::from_fn(|r| dot(&jac[r], &a));
+    Local {
+        phi: along.map(|d| d.re),
+        phi_dot: along.map(|d| d.v1),
+        phi_t: std::array::from_fn(|r| along[r].v1 - jv[r]),
+        gamma: along.map(|d| -d.v2),
+        rhs: std::array::from_fn(|r| ja[r] + along[r].v2),
+        jac,
+    }
+}
+
+/// `Φ_x` by dual passes of `c.eval`. For an element of a few coordinates,
+/// one scalar dual pass per coordinate is cheapest (planar chain, K = 4:
+/// num-dual's vector dual was ten times dearer); over more than
+/// `JET_FROM`, one pass of a `JetN`, whose derivative is a plain array
+/// (100-body spatial chain, before its joints composed their own: 1.98 M
+/// instructions per step with scalar passes, 1.73 M with num-dual's vector
+/// dual, 1.62 M with the jet).
+#[inline(always)]
+pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x: [f64; K], t: f64) -> [[f64; K]; R] {
     let mut jac = [[0.0; K]; R];
     if K > JET_FROM {
         let seeded: [JetN<K>; K] = std::array::from_fn(|j| JetN::seeded(x[j], j));
@@ -204,17 +232,7 @@ pub(crate) fn local<C: Constraint<K, R>, const K: usize, const R: usize>(
             }
         }
     }
-    let dot = |row: &[f64; K], y: &[f64; K]| row.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
-    let jv: [f64; R] = std::array::from_fn(|r| dot(&jac[r], &v));
-    let ja: [f64; R] = std::array::from_fn(|r| dot(&jac[r], &a));
-    Local {
-        phi: along.map(|d| d.re),
-        phi_dot: along.map(|d| d.v1),
-        phi_t: std::array::from_fn(|r| along[r].v1 - jv[r]),
-        gamma: along.map(|d| -d.v2),
-        rhs: std::array::from_fn(|r| ja[r] + along[r].v2),
-        jac,
-    }
+    jac
 }
 
 /// `x` as dual numbers with unit derivative in coordinate `j`.

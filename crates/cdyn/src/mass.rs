@@ -271,7 +271,10 @@ pub struct BlockMass {
     coords: Vec<u32>,
     /// Block `b`'s `k × k` matrix, row-major, from `values_start(b)`.
     matrix: Vec<f64>,
-    /// Its Cholesky factor `L`, row-major lower triangle.
+    /// The inverse `L⁻¹` of its Cholesky factor, row-major lower triangle:
+    /// products with `L⁻¹` and `L⁻ᵀ` are independent sums, where
+    /// substitution chains a division per coordinate (spatial chain: the
+    /// divisions' latency was most of the per-row block products).
     factor: Vec<f64>,
     /// Where each block's matrix starts in `matrix` and `factor`.
     at: Vec<u32>,
@@ -342,8 +345,8 @@ impl BlockMass {
         (k, coords, &self.matrix[self.at[b] as usize..self.at[b] as usize + k * k])
     }
 
-    /// Factors every block, `M_b = L_b L_bᵀ`. `Err(c)` names the first
-    /// coordinate whose pivot is not positive (or not finite).
+    /// Factors every block, `M_b = L_b L_bᵀ`, and keeps `L_b⁻¹`. `Err(c)`
+    /// names the first coordinate whose pivot is not positive (or not finite).
     pub fn factor(&mut self) -> std::result::Result<(), usize> {
         for b in 0..self.blocks() {
             let (s, e) = (self.start[b] as usize, self.start[b + 1] as usize);
@@ -362,30 +365,42 @@ impl BlockMass {
                     l[i * k + j] = s / d;
                 }
             }
+            // L⁻¹ in place, row by row: row i of L⁻¹ from the rows above it,
+            // left to right, each entry read from L just before it is replaced.
+            for i in 0..k {
+                let d = 1.0 / l[i * k + i];
+                for j in 0..i {
+                    let s: f64 = (j..i).map(|m| l[i * k + m] * l[m * k + j]).sum();
+                    l[i * k + j] = -s * d;
+                }
+                l[i * k + i] = d;
+            }
         }
         Ok(())
     }
 
-    /// `x ← L_b⁻¹ x` (forward substitution with block `b`'s factor).
+    /// `x ← L_b⁻¹ x`.
     #[inline(always)]
     pub(crate) fn forward(&self, b: usize, x: &mut [f64]) {
         let (k, at) = (x.len(), self.at[b] as usize);
-        let l = &self.factor[at..at + k * k];
+        let inv = &self.factor[at..at + k * k];
+        let mut y = [0.0; MAX_BLOCK];
         for i in 0..k {
-            let s: f64 = (0..i).map(|c| l[i * k + c] * x[c]).sum();
-            x[i] = (x[i] - s) / l[i * k + i];
+            y[i] = (0..=i).map(|c| inv[i * k + c] * x[c]).sum();
         }
+        x.copy_from_slice(&y[..k]);
     }
 
-    /// `x ← L_b⁻ᵀ x` (backward substitution with block `b`'s factor).
+    /// `x ← L_b⁻ᵀ x`.
     #[inline(always)]
     pub(crate) fn backward(&self, b: usize, x: &mut [f64]) {
         let (k, at) = (x.len(), self.at[b] as usize);
-        let l = &self.factor[at..at + k * k];
-        for i in (0..k).rev() {
-            let s: f64 = (i + 1..k).map(|c| l[c * k + i] * x[c]).sum();
-            x[i] = (x[i] - s) / l[i * k + i];
+        let inv = &self.factor[at..at + k * k];
+        let mut y = [0.0; MAX_BLOCK];
+        for i in 0..k {
+            y[i] = (i..k).map(|c| inv[c * k + i] * x[c]).sum();
         }
+        x.copy_from_slice(&y[..k]);
     }
 
     /// Calls `f(c, (M x)_c)` once for every coordinate `c` (every

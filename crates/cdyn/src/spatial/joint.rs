@@ -21,6 +21,7 @@
 
 use super::rotation::rotate_fixed;
 use crate::constraint::Constraint;
+use crate::jet::{Eps, JetN};
 use crate::scalar::Scalar;
 use crate::timefn::TimeFn;
 
@@ -161,13 +162,19 @@ pub(crate) struct Frame {
     pub axes: [[f64; 3]; 3],
 }
 
+/// What a joint's rows read of one side: its point and axes in space.
+trait Place<D> {
+    fn point(&self) -> [D; 3];
+    fn axis(&self, k: usize) -> [D; 3];
+}
+
 /// One side of a joint at a state: a body's pose, or the ground.
 enum Side<'a, D> {
     Body { r: [D; 3], p: [D; 4], frame: &'a Frame },
     Ground(&'a Frame),
 }
 
-impl<D: Scalar> Side<'_, D> {
+impl<D: Scalar> Place<D> for Side<'_, D> {
     fn point(&self) -> [D; 3] {
         match self {
             Side::Body { r, p, frame } => {
@@ -182,6 +189,47 @@ impl<D: Scalar> Side<'_, D> {
             Side::Body { p, frame, .. } => rotate_fixed(*p, frame.axes[k]),
             Side::Ground(frame) => frame.axes[k].map(D::from),
         }
+    }
+}
+
+/// A body side of a joint's Jacobian pass: its seven coordinates are
+/// `offset..offset + 7` of the pass's jet, and a point or axis depends on
+/// them through `p` alone (and `r`, with unit slope). So it is rotated by a
+/// 4-wide jet over `p` and then placed among the jet's derivatives: a
+/// spatial joint's Jacobian costs two 4-wide rotations, where one pass of
+/// a 14-wide jet carried the other body's zeros through every product.
+struct Seeded<'a> {
+    r: [f64; 3],
+    p: [JetN<4>; 4],
+    offset: usize,
+    frame: &'a Frame,
+}
+
+impl<'a> Seeded<'a> {
+    fn new(r: [f64; 3], p: [f64; 4], offset: usize, frame: &'a Frame) -> Self {
+        Self { r, p: std::array::from_fn(|j| JetN::seeded(p[j], j)), offset, frame }
+    }
+
+    /// `x` rotated by the body, moved by `r` when `moved`, as an `N`-wide jet.
+    fn place<const N: usize>(&self, x: [f64; 3], moved: bool) -> [JetN<N>; 3] {
+        let x = rotate_fixed(self.p, x);
+        std::array::from_fn(|i| {
+            let mut d = [0.0; N];
+            d[self.offset + 3..self.offset + 7].copy_from_slice(x[i].eps.0.as_slice());
+            if moved {
+                d[self.offset + i] = 1.0;
+            }
+            JetN::new(x[i].re + if moved { self.r[i] } else { 0.0 }, Eps(d.into()))
+        })
+    }
+}
+
+impl<const N: usize> Place<JetN<N>> for Seeded<'_> {
+    fn point(&self) -> [JetN<N>; 3] {
+        self.place(self.frame.s, true)
+    }
+    fn axis(&self, k: usize) -> [JetN<N>; 3] {
+        self.place(self.frame.axes[k], false)
     }
 }
 
@@ -207,7 +255,7 @@ pub(crate) struct JointRows<const R: usize> {
 }
 
 impl<const R: usize> JointRows<R> {
-    fn rows<D: Scalar>(&self, a: Side<'_, D>, b: Side<'_, D>, t: D) -> [D; R] {
+    fn rows<D: Scalar>(&self, a: impl Place<D>, b: impl Place<D>, t: D) -> [D; R] {
         let mut out = self.kinematic_rows(&a, &b);
         let mut next = self.kind.rows();
         // At the initial pose both sides' frames coincide, so a's f axis
@@ -226,7 +274,7 @@ impl<const R: usize> JointRows<R> {
         out
     }
 
-    fn kinematic_rows<D: Scalar>(&self, a: &Side<'_, D>, b: &Side<'_, D>) -> [D; R] {
+    fn kinematic_rows<D: Scalar>(&self, a: &impl Place<D>, b: &impl Place<D>) -> [D; R] {
         let mut out = [D::zero(); R];
         let (pa, pb) = (a.point(), b.point());
         let d: [D; 3] = std::array::from_fn(|i| pb[i] - pa[i]);
@@ -282,12 +330,24 @@ impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
         let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
         self.0.rows(Side::Body { r: ra, p: pa, frame: &self.0.a }, Side::Body { r: rb, p: pb, frame: &self.0.b }, t)
     }
+
+    fn jacobian(&self, x: [f64; 14], t: f64) -> [[f64; 14]; R] {
+        let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
+        let (a, b) = (Seeded::new(ra, pa, 0, &self.0.a), Seeded::new(rb, pb, 7, &self.0.b));
+        self.0.rows::<JetN<14>>(a, b, JetN::from_re(t)).map(|row| row.eps.0.into())
+    }
 }
 
 impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
     fn eval<D: Scalar>(&self, x: [D; 7], t: D) -> [D; R] {
         let (r, p) = pose(&x, 0);
         self.0.rows(Side::Body { r, p, frame: &self.0.a }, Side::Ground(&self.0.b), t)
+    }
+
+    fn jacobian(&self, x: [f64; 7], t: f64) -> [[f64; 7]; R] {
+        let (r, p) = pose(&x, 0);
+        let a = Seeded::new(r, p, 0, &self.0.a);
+        self.0.rows::<JetN<7>>(a, Side::Ground(&self.0.b), JetN::from_re(t)).map(|row| row.eps.0.into())
     }
 }
 
