@@ -360,3 +360,59 @@ impl Constraint<4, 1> for UnitNorm {
         [p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3] - 1.0]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constraint::jacobian_of;
+
+    /// A reproducible stream of numbers in (−1, 1).
+    fn numbers(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+    }
+
+    /// The joints' composed Jacobians against one jet pass of their rows,
+    /// at poses off the constraints with quaternions off unit length.
+    fn composed_is_the_plain_pass<const R: usize>(kind: JointKind, angle: bool, displacement: bool) {
+        let mut x = numbers(R as u64 + 7 * kind.rows() as u64);
+        let mut frame =
+            || Frame { s: std::array::from_fn(|_| x()), axes: std::array::from_fn(|_| std::array::from_fn(|_| x())) };
+        let rows = JointRows::<R> {
+            kind,
+            a: frame(),
+            b: frame(),
+            length2: 0.7,
+            angle: angle.then(|| TimeFn::constant(0.4)),
+            displacement: displacement.then(|| TimeFn::constant(-0.2)),
+        };
+        let mut x = numbers(99);
+        for _ in 0..20 {
+            let (q, t): ([f64; 14], f64) = (std::array::from_fn(|_| x()), x());
+            let (two, one) = (BodyToBody(rows.clone()), BodyToGround(rows.clone()));
+            let q7: [f64; 7] = std::array::from_fn(|i| q[i]);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * (1.0 + b.abs());
+            let (c, p) = (two.jacobian(q, t), jacobian_of(&two, q, t));
+            assert!(c.iter().flatten().zip(p.iter().flatten()).all(|(a, b)| close(*a, *b)), "{kind:?}: {c:?} vs {p:?}");
+            let (c, p) = (one.jacobian(q7, t), jacobian_of(&one, q7, t));
+            assert!(c.iter().flatten().zip(p.iter().flatten()).all(|(a, b)| close(*a, *b)), "{kind:?} grounded");
+        }
+    }
+
+    #[test]
+    fn composed_jacobians_equal_the_plain_jet_pass_for_every_joint() {
+        composed_is_the_plain_pass::<3>(JointKind::Spherical, false, false);
+        composed_is_the_plain_pass::<5>(JointKind::Revolute, false, false);
+        composed_is_the_plain_pass::<6>(JointKind::Revolute, true, false);
+        composed_is_the_plain_pass::<4>(JointKind::Universal, false, false);
+        composed_is_the_plain_pass::<4>(JointKind::Cylindrical, false, false);
+        composed_is_the_plain_pass::<6>(JointKind::Cylindrical, true, true);
+        composed_is_the_plain_pass::<5>(JointKind::Prismatic, false, false);
+        composed_is_the_plain_pass::<6>(JointKind::Prismatic, false, true);
+        composed_is_the_plain_pass::<6>(JointKind::Fixed, false, false);
+        composed_is_the_plain_pass::<1>(JointKind::Distance, false, false);
+    }
+}
