@@ -7,6 +7,7 @@
 
 use crate::constraint::seeded;
 use crate::scalar::Scalar;
+use num_dual::Dual64;
 use std::any::Any;
 
 /// Potential energy `V(x)` of `K` coordinates.
@@ -34,6 +35,8 @@ pub(crate) trait PotentialBlock: Send + Sync {
 pub(crate) trait ForceBlock: Send + Sync {
     /// Adds the forces into `f` and returns their power.
     fn add_forces(&self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> f64;
+    /// Adds `−∂Q/∂v · w` into `out` (one directional dual pass per element).
+    fn add_damping(&self, q: &[f64], v: &[f64], w: &[f64], t: f64, out: &mut [f64]);
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
@@ -99,6 +102,17 @@ impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
             }
         }
         power
+    }
+
+    fn add_damping(&self, q: &[f64], v: &[f64], w: &[f64], t: f64, out: &mut [f64]) {
+        for (f, idx) in &self.items {
+            let x = std::array::from_fn(|j| Dual64::from(q[idx[j]]));
+            let along = std::array::from_fn(|j| Dual64::new(v[idx[j]], w[idx[j]]));
+            let fx = f.force(x, along, Dual64::from(t));
+            for j in 0..K {
+                out[idx[j]] -= fx[j].eps;
+            }
+        }
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {

@@ -117,48 +117,36 @@ where
 
 impl<T: DualNum + Copy, const N: usize> Copy for Eps<T, Const<N>> {}
 
-impl<T: DualNum, D: Dim> Add<&Eps<T, D>> for Eps<T, D>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    type Output = Self;
-    #[inline]
-    fn add(mut self, other: &Self) -> Self {
-        self.0.iter_mut().zip(other.0.iter()).for_each(|(a, b)| *a += b.clone());
-        self
-    }
+/// `Eps ± &Eps` and `Eps ±= Eps`, entry by entry.
+macro_rules! entrywise {
+    ($($op:ident $method:ident $assign:ident $assign_method:ident $apply:tt;)*) => {$(
+        impl<T: DualNum, D: Dim> $op<&Eps<T, D>> for Eps<T, D>
+        where
+            DefaultAllocator: Allocator<D>,
+        {
+            type Output = Self;
+            #[inline]
+            fn $method(mut self, other: &Self) -> Self {
+                self.0.iter_mut().zip(other.0.iter()).for_each(|(a, b)| *a $apply b.clone());
+                self
+            }
+        }
+
+        impl<T: DualNum, D: Dim> $assign for Eps<T, D>
+        where
+            DefaultAllocator: Allocator<D>,
+        {
+            #[inline]
+            fn $assign_method(&mut self, other: Self) {
+                self.0.iter_mut().zip(other.0.iter()).for_each(|(a, b)| *a $apply b.clone());
+            }
+        }
+    )*};
 }
 
-impl<T: DualNum, D: Dim> Sub<&Eps<T, D>> for Eps<T, D>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    type Output = Self;
-    #[inline]
-    fn sub(mut self, other: &Self) -> Self {
-        self.0.iter_mut().zip(other.0.iter()).for_each(|(a, b)| *a -= b.clone());
-        self
-    }
-}
-
-impl<T: DualNum, D: Dim> AddAssign for Eps<T, D>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    #[inline]
-    fn add_assign(&mut self, other: Self) {
-        *self = self.clone() + &other;
-    }
-}
-
-impl<T: DualNum, D: Dim> SubAssign for Eps<T, D>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    #[inline]
-    fn sub_assign(&mut self, other: Self) {
-        *self = self.clone() - &other;
-    }
+entrywise! {
+    Add add AddAssign add_assign +=;
+    Sub sub SubAssign sub_assign -=;
 }
 
 impl<T: DualNum, D: Dim> Neg for Eps<T, D>

@@ -414,6 +414,12 @@ impl Model {
         self.forces.iter().map(|b| b.add_forces(q, v, t, f)).sum()
     }
 
+    /// Adds `C w = −∂Q/∂v · w`, the damping of the non-conservative forces
+    /// along `w`, into `out` (by one directional dual pass of each force).
+    pub fn add_damping(&self, q: &[f64], v: &[f64], w: &[f64], t: f64, out: &mut [f64]) {
+        self.forces.iter().for_each(|b| b.add_damping(q, v, w, t, out));
+    }
+
     /// Kinetic energy `T(q, v) = ½ vᵀ M(q) v`.
     pub fn kinetic(&self, q: &[f64], v: &[f64]) -> f64 {
         self.kinetic_and_gradient(q, v, None)

@@ -224,16 +224,9 @@ impl System for ControlledSystem<'_> {
         self.dynamics.evaluate(model, q, v, t).map_err(|b| EvalError::at(b, t))?;
         let d = Evaluated { model, dynamics: &self.dynamics, mass: &self.dynamics.mass(model) };
         let rows = (0..model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
-        let (mut vp, mut fp, mut fm) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let damping = |w: &[f64], out: &mut [f64]| {
-            // −∂Q/∂v · w by central differences (exact for linear dampers).
-            let scale = 1e-6 * (1.0 + v.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
-            for (sign, f) in [(1.0, &mut fp), (-1.0, &mut fm)] {
-                vp.iter_mut().zip(v).zip(w).for_each(|((p, v), w)| *p = v + sign * scale * w);
-                f.fill(0.0);
-                model.add_forces(q, &vp, t, f);
-            }
-            out.iter_mut().zip(fp.iter().zip(&fm)).for_each(|(o, (p, m))| *o = -(p - m) / (2.0 * scale));
+            out.fill(0.0);
+            model.add_damping(q, v, w, t, out);
         };
         Ok(Operators {
             coupling: crate::gains::coupling(&d, n),
