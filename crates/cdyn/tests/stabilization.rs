@@ -107,7 +107,14 @@ fn on_constraints(model: &Model, q0: &[f64], dq: &[f64], v: &[f64]) -> (Vec<f64>
     let mut q: Vec<f64> = q0.iter().zip(dq).map(|(q, d)| q + d).collect();
     let mut v = v[..model.n()].to_vec();
     let report = assemble(model, &mut q, &mut v, 0.0, 1e-13).unwrap();
-    assert!(report.phi_after <= 1e-13 && report.phi_dot_after <= 1e-12, "{report:?}");
+    // One linear step leaves Φ̇ at the round-off of the products Φ_q v,
+    // relative to their size: the saved proptest regression, with Φ̇ = 3.9
+    // before assembly, is left at 1.1e-12.
+    let size = Dense::at(model, &q, &v, 0.0).jac.norm() * v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    assert!(
+        report.phi_after <= 1e-13 && report.phi_dot_after <= ROUND_OFF * size.max(1.0),
+        "{report:?}, size {size:e}"
+    );
     (q, v)
 }
 
