@@ -5,7 +5,7 @@ use crate::constraint::ConstraintBuffers;
 use crate::energy;
 pub use crate::linalg::{Breakdown, DependentRows, LinearSolver, SPARSE_FROM};
 use crate::linalg::{DenseLdl, Schur};
-use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassAt, MassMatrix};
+use crate::mass::{BlockMass, DenseMass, DiagonalMass, MassAt, MassMatrix, WidthFn};
 use crate::model::Model;
 
 /// Workspace holding one evaluation of the dynamics. Allocated once per
@@ -126,16 +126,31 @@ impl Blocks {
             self.scaled[j] = jac[j];
             self.weighted[j] = jac[j] * inverse[c];
         }
-        let mut x = [0.0; MAX_BLOCK];
+        // One row's entries on one block: `J̃` is `L⁻¹` times them, `M⁻¹ Φ_qᵀ` `L⁻ᵀ L⁻¹`.
+        struct Segment<'a> {
+            entries: &'a [u32],
+            jac: &'a [f64],
+            scaled: &'a mut [f64],
+            weighted: &'a mut [f64],
+        }
+        impl WidthFn<()> for Segment<'_> {
+            #[inline(always)]
+            fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
+                let idx: &[u32; K] = self.entries[..K].try_into().expect("a block's K entries");
+                let x = mass.forward(b, idx.map(|j| self.jac[j as usize]));
+                idx.iter().zip(x).for_each(|(&j, x)| self.scaled[j as usize] = x);
+                let y = mass.backward(b, x);
+                idx.iter().zip(y).for_each(|(&j, y)| self.weighted[j as usize] = y);
+            }
+        }
         for &(block, at) in &self.segments {
-            let (block, at) = (block as usize, at as usize);
-            let idx = &self.entries[at..at + self.mass.coordinates(block).len()];
-            let x = &mut x[..idx.len()];
-            idx.iter().zip(x.iter_mut()).for_each(|(&j, x)| *x = jac[j as usize]);
-            self.mass.forward(block, x);
-            idx.iter().zip(x.iter()).for_each(|(&j, x)| self.scaled[j as usize] = *x);
-            self.mass.backward(block, x);
-            idx.iter().zip(x.iter()).for_each(|(&j, x)| self.weighted[j as usize] = *x);
+            let segment = Segment {
+                entries: &self.entries[at as usize..],
+                jac,
+                scaled: &mut self.scaled,
+                weighted: &mut self.weighted,
+            };
+            self.mass.at_width(block as usize, segment);
         }
         self.schur.factor_and_solve(&self.scaled, b)
     }

@@ -1,6 +1,22 @@
 #![doc = include_str!("../../../README.md")]
 #![warn(missing_docs)]
 
+/// Runs `$body` with the const `$k` equal to the run-time `$n`, one of the
+/// listed values: code generic over a small size (an element's coordinates,
+/// a mass block's width) is then compiled for each, with its loops unrolled.
+macro_rules! with_const {
+    ($n:expr, $k:ident, [$($v:literal),+], $body:expr) => {
+        match $n {
+            $($v => {
+                const $k: usize = $v;
+                $body
+            })+
+            n => unreachable!("no compiled size {n}"),
+        }
+    };
+}
+pub(crate) use with_const;
+
 pub mod assemble;
 #[doc(hidden)] // for benchmarks only; see its module head
 pub mod baseline;

@@ -337,70 +337,48 @@ impl BlockMass {
         self.matrix[self.at[b] as usize + i * k + i] += x;
     }
 
-    /// Block `b`'s width and matrix.
+    /// Block `b`'s coordinates and matrix, at its width `K`.
     #[inline(always)]
-    fn block(&self, b: usize) -> (usize, &[u32], &[f64]) {
-        let coords = self.coordinates(b);
-        let k = coords.len();
-        (k, coords, &self.matrix[self.at[b] as usize..self.at[b] as usize + k * k])
+    fn block<const K: usize>(&self, b: usize) -> (&[u32; K], &[f64]) {
+        let at = self.at[b] as usize;
+        (self.coordinates(b).try_into().expect("block of width K"), &self.matrix[at..at + K * K])
     }
 
     /// Factors every block, `M_b = L_b L_bᵀ`, and keeps `L_b⁻¹`. `Err(c)`
     /// names the first coordinate whose pivot is not positive (or not finite).
     pub fn factor(&mut self) -> std::result::Result<(), usize> {
         for b in 0..self.blocks() {
-            let (s, e) = (self.start[b] as usize, self.start[b + 1] as usize);
-            let (k, at) = (e - s, self.at[b] as usize);
+            let at = self.at[b] as usize;
+            let k = self.coordinates(b).len();
             let (a, l) = (&self.matrix[at..at + k * k], &mut self.factor[at..at + k * k]);
-            for j in 0..k {
-                let d = a[j * k + j] - (0..j).map(|i| l[j * k + i] * l[j * k + i]).sum::<f64>();
-                // Relative to the diagonal entry, as for a dense `M`.
-                if d.is_nan() || d <= 1e-14 * a[j * k + j].abs() || !d.is_finite() {
-                    return Err(self.coords[s + j] as usize);
-                }
-                let d = d.sqrt();
-                l[j * k + j] = d;
-                for i in j + 1..k {
-                    let s = a[i * k + j] - (0..j).map(|c| l[i * k + c] * l[j * k + c]).sum::<f64>();
-                    l[i * k + j] = s / d;
-                }
-            }
-            // L⁻¹ in place, row by row: row i of L⁻¹ from the rows above it,
-            // left to right, each entry read from L just before it is replaced.
-            for i in 0..k {
-                let d = 1.0 / l[i * k + i];
-                for j in 0..i {
-                    let s: f64 = (j..i).map(|m| l[i * k + m] * l[m * k + j]).sum();
-                    l[i * k + j] = -s * d;
-                }
-                l[i * k + i] = d;
-            }
+            with_const!(k, K, [1, 2, 3, 4, 5, 6, 7, 8], factor_block::<K>(a, l))
+                .map_err(|j| self.coordinates(b)[j] as usize)?;
         }
         Ok(())
     }
 
-    /// `x ← L_b⁻¹ x`.
+    /// Calls `f` with the width `K` of block `b`: each width's loops are
+    /// compiled apart and unrolled (a block's width is known only at run
+    /// time; spatial bodies' are 4).
     #[inline(always)]
-    pub(crate) fn forward(&self, b: usize, x: &mut [f64]) {
-        let (k, at) = (x.len(), self.at[b] as usize);
-        let inv = &self.factor[at..at + k * k];
-        let mut y = [0.0; MAX_BLOCK];
-        for i in 0..k {
-            y[i] = (0..=i).map(|c| inv[i * k + c] * x[c]).sum();
-        }
-        x.copy_from_slice(&y[..k]);
+    pub(crate) fn at_width<R>(&self, b: usize, f: impl WidthFn<R>) -> R {
+        with_const!(self.coordinates(b).len(), K, [1, 2, 3, 4, 5, 6, 7, 8], f.call::<K>(self, b))
     }
 
-    /// `x ← L_b⁻ᵀ x`.
+    /// `L_b⁻¹ x`.
     #[inline(always)]
-    pub(crate) fn backward(&self, b: usize, x: &mut [f64]) {
-        let (k, at) = (x.len(), self.at[b] as usize);
-        let inv = &self.factor[at..at + k * k];
-        let mut y = [0.0; MAX_BLOCK];
-        for i in 0..k {
-            y[i] = (i..k).map(|c| inv[c * k + i] * x[c]).sum();
-        }
-        x.copy_from_slice(&y[..k]);
+    pub(crate) fn forward<const K: usize>(&self, b: usize, x: [f64; K]) -> [f64; K] {
+        let at = self.at[b] as usize;
+        let inv = &self.factor[at..at + K * K];
+        std::array::from_fn(|i| (0..=i).map(|c| inv[i * K + c] * x[c]).sum())
+    }
+
+    /// `L_b⁻ᵀ x`.
+    #[inline(always)]
+    pub(crate) fn backward<const K: usize>(&self, b: usize, x: [f64; K]) -> [f64; K] {
+        let at = self.at[b] as usize;
+        let inv = &self.factor[at..at + K * K];
+        std::array::from_fn(|i| (i..K).map(|c| inv[c * K + i] * x[c]).sum())
     }
 
     /// Calls `f(c, (M x)_c)` once for every coordinate `c` (every
@@ -412,13 +390,57 @@ impl BlockMass {
                 f(c, m * x);
             }
         }
-        for b in 0..self.blocks() {
-            let (k, coords, a) = self.block(b);
-            for i in 0..k {
-                f(coords[i] as usize, (0..k).map(|j| a[i * k + j] * x[coords[j] as usize]).sum());
+        struct Product<'a, F>(&'a [f64], &'a mut F);
+        impl<F: FnMut(usize, f64)> WidthFn<()> for Product<'_, F> {
+            #[inline(always)]
+            fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
+                let (coords, a) = mass.block::<K>(b);
+                let x: [f64; K] = coords.map(|c| self.0[c as usize]);
+                for i in 0..K {
+                    (self.1)(coords[i] as usize, (0..K).map(|j| a[i * K + j] * x[j]).sum());
+                }
             }
         }
+        for b in 0..self.blocks() {
+            self.at_width(b, Product(x, &mut f));
+        }
     }
+}
+
+/// An operation on one block of a [`BlockMass`], generic over its width.
+pub(crate) trait WidthFn<R> {
+    fn call<const K: usize>(self, mass: &BlockMass, b: usize) -> R;
+}
+
+/// `A = L Lᵀ` for the `K × K` row-major `a`, with `L⁻¹` left in `l`;
+/// `Err(j)` for the first pivot `j` that is not positive (or not finite).
+#[inline(always)]
+fn factor_block<const K: usize>(a: &[f64], l: &mut [f64]) -> std::result::Result<(), usize> {
+    let (a, l) = (&a[..K * K], &mut l[..K * K]);
+    for j in 0..K {
+        let d = a[j * K + j] - (0..j).map(|i| l[j * K + i] * l[j * K + i]).sum::<f64>();
+        // Relative to the diagonal entry, as for a dense `M`.
+        if d.is_nan() || d <= 1e-14 * a[j * K + j].abs() || !d.is_finite() {
+            return Err(j);
+        }
+        let d = d.sqrt();
+        l[j * K + j] = d;
+        for i in j + 1..K {
+            let s = a[i * K + j] - (0..j).map(|c| l[i * K + c] * l[j * K + c]).sum::<f64>();
+            l[i * K + j] = s / d;
+        }
+    }
+    // L⁻¹ in place, row by row: row i of L⁻¹ from the rows above it,
+    // left to right, each entry read from L just before it is replaced.
+    for i in 0..K {
+        let d = 1.0 / l[i * K + i];
+        for j in 0..i {
+            let s: f64 = (j..i).map(|m| l[i * K + m] * l[m * K + j]).sum();
+            l[i * K + j] = -s * d;
+        }
+        l[i * K + i] = d;
+    }
+    Ok(())
 }
 
 impl MassMatrix for BlockMass {
@@ -434,14 +456,17 @@ impl MassMatrix for BlockMass {
         for ((o, w), x) in out.iter_mut().zip(&self.inverse).zip(x) {
             *o = x * w;
         }
-        let mut local = [0.0; MAX_BLOCK];
+        struct Solve<'a>(&'a [f64], &'a mut [f64]);
+        impl WidthFn<()> for Solve<'_> {
+            #[inline(always)]
+            fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
+                let (coords, _) = mass.block::<K>(b);
+                let y = mass.backward(b, mass.forward(b, coords.map(|c| self.0[c as usize])));
+                coords.iter().zip(y).for_each(|(&c, y)| self.1[c as usize] = y);
+            }
+        }
         for b in 0..self.blocks() {
-            let coords = self.coordinates(b);
-            let y = &mut local[..coords.len()];
-            coords.iter().zip(y.iter_mut()).for_each(|(&c, y)| *y = x[c as usize]);
-            self.forward(b, y);
-            self.backward(b, y);
-            coords.iter().zip(y.iter()).for_each(|(&c, y)| out[c as usize] = *y);
+            self.at_width(b, Solve(x, out));
         }
     }
 

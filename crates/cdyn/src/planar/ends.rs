@@ -5,37 +5,12 @@
 
 use crate::scalar::Scalar;
 
-/// Runs `$body` with the const `$k` equal to `$idx.len()` (1 to 6): the
-/// elements are generic over how many coordinates they read.
+/// Runs `$body` with the const `$k` equal to `$idx.len()` (1 to 6: an
+/// element reads at most two bodies): the elements are generic over how
+/// many coordinates they read.
 macro_rules! with_k {
     ($idx:expr, $k:ident, $body:expr) => {
-        match $idx.len() {
-            1 => {
-                const $k: usize = 1;
-                $body
-            }
-            2 => {
-                const $k: usize = 2;
-                $body
-            }
-            3 => {
-                const $k: usize = 3;
-                $body
-            }
-            4 => {
-                const $k: usize = 4;
-                $body
-            }
-            5 => {
-                const $k: usize = 5;
-                $body
-            }
-            6 => {
-                const $k: usize = 6;
-                $body
-            }
-            n => unreachable!("an element reads at most two bodies, 6 coordinates, not {n}"),
-        }
+        crate::with_const!($idx.len(), $k, [1, 2, 3, 4, 5, 6], $body)
     };
 }
 pub(super) use with_k;
