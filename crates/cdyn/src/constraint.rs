@@ -27,6 +27,14 @@ pub trait Constraint<const K: usize, const R: usize>: Send + Sync + 'static {
     {
         jacobian_of(self, x, t)
     }
+
+    /// Which coordinates each row can depend on: an entry `false` here must
+    /// be zero at every state, and its products are left out when
+    /// `Φ_q M⁻¹ Φ_qᵀ` is assembled (a spherical joint's row reads one
+    /// component of each centre of mass, not three). All `true` by default.
+    fn reads(&self) -> [[bool; K]; R] {
+        [[true; K]; R]
+    }
 }
 
 /// Where one evaluation of the constraints goes: per row `Φ`, `Φ̇`, `Φ_t`,
@@ -83,6 +91,11 @@ pub(crate) trait ConstraintBlock: Send + Sync {
     /// Appends the coordinate index of every Jacobian entry, row by row
     /// (the model checks they fit in `u32`).
     fn columns(&self, out: &mut Vec<u32>);
+    /// Appends, entry by entry as [`columns`](Self::columns), whether it
+    /// can be non-zero (see [`Constraint::reads`]).
+    fn reads(&self, out: &mut Vec<bool>) {
+        out.extend(std::iter::repeat_n(true, self.rows() * self.width()));
+    }
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>);
     /// `Φ` only, in plain `f64`.
     fn values(&self, q: &[f64], t: f64, phi: &mut [f64]);
@@ -104,6 +117,12 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
 
     fn columns(&self, out: &mut Vec<u32>) {
         columns_of::<_, K, R>(&self.items, out);
+    }
+
+    fn reads(&self, out: &mut Vec<bool>) {
+        for (c, _) in &self.items {
+            out.extend(c.reads().as_flattened());
+        }
     }
 
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {

@@ -252,10 +252,10 @@ impl DenseLdl {
 /// `(M⁻¹)_col,col` of the product.
 pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize, usize, usize)> {
     let m = pattern.start.len() - 1;
-    // For every coordinate, the Jacobian entries that touch it.
+    // For every coordinate, the Jacobian entries that touch it (that can be non-zero).
     let mut by_col: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
     for r in 0..m {
-        for j in pattern.row(r) {
+        for j in pattern.row(r).filter(|&j| pattern.read[j]) {
             by_col[pattern.cols[j] as usize].push((r, j));
         }
     }
@@ -660,9 +660,10 @@ mod tests {
                 rows.push(vec![inner, inner + 1, outer, outer + 1]);
             }
         }
-        let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new(), read: Vec::new() };
         for r in rows {
             pattern.cols.extend(r.iter().map(|&c| c as u32));
+            pattern.read.extend(r.iter().map(|_| true));
             pattern.start.push(pattern.cols.len() as u32);
         }
         (pattern, 2 + 2 * arms * len)
@@ -684,10 +685,11 @@ mod tests {
                 }
             }
         }
-        let mut pattern = Pattern { start: vec![0], cols: Vec::new() };
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new(), read: Vec::new() };
         for r in 0..edges.len() {
             let (a, b) = edges[(r * stride) % edges.len()];
             pattern.cols.extend([a, a + 1, b, b + 1].map(|c| c as u32));
+            pattern.read.extend([true; 4]);
             pattern.start.push(pattern.cols.len() as u32);
         }
         (pattern, 2 * w * w)

@@ -164,11 +164,12 @@ impl ModelBuilder {
         if u32::try_from(n.max(nnz)).is_err() {
             return Err(Problem::TooLarge { n, nnz }.into());
         }
-        let mut pattern = Pattern { start: vec![0], cols: Vec::with_capacity(nnz) };
+        let mut pattern = Pattern { start: vec![0], cols: Vec::with_capacity(nnz), read: Vec::with_capacity(nnz) };
         let mut offsets = Vec::with_capacity(self.constraints.len());
         for b in &self.constraints {
             offsets.push((pattern.start.len() - 1, pattern.cols.len()));
             b.columns(&mut pattern.cols);
+            b.reads(&mut pattern.read);
             for _ in 0..b.rows() {
                 let last = *pattern.start.last().unwrap();
                 pattern.start.push(last + b.width() as u32);

@@ -32,6 +32,8 @@ pub struct Pattern {
     pub start: Vec<u32>,
     /// The coordinate of each entry, row after row.
     pub cols: Vec<u32>,
+    /// Whether each entry can be non-zero ([`Constraint::reads`](crate::Constraint::reads)).
+    pub read: Vec<bool>,
 }
 
 impl Pattern {

@@ -274,6 +274,47 @@ impl<const R: usize> JointRows<R> {
         out
     }
 
+    /// What each row reads of the bodies' centres of mass: the rows that
+    /// are components of `d` one component of each, the dot-1 rows and the
+    /// angle drive none (they turn with `p` alone), the others all three.
+    /// The Euler parameters are read by every row. A unit test checks this
+    /// against the Jacobian's zeros.
+    fn reads_position(&self) -> [Reach; R] {
+        let mut out = [Reach::All; R];
+        let components = |out: &mut [Reach; R]| (0..3).for_each(|i| out[i] = Reach::Component(i));
+        match self.kind {
+            JointKind::Spherical => components(&mut out),
+            JointKind::Revolute | JointKind::Universal | JointKind::Fixed => {
+                components(&mut out);
+                (3..self.kind.rows()).for_each(|k| out[k] = Reach::None);
+            }
+            JointKind::Cylindrical | JointKind::Prismatic => {
+                out[0] = Reach::None;
+                out[1] = Reach::None;
+                if self.kind == JointKind::Prismatic {
+                    out[4] = Reach::None;
+                }
+            }
+            JointKind::Distance => {}
+        }
+        if self.angle.is_some() {
+            out[self.kind.rows()] = Reach::None;
+        }
+        out
+    }
+
+    /// [`Constraint::reads`] for a joint whose bodies' poses start at the offsets `sides`.
+    fn reads<const K: usize>(&self, sides: &[usize]) -> [[bool; K]; R] {
+        self.reads_position().map(|reach| {
+            let mut row = [false; K];
+            for &at in sides {
+                (0..3).for_each(|i| row[at + i] = reach.reads(i));
+                (3..7).for_each(|i| row[at + i] = true);
+            }
+            row
+        })
+    }
+
     fn kinematic_rows<D: Scalar>(&self, a: &impl Place<D>, b: &impl Place<D>) -> [D; R] {
         let mut out = [D::zero(); R];
         let (pa, pb) = (a.point(), b.point());
@@ -313,6 +354,24 @@ impl<const R: usize> JointRows<R> {
     }
 }
 
+/// Which components of a centre of mass a joint's row reads.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Reach {
+    None,
+    Component(usize),
+    All,
+}
+
+impl Reach {
+    fn reads(self, i: usize) -> bool {
+        match self {
+            Reach::None => false,
+            Reach::Component(j) => i == j,
+            Reach::All => true,
+        }
+    }
+}
+
 /// A joint between two bodies: reads `(r_a, p_a, r_b, p_b)`.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BodyToBody<const R: usize>(pub JointRows<R>);
@@ -336,6 +395,10 @@ impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
         let (a, b) = (Seeded::new(ra, pa, 0, &self.0.a), Seeded::new(rb, pb, 7, &self.0.b));
         self.0.rows::<JetN<14>>(a, b, JetN::from_re(t)).map(|row| row.eps.0.into())
     }
+
+    fn reads(&self) -> [[bool; 14]; R] {
+        self.0.reads(&[0, 7])
+    }
 }
 
 impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
@@ -348,6 +411,10 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
         let (r, p) = pose(&x, 0);
         let a = Seeded::new(r, p, 0, &self.0.a);
         self.0.rows::<JetN<7>>(a, Side::Ground(&self.0.b), JetN::from_re(t)).map(|row| row.eps.0.into())
+    }
+
+    fn reads(&self) -> [[bool; 7]; R] {
+        self.0.reads(&[0])
     }
 }
 
@@ -376,7 +443,8 @@ mod tests {
     }
 
     /// The joints' composed Jacobians against one jet pass of their rows,
-    /// at poses off the constraints with quaternions off unit length.
+    /// at poses off the constraints with quaternions off unit length; and
+    /// the entries `reads` leaves out are zero in that pass.
     fn composed_is_the_plain_pass<const R: usize>(kind: JointKind, angle: bool, displacement: bool) {
         let mut x = numbers(R as u64 + 7 * kind.rows() as u64);
         let mut frame =
@@ -397,13 +465,16 @@ mod tests {
             let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * (1.0 + b.abs());
             let (c, p) = (two.jacobian(q, t), jacobian_of(&two, q, t));
             assert!(c.iter().flatten().zip(p.iter().flatten()).all(|(a, b)| close(*a, *b)), "{kind:?}: {c:?} vs {p:?}");
+            let unread_are_zero = |p: &[f64], reads: &[bool]| p.iter().zip(reads).all(|(p, &r)| r || *p == 0.0);
+            assert!(unread_are_zero(p.as_flattened(), two.reads().as_flattened()), "{kind:?} reads");
             let (c, p) = (one.jacobian(q7, t), jacobian_of(&one, q7, t));
             assert!(c.iter().flatten().zip(p.iter().flatten()).all(|(a, b)| close(*a, *b)), "{kind:?} grounded");
+            assert!(unread_are_zero(p.as_flattened(), one.reads().as_flattened()), "{kind:?} grounded reads");
         }
     }
 
     #[test]
-    fn composed_jacobians_equal_the_plain_jet_pass_for_every_joint() {
+    fn composed_jacobians_equal_the_plain_jet_pass_and_unread_entries_are_zero_for_every_joint() {
         composed_is_the_plain_pass::<3>(JointKind::Spherical, false, false);
         composed_is_the_plain_pass::<5>(JointKind::Revolute, false, false);
         composed_is_the_plain_pass::<6>(JointKind::Revolute, true, false);
