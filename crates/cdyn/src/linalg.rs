@@ -808,6 +808,7 @@ mod tests {
         let last = pattern.row(pattern.start.len() - 2);
         let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
         pattern.cols.extend(&repeated);
+        pattern.read.extend(repeated.iter().map(|_| true));
         pattern.start.push(pattern.cols.len() as u32);
         let mut jac = values(pattern.nnz(), 0.7);
         let k = repeated.len();

@@ -345,6 +345,7 @@ impl MethodKeys {
                     tolerance: self.tolerance.unwrap_or(d.tolerance),
                     max_iterations: self.max_iterations.unwrap_or(d.max_iterations),
                     on_failure: self.on_failure.unwrap_or(d.on_failure),
+                    ..d
                 };
                 p.validate()?;
                 Control { projection: Some(p), ..Control::none() }

@@ -45,12 +45,18 @@ pub struct Projection {
     pub max_iterations: u32,
     /// Stop or continue when the iterations do not converge.
     pub on_failure: OnFailure,
+    /// Whether `Ψ` is projected too. A run turns it off where the damping
+    /// is stiff against the step, as it leaves out robust's automatic
+    /// energy term ([`STIFF_DISSIPATION_H`](crate::gains::STIFF_DISSIPATION_H)):
+    /// there the integrated work of the dampers, which `Ψ` holds the
+    /// energy to, carries more error than the state.
+    pub energy: bool,
 }
 
 impl Default for Projection {
-    /// Tolerance 1e-10, at most 10 iterations, stop on failure.
+    /// Tolerance 1e-10, at most 10 iterations, stop on failure, `Ψ` projected.
     fn default() -> Self {
-        Self { tolerance: 1e-10, max_iterations: 10, on_failure: OnFailure::Stop }
+        Self { tolerance: 1e-10, max_iterations: 10, on_failure: OnFailure::Stop, energy: true }
     }
 }
 
@@ -188,7 +194,7 @@ pub(crate) fn invariants(
         // With as many constraint rows as coordinates no motion is free (a
         // fully driven mechanism): T and V are fixed by the constraints, and
         // Ψ measures only the quadrature of Ė, which no projection can change.
-        if psi.abs() <= psi_tol || model.m() == model.n() {
+        if !settings.energy || psi.abs() <= psi_tol || model.m() == model.n() {
             return Ok(iterations);
         }
         if energy_steps == settings.max_iterations {

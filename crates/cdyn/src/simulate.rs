@@ -148,7 +148,8 @@ impl<S: System> Stepper<S> {
         // Automatic gains, and the rate × h every control term runs at.
         // A state the dynamics cannot evaluate fails the first step, which
         // reports it with the run's record; the gains are then moot.
-        let operators = if settings.control.is_active() {
+        // The projection reads the damping's rate (whether to project `Ψ`).
+        let operators = if settings.control.is_active() || settings.control.projection.is_some() {
             system.operators(x.as_slice(), 0.0).unwrap_or(Operators { coupling: 1.0, ..Operators::default() })
         } else {
             Operators::default()

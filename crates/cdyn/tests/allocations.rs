@@ -161,7 +161,8 @@ fn robust_controls() -> Vec<Control> {
 /// The projection method: as the preset sets it, and one that never
 /// converges and goes on (its failure path must not allocate either).
 fn projections() -> [Control; 2] {
-    let failing = Projection { tolerance: 1e-30, max_iterations: 2, on_failure: OnFailure::Continue };
+    let failing =
+        Projection { tolerance: 1e-30, max_iterations: 2, on_failure: OnFailure::Continue, ..Projection::default() };
     [methods::projection(), Control { projection: Some(failing), ..Control::none() }]
 }
 

@@ -497,7 +497,8 @@ fn projection_holds_every_invariant_to_its_tolerance_after_every_step() {
 fn a_projection_that_cannot_converge_stops_by_name_or_is_counted() {
     for (name, ex, _) in projection_cases() {
         for (tolerance, max_iterations, h) in [(1e-30, 10, 0.01), (1e-10, 1, 0.1)] {
-            let projection = Projection { tolerance, max_iterations, on_failure: OnFailure::Stop };
+            let projection =
+                Projection { tolerance, max_iterations, on_failure: OnFailure::Stop, ..Projection::default() };
             let settings =
                 |p| Settings::new(Scheme::AdamsBashforth3, h, Control { projection: Some(p), ..Control::none() });
             let mut sim = Simulation::new(&ex.model, settings(projection), &ex.q0, &ex.v0).unwrap();
@@ -588,8 +589,9 @@ fn automatic_cvsgf_gain_sees_the_coupling_of_the_rows() {
     }
 }
 
-/// The automatic energy term is left out where the damping is stiff
-/// against the step (`gains::STIFF_DISSIPATION_H`), and only there. The
+/// The automatic energy term and the projection of `Ψ` are left out where
+/// the damping is stiff against the step (`gains::STIFF_DISSIPATION_H`),
+/// and only there. The
 /// damped pendulum's only damping is the rotary damper: `λ_d = c /
 /// I_pivot` exactly, on the one motion its pin allows.
 #[test]
@@ -598,28 +600,41 @@ fn the_automatic_energy_term_is_left_out_where_the_damping_is_stiff() {
         let params = DampedPendulumParams { damping, ..Default::default() };
         let ex = damped_pendulum(params).unwrap();
         let rate = damping / params.pivot_inertia();
-        for (name, control) in [("robust", methods::robust()), ("cvsgf_energy", MethodGains::paper().cvsgf_energy())] {
+        let methods = [
+            ("robust", methods::robust()),
+            ("projection", methods::projection()),
+            ("cvsgf_energy", MethodGains::paper().cvsgf_energy()),
+        ];
+        for (name, control) in methods {
             let sim =
                 Simulation::new(&ex.model, Settings::new(Scheme::RungeKutta4, h, control), &ex.q0, &ex.v0).unwrap();
             let tuning = *sim.tuning();
             let case = format!("c = {damping}, h = {h}, {name}: {tuning:?}");
             assert!((tuning.dissipation_h - rate * h).abs() <= 1e-6 * (rate * h).max(1e-12), "{case}: λ_d = {rate}");
-            // Only robust's automatic term is dropped; the paper's stays as given.
-            let left_out = name == "robust" && rate * h > gains::STIFF_DISSIPATION_H;
+            // Only robust's automatic term and the projection of Ψ are
+            // dropped; the paper's term stays as given.
+            let left_out = name != "cvsgf_energy" && rate * h > gains::STIFF_DISSIPATION_H;
             assert_eq!(tuning.energy_left_out, left_out, "{case}");
-            assert_eq!(sim.settings().control.energy == Energy::None, left_out, "{case}");
+            let resolved = sim.settings().control;
+            match resolved.projection {
+                Some(p) => assert_eq!(p.energy, !left_out, "{case}"),
+                None => assert_eq!(resolved.energy == Energy::None, left_out, "{case}"),
+            }
         }
     }
 }
 
-/// Robust is no worse than no control on the damped pendulum from light
-/// to heavy damping (released at 0.5 rad, h = 2e-3, 5 s, against its fine
-/// reference), at AB-3 and RK-4: below `gains::STIFF_DISSIPATION_H` with
-/// its energy term, above it without. Kept at every damping, the term made
-/// AB-3 worse than none from `h λ_d` = 0.018 on (printed): the threshold
-/// 0.01 sits between 0.006, where the term still helps, and 0.018.
+/// Robust and the projection are no worse than no control on the damped
+/// pendulum from light to heavy damping (released at 0.5 rad, h = 2e-3,
+/// 5 s, against its fine reference), at AB-3 and RK-4: below
+/// `gains::STIFF_DISSIPATION_H` with robust's energy term and the
+/// projection of `Ψ`, above it without. Kept at every damping, the term
+/// made AB-3 worse than none from `h λ_d` = 0.018 on (printed), and so did
+/// the projection of `Ψ` (6.6e-6 against none's 3.1e-6 at 0.018, before
+/// the gate covered it): the threshold 0.01 sits between 0.006, where
+/// both still help, and 0.018.
 #[test]
-fn robust_is_no_worse_than_none_from_light_to_heavy_damping() {
+fn robust_and_projection_are_no_worse_than_none_from_light_to_heavy_damping() {
     let h = 2e-3;
     let error = |ex: &cdyn::models::Example, scheme: Scheme, control: Control| {
         let mut sim = Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
@@ -644,12 +659,14 @@ fn robust_is_no_worse_than_none_from_light_to_heavy_damping() {
                 ..methods::robust()
             };
             let (with_energy, _) = error(&ex, scheme, kept);
+            let (projection, _) = error(&ex, scheme, methods::projection());
             println!(
-                "{scheme:?} c = {damping}: h λ_d = {:.4}, none {none:.2e}, robust {robust:.2e} (energy term {}), with the energy term kept {with_energy:.2e}",
+                "{scheme:?} c = {damping}: h λ_d = {:.4}, none {none:.2e}, robust {robust:.2e} (energy term {}), with the energy term kept {with_energy:.2e}; projection {projection:.2e}",
                 tuning.dissipation_h,
                 if tuning.energy_left_out { "left out" } else { "on" }
             );
             assert!(robust <= none, "{scheme:?} c = {damping}: robust {robust:e} worse than none {none:e}");
+            assert!(projection <= none, "{scheme:?} c = {damping}: projection {projection:e} worse than none {none:e}");
         }
     }
 }
