@@ -251,7 +251,7 @@ impl<S: System> Stepper<S> {
         }
         if let Some(p) = self.settings.control.projection {
             let t = self.t();
-            match self.system.project(self.x.as_mut_slice(), t, &p) {
+            match self.system.project(self.x.as_mut_slice(), t, self.settings.h, &p) {
                 Ok(iterations) => self.projection_iterations += u64::from(iterations),
                 Err(f) => {
                     let (invariant, residual, row, iterations) = match f {

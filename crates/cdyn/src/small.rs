@@ -438,7 +438,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         self.control = control;
     }
     /// Not reached: [`SmallSimulation::new`] refuses a projection.
-    fn project(&mut self, _: &mut [f64], _: f64, _: &Projection) -> Result<u32, Failure> {
+    fn project(&mut self, _: &mut [f64], _: f64, _: f64, _: &Projection) -> Result<u32, Failure> {
         Err(Failure::Energy { residual: f64::NAN })
     }
 }

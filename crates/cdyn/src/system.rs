@@ -74,7 +74,7 @@ pub trait System: Rhs<Error = EvalError> {
     fn set_control(&mut self, control: Control);
     /// Projects the state `x` at time `t` onto the invariants (the
     /// `projection` method); returns the Newton iterations taken.
-    fn project(&mut self, x: &mut [f64], t: f64, settings: &Projection) -> Result<u32, Failure>;
+    fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure>;
 }
 
 /// Splits a state into `(q, v, e)`.
@@ -237,12 +237,12 @@ impl System for ControlledSystem<'_> {
     fn set_control(&mut self, control: Control) {
         self.control = control;
     }
-    fn project(&mut self, x: &mut [f64], t: f64, settings: &Projection) -> Result<u32, Failure> {
+    fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
         let n = self.model.n();
         let (q, rest) = x.split_at_mut(n);
         let (v, e) = rest.split_at_mut(n);
         let target = self.e0 + e[0];
-        projection::invariants(self.model, &mut self.dynamics, q, v, t, target, settings, &mut self.projection)
+        projection::invariants(self.model, &mut self.dynamics, q, v, t, target, h, settings, &mut self.projection)
     }
 }
 
