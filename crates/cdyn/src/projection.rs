@@ -110,13 +110,20 @@ pub enum Failure {
 /// Buffers of a projection: allocated once per model.
 pub(crate) struct Work {
     rows: Vec<f64>,
+    /// A second right-hand side in the rows (the energy step's two projections).
+    rows_2: Vec<f64>,
     correction: Vec<f64>,
     direction: Vec<f64>,
 }
 
 impl Work {
     pub(crate) fn new(model: &Model) -> Self {
-        Self { rows: vec![0.0; model.m()], correction: vec![0.0; model.n()], direction: vec![0.0; model.n()] }
+        Self {
+            rows: vec![0.0; model.m()],
+            rows_2: vec![0.0; model.m()],
+            correction: vec![0.0; model.n()],
+            direction: vec![0.0; model.n()],
+        }
     }
 }
 
@@ -170,13 +177,6 @@ pub(crate) fn velocities(model: &Model, d: &Dynamics, v: &mut [f64], work: &mut 
     }
 }
 
-/// `out = P x`, the `M`-orthogonal projection onto the null space of `Φ_q`.
-fn project(model: &Model, d: &Dynamics, x: &[f64], rows: &mut [f64], out: &mut [f64]) {
-    d.jac_mul(model, x, rows);
-    out.copy_from_slice(x);
-    d.add_constraint_response(model, rows, out);
-}
-
 /// Projects `(q, v)` onto `Φ = 0`, `Φ̇ = 0` and `Ψ = T + V − E₀ − e = 0`
 /// (`e0_plus_e = E₀ + e`), `|Ψ|` to the tolerance times the mechanical
 /// energy's magnitude where that exceeds 1. Returns the Newton iterations taken.
@@ -224,11 +224,15 @@ pub(crate) fn invariants(
         // in the target became a velocity error of 2e-7 rad/s there, and
         // a phase error that grew (damped pendulum, AB-3, h = 1e-3).
         let c = settings.position_weight * h * h;
+        // w = P M⁻¹ Ψ_q and P v, with one solve of both right-hand sides.
         let mass = d.mass(model);
-        mass.solve(d.psi_q(), &mut work.direction);
-        project(model, d, &work.direction, &mut work.rows, &mut work.correction);
+        mass.solve(d.psi_q(), &mut work.correction);
+        work.direction.copy_from_slice(v);
+        d.jac_mul(model, &work.correction, &mut work.rows);
+        d.jac_mul(model, v, &mut work.rows_2);
+        d.solve_many(&mut [&mut work.rows, &mut work.rows_2]);
+        d.add_weighted_jt_pair(model, [&work.rows, &work.rows_2], [&mut work.correction, &mut work.direction]);
         let b: f64 = d.psi_q().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
-        project(model, d, v, &mut work.rows, &mut work.direction);
         let a = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
         let slope = c * b + a;
         if slope.is_nan() || slope <= 0.0 {
