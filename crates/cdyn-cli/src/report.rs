@@ -118,9 +118,11 @@ pub fn table(cases: &[CaseResult]) -> String {
     }
     for c in cases {
         if let Some(t) = c.tuning.filter(|t| t.energy_left_out) {
+            let projected = c.control.is_some_and(|c| c.projection.is_some());
             out += &format!(
-                "note: {}: energy term left out, the damping is stiff against the step (h λ_d = {:.3}, above {})\n",
+                "note: {}: {} left out, the damping is stiff against the step (h λ_d = {:.3}, above {})\n",
                 c.name,
+                if projected { "the projection of Ψ" } else { "energy term" },
                 t.dissipation_h,
                 cdyn::gains::STIFF_DISSIPATION_H
             );

@@ -255,6 +255,15 @@ impl MassMatrix for DenseMass {
 /// with a wider one is factored densely.
 pub const MAX_BLOCK: usize = 8;
 
+/// Runs `$body` with the const `$k` equal to the block width `$n` (1 to
+/// [`MAX_BLOCK`]).
+macro_rules! by_width {
+    ($n:expr, $k:ident, $body:expr) => {
+        crate::with_const!($n, $k, [1, 2, 3, 4, 5, 6, 7, 8], $body)
+    };
+}
+const _: () = assert!(MAX_BLOCK == 8, "by_width! lists the widths up to MAX_BLOCK");
+
 /// A block-diagonal `M(q)`: a constant diagonal on most coordinates, and
 /// small dense blocks, each the mass of one kinetic element, on disjoint
 /// sets of coordinates (the Euler parameters of a spatial body, a 4 × 4
@@ -351,8 +360,7 @@ impl BlockMass {
             let at = self.at[b] as usize;
             let k = self.coordinates(b).len();
             let (a, l) = (&self.matrix[at..at + k * k], &mut self.factor[at..at + k * k]);
-            with_const!(k, K, [1, 2, 3, 4, 5, 6, 7, 8], factor_block::<K>(a, l))
-                .map_err(|j| self.coordinates(b)[j] as usize)?;
+            by_width!(k, K, factor_block::<K>(a, l)).map_err(|j| self.coordinates(b)[j] as usize)?;
         }
         Ok(())
     }
@@ -362,7 +370,7 @@ impl BlockMass {
     /// time; spatial bodies' are 4).
     #[inline(always)]
     pub(crate) fn at_width<R>(&self, b: usize, f: impl WidthFn<R>) -> R {
-        with_const!(self.coordinates(b).len(), K, [1, 2, 3, 4, 5, 6, 7, 8], f.call::<K>(self, b))
+        by_width!(self.coordinates(b).len(), K, f.call::<K>(self, b))
     }
 
     /// `L_b⁻¹ x`.
