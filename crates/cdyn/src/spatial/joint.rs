@@ -175,15 +175,17 @@ enum Side<'a, D> {
 }
 
 impl<D: Scalar> Place<D> for Side<'_, D> {
+    #[inline(always)]
     fn point(&self) -> [D; 3] {
         match self {
             Side::Body { r, p, frame } => {
-                let x = rotate_fixed(*p, frame.s);
-                std::array::from_fn(|i| r[i] + x[i])
+                let [x, y, z] = rotate_fixed(*p, frame.s);
+                [r[0] + x, r[1] + y, r[2] + z]
             }
             Side::Ground(frame) => frame.s.map(D::from),
         }
     }
+    #[inline(always)]
     fn axis(&self, k: usize) -> [D; 3] {
         match self {
             Side::Body { p, frame, .. } => rotate_fixed(*p, frame.axes[k]),
@@ -211,16 +213,18 @@ impl<'a> Seeded<'a> {
     }
 
     /// `x` rotated by the body, moved by `r` when `moved`, as an `N`-wide jet.
+    #[inline(always)]
     fn place<const N: usize>(&self, x: [f64; 3], moved: bool) -> [JetN<N>; 3] {
         let x = rotate_fixed(self.p, x);
-        std::array::from_fn(|i| {
+        let at = |i: usize| {
             let mut d = [0.0; N];
             d[self.offset + 3..self.offset + 7].copy_from_slice(x[i].eps.0.as_slice());
             if moved {
                 d[self.offset + i] = 1.0;
             }
             JetN::new(x[i].re + if moved { self.r[i] } else { 0.0 }, Eps(d.into()))
-        })
+        };
+        [at(0), at(1), at(2)]
     }
 }
 
