@@ -637,17 +637,7 @@ fn the_automatic_energy_term_is_left_out_where_the_damping_is_stiff() {
 fn robust_and_projection_are_no_worse_than_none_from_light_to_heavy_damping() {
     let h = 2e-3;
     let error = |ex: &cdyn::models::Example, scheme: Scheme, control: Control| {
-        let mut sim = Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
-        let reference = ex.reference.as_ref().unwrap();
-        let (mut q, mut v) = (vec![0.0; ex.model.n()], vec![0.0; ex.model.n()]);
-        let mut worst = 0.0_f64;
-        sim.run::<Error>(5.0, 5, |s| {
-            reference(s.t(), &mut q, &mut v);
-            worst = worst.max(s.q().iter().zip(&q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max));
-            Ok(())
-        })
-        .unwrap();
-        (worst, *sim.tuning())
+        worst_error(ex, Settings::new(scheme, h, control), 5.0, 5)
     };
     for scheme in [Scheme::AdamsBashforth3, Scheme::RungeKutta4] {
         for damping in [0.1, 0.5, 1.0, 3.0, 10.0, 30.0] {
@@ -682,24 +672,27 @@ fn robust_and_projection_are_no_worse_than_none_from_light_to_heavy_damping() {
 #[test]
 fn projection_is_no_worse_than_none_through_the_turning_points_of_a_damped_swing() {
     let ex = damped_pendulum(DampedPendulumParams { damping: 0.1, ..Default::default() }).unwrap();
-    let reference = ex.reference.as_ref().unwrap();
     for h in [1e-3, 2e-3] {
-        let error = |control: Control| {
-            let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
-            let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
-            let (mut q, mut v) = (vec![0.0; ex.model.n()], vec![0.0; ex.model.n()]);
-            let mut worst = 0.0_f64;
-            sim.run::<Error>(10.0, 10, |s| {
-                reference(s.t(), &mut q, &mut v);
-                worst = worst.max(s.q().iter().zip(&q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max));
-                Ok(())
-            })
-            .unwrap();
-            worst
-        };
+        let error = |control: Control| worst_error(&ex, Settings::new(Scheme::AdamsBashforth3, h, control), 10.0, 10).0;
         let (none, robust, projection) =
             (error(Control::none()), error(methods::robust()), error(methods::projection()));
         println!("h = {h}: none {none:.3e}, robust {robust:.3e}, projection {projection:.3e}");
         assert!(projection <= none && projection <= 2.0 * robust, "h = {h}: {projection:e}");
     }
+}
+
+/// The largest coordinate error against the example's reference, sampled
+/// every `every` steps up to `t_end`, and the run's tuning.
+fn worst_error(ex: &cdyn::models::Example, settings: Settings, t_end: f64, every: u64) -> (f64, gains::Tuning) {
+    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+    let reference = ex.reference.as_ref().unwrap();
+    let (mut q, mut v) = (vec![0.0; ex.model.n()], vec![0.0; ex.model.n()]);
+    let mut worst = 0.0_f64;
+    sim.run::<Error>(t_end, every, |s| {
+        reference(s.t(), &mut q, &mut v);
+        worst = worst.max(s.q().iter().zip(&q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max));
+        Ok(())
+    })
+    .unwrap();
+    (worst, *sim.tuning())
 }
