@@ -133,7 +133,7 @@ impl Blocks {
             scaled: &'a mut [f64],
             weighted: &'a mut [f64],
         }
-        impl WidthFn<()> for Segment<'_> {
+        impl WidthFn for Segment<'_> {
             #[inline(always)]
             fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
                 let idx: &[u32; K] = self.entries[..K].try_into().expect("a block's K entries");

@@ -369,7 +369,7 @@ impl BlockMass {
     /// compiled apart and unrolled (a block's width is known only at run
     /// time; spatial bodies' are 4).
     #[inline(always)]
-    pub(crate) fn at_width<R>(&self, b: usize, f: impl WidthFn<R>) -> R {
+    pub(crate) fn at_width(&self, b: usize, f: impl WidthFn) {
         by_width!(self.coordinates(b).len(), K, f.call::<K>(self, b))
     }
 
@@ -399,7 +399,7 @@ impl BlockMass {
             }
         }
         struct Product<'a, F>(&'a [f64], &'a mut F);
-        impl<F: FnMut(usize, f64)> WidthFn<()> for Product<'_, F> {
+        impl<F: FnMut(usize, f64)> WidthFn for Product<'_, F> {
             #[inline(always)]
             fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
                 let (coords, a) = mass.block::<K>(b);
@@ -416,8 +416,8 @@ impl BlockMass {
 }
 
 /// An operation on one block of a [`BlockMass`], generic over its width.
-pub(crate) trait WidthFn<R> {
-    fn call<const K: usize>(self, mass: &BlockMass, b: usize) -> R;
+pub(crate) trait WidthFn {
+    fn call<const K: usize>(self, mass: &BlockMass, b: usize);
 }
 
 /// `A = L Lᵀ` for the `K × K` row-major `a`, with `L⁻¹` left in `l`;
@@ -465,7 +465,7 @@ impl MassMatrix for BlockMass {
             *o = x * w;
         }
         struct Solve<'a>(&'a [f64], &'a mut [f64]);
-        impl WidthFn<()> for Solve<'_> {
+        impl WidthFn for Solve<'_> {
             #[inline(always)]
             fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
                 let (coords, _) = mass.block::<K>(b);
