@@ -1,12 +1,7 @@
 //! Example 1 with CVSGF + energy control (Eq. 51, forward Euler control,
 //! Eqs. 57–58), AB-3 with RK-4 start-up, written out by hand: closed-form
-//! accelerations, no automatic differentiation, no generic code, no
-//! buffers. It is what the benchmark measures cdyn's abstraction overhead
-//! against, and a test holds it to cdyn's trajectory.
-//!
-//! For benchmarks and comparisons only: it is public because the benches
-//! and the command line's `bench` use it, and hidden from the documentation
-//! because it is not a capability of the library.
+//! accelerations, no buffers. It is what the benchmark measures cdyn's
+//! abstraction overhead against, and a test holds it to cdyn's trajectory.
 
 /// State `(X, Y, V_X, V_Y)`.
 pub type State = [f64; 4];
