@@ -13,7 +13,9 @@
 //! - The spatial chain (`cdyn::spatial::chain`: N rods of 1 kg and 1 m in
 //!   Euler parameters joined by spherical joints, released at rest 0.3 rad
 //!   from vertical, g = 1) with the same control, scheme and step: the same
-//!   figures.
+//!   figures; and against the same chain written out by hand
+//!   (`cdyn::baseline::HandWrittenChain`: closed-form derivatives, `S`
+//!   factored by 4 × 4 blocks), interleaved trials, best of each.
 //! - The methods side by side, each on Example 1 (general `Model`, h = 0.01)
 //!   and on the chain (h = 1e-3), AB-3: `cvsgf_energy` (the control timed
 //!   above), the `robust` preset (automatic gains resolved when each
@@ -26,7 +28,7 @@
 
 use crate::alloc_count::allocations;
 use anyhow::Result;
-use cdyn::baseline::HandWritten;
+use cdyn::baseline::{HandWritten, HandWrittenChain};
 use cdyn::methods::{self, MethodGains};
 use cdyn::models::{ChainParams, Example, PendulumParams, cartesian_pendulum, chain, small_pendulum};
 use cdyn::small::SmallSimulation;
@@ -64,6 +66,20 @@ pub struct ChainRun {
     pub max_abs_phi: f64,
     pub allocations_per_step: f64,
     pub solver: &'static str,
+}
+
+/// The spatial chain's step in cdyn against the same chain written out by hand.
+#[derive(Debug, Serialize)]
+pub struct SpatialBaseline {
+    pub n: usize,
+    /// Every run starts afresh (set-up untimed) and lasts this many steps.
+    pub steps_per_run: u64,
+    pub trials: usize,
+    /// Best over the interleaved trials.
+    pub cdyn_us_per_step: f64,
+    pub handwritten_us_per_step: f64,
+    /// cdyn / hand-written.
+    pub overhead_ratio: f64,
 }
 
 /// One method's cost on one model, over the interleaved trials of a [`MethodComparison`].
@@ -111,6 +127,8 @@ pub struct Report {
     pub spatial_chain: Vec<ChainRun>,
     /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
     pub spatial_chain_cost_exponent: Option<f64>,
+    /// The spatial chain against the hand-written one, by N.
+    pub spatial_handwritten: Vec<SpatialBaseline>,
     /// `cvsgf_energy`, `robust` and `projection` on Example 1, then on the chain by N.
     pub methods: Vec<MethodComparison>,
     /// Over every run above, the methods' included.
@@ -187,6 +205,34 @@ fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
 fn spatial_chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
     let built = cdyn::spatial::chain(n, 0.3, 1.0).build()?;
     timed_chain(n, &built.model, &built.q0, &built.v0, t_end)
+}
+
+/// The spatial chain of `n` rods in cdyn and hand-written, in interleaved
+/// trials of fresh runs (from rest, the benchmark's control and step).
+fn spatial_baseline(n: usize, steps: u64, trials: usize) -> Result<SpatialBaseline> {
+    let built = cdyn::spatial::chain(n, 0.3, 1.0).build()?;
+    let h = 1e-3;
+    let settings = Settings::new(Scheme::AdamsBashforth3, h, chain_control(h));
+    let (mut cdyn, mut hand) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..trials {
+        let start = || Ok(Simulation::new(&built.model, settings, &built.q0, &built.v0)?);
+        cdyn = cdyn.min(timed_runs(1, steps, start, |s| Ok(s.step()?))?.0);
+        let start = || Ok(HandWrittenChain::new(n, 0.3, 1.0, h, 0.4 / h, 0.4 / h));
+        let step = |c: &mut HandWrittenChain| {
+            c.step();
+            Ok(())
+        };
+        hand = hand.min(timed_runs(1, steps, start, step)?.0);
+    }
+    let us = |seconds: f64| seconds / steps as f64 * 1e6;
+    Ok(SpatialBaseline {
+        n,
+        steps_per_run: steps,
+        trials,
+        cdyn_us_per_step: us(cdyn),
+        handwritten_us_per_step: us(hand),
+        overhead_ratio: cdyn / hand,
+    })
 }
 
 /// A chain's run at h = 1e-3, AB-3, with [`chain_control`].
@@ -372,6 +418,11 @@ pub fn run(light: bool) -> Result<Report> {
         if light { (&[10, 100], 0.01) } else { (&[10, 100, 1000, 10_000], 10.0) };
     let spatial_chain =
         spatial_sizes.iter().map(|&n| spatial_chain_run(n, spatial_t_end)).collect::<Result<Vec<_>>>()?;
+    let baselines: &[(usize, u64)] =
+        if light { &[(10, 20), (100, 10)] } else { &[(10, 5000), (100, 500), (1000, 100)] };
+    let trials = if light { 1 } else { 7 };
+    let spatial_handwritten =
+        baselines.iter().map(|&(n, steps)| spatial_baseline(n, steps, trials)).collect::<Result<Vec<_>>>()?;
     let fit = |runs: &[ChainRun]| {
         let points: Vec<(f64, f64)> = runs.iter().filter(|c| c.n >= 100).map(|c| (c.n as f64, c.us_per_step)).collect();
         fitted_exponent(&points)
@@ -390,6 +441,7 @@ pub fn run(light: bool) -> Result<Report> {
         chain,
         spatial_chain_cost_exponent: fit(&spatial_chain),
         spatial_chain,
+        spatial_handwritten,
         methods,
         max_allocations_per_step,
     })
@@ -422,6 +474,19 @@ pub fn table(r: &Report) -> String {
         }
         if let Some(p) = exponent {
             out += &format!("  cost exponent (N ≥ 100): {p:.3}\n");
+        }
+    }
+    if let Some(b) = r.spatial_handwritten.first() {
+        out += &format!(
+            "spatial chain, cdyn against hand-written (fresh runs of the steps shown, best of {} interleaved trials):\n",
+            b.trials
+        );
+        out += &format!("  {:>6} {:>8} {:>12} {:>14} {:>9}\n", "N", "steps", "cdyn µs", "hand µs", "ratio");
+        for b in &r.spatial_handwritten {
+            out += &format!(
+                "  {:>6} {:>8} {:>12.2} {:>14.2} {:>8.2}×\n",
+                b.n, b.steps_per_run, b.cdyn_us_per_step, b.handwritten_us_per_step, b.overhead_ratio
+            );
         }
     }
     if let Some(m) = r.methods.first() {

@@ -30,7 +30,15 @@ fn light_bench_writes_a_complete_report() {
         assert!(c["max_abs_phi"].as_f64().unwrap() < 1e-8, "{c}");
         assert_eq!(c["allocations_per_step"].as_f64(), Some(0.0), "{c}");
     }
-    assert!(String::from_utf8_lossy(&out.stdout).contains("overhead"));
+    let against_hand = r["spatial_handwritten"].as_array().unwrap();
+    assert_eq!(against_hand.iter().map(|c| c["n"].as_u64().unwrap()).collect::<Vec<_>>(), [10, 100]);
+    for c in against_hand {
+        for key in ["cdyn_us_per_step", "handwritten_us_per_step", "overhead_ratio"] {
+            assert!(c[key].as_f64().unwrap() > 0.0, "{key}: {c}");
+        }
+    }
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("overhead") && table.contains("hand µs"), "{table}");
 }
 
 /// The methods' comparison: every model and method, ratios to
