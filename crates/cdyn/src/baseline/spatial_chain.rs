@@ -95,32 +95,29 @@ impl HandWrittenChain {
     /// The chain of `n` rods of `spatial::chain(n, theta0, g)` at rest,
     /// with step `h` and control rates `α_g`, `α_e`.
     pub fn new(n: usize, theta0: f64, g: f64, h: f64, alpha_g: f64, alpha_e: f64) -> Self {
-        let (length, radius, mass) = (1.0, 0.01, 1.0);
-        let d = [theta0.sin(), 0.0, -theta0.cos()];
-        let (across, along) = (mass * (length * length / 12.0 + radius * radius / 4.0), 0.5 * mass * radius * radius);
-        let inertia: [[f64; 3]; 3] = std::array::from_fn(|a| {
-            std::array::from_fn(|b| across * ((a == b) as u8 as f64 - d[a] * d[b]) + along * d[a] * d[b])
-        });
-        // The same tensor's inverse, by its eigen-decomposition: J⁻¹ = (I − d dᵀ)/J⊥ + d dᵀ/J∥.
-        let quarter_inverse = std::array::from_fn(|a| {
-            std::array::from_fn(|b| 0.25 * (((a == b) as u8 as f64 - d[a] * d[b]) / across + d[a] * d[b] / along))
-        });
-        let k = 4.0 * (inertia[0][0] + inertia[1][1] + inertia[2][2]) / 3.0;
-        let half = d.map(|x| 0.5 * length * x);
+        // The rods as the library's chain describes them: equal, uniform
+        // (joined at their ends, their centres of mass between), body axes
+        // the space axes at the start.
+        let mechanism = crate::spatial::chain(n, theta0, g);
+        let rod = &mechanism.bodies[0];
+        let top: [f64; 3] = std::array::from_fn(|i| mechanism.joints[0].point[i] - rod.position[i]);
         let mut x = vec![0.0; 14 * n];
-        for b in 0..n {
-            x[7 * b..7 * b + 3].copy_from_slice(&d.map(|x| x * length * (b as f64 + 0.5)));
-            x[7 * b + 3] = 1.0;
+        for (b, body) in mechanism.bodies.iter().enumerate() {
+            x[7 * b..7 * b + 3].copy_from_slice(&body.position);
+            x[7 * b + 3..7 * b + 7].copy_from_slice(&body.orientation);
         }
+        let inertia = rod.inertia;
+        let quarter_inverse = inverse(&inertia).map(|row| row.map(|x| 0.25 * x));
+        let k = 4.0 * (inertia[0][0] + inertia[1][1] + inertia[2][2]) / 3.0;
         let mut chain = Chain {
             n,
-            mass,
+            mass: rod.mass,
             gravity: g,
             inertia,
             quarter_inverse,
             k,
-            top: half.map(|x| -x),
-            bottom: half,
+            top,
+            bottom: top.map(|x| -x),
             alpha_g,
             alpha_e,
             e0: 0.0,
@@ -378,6 +375,16 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 fn quaternion(x: &[f64]) -> [f64; 4] {
     [x[0], x[1], x[2], x[3]]
+}
+
+/// The inverse of a symmetric positive definite 3 × 3 matrix, by cofactors.
+fn inverse(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let cofactor = |i: usize, j: usize| {
+        let (r, c) = ([(i + 1) % 3, (i + 2) % 3], [(j + 1) % 3, (j + 2) % 3]);
+        a[r[0]][c[0]] * a[r[1]][c[1]] - a[r[0]][c[1]] * a[r[1]][c[0]]
+    };
+    let det: f64 = (0..3).map(|j| a[0][j] * cofactor(0, j)).sum();
+    std::array::from_fn(|i| std::array::from_fn(|j| cofactor(j, i) / det))
 }
 
 /// The Cholesky factor of the lower triangle of `s`.
