@@ -3,8 +3,8 @@
 //! `spatial_chain_step N STEPS [cdyn|hand]`. Prints the time per step;
 //! callgrind's difference between two step counts gives instructions per step.
 
+use cdyn::Simulation;
 use cdyn::baseline::HandWrittenChain;
-use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
 use std::time::Instant;
 
 fn main() {
@@ -13,16 +13,10 @@ fn main() {
     let (n, steps) = (count(0, 1000), count(1, 1000));
     let which = args.get(2).map_or("both", String::as_str);
     let h = 1e-3;
+    let mut hand = HandWrittenChain::new(n, 0.3, 1.0, h, 0.4 / h, 0.4 / h);
     if which != "hand" {
         let built = cdyn::spatial::chain(n, 0.3, 1.0).build().expect("the chain builds");
-        let control = Control {
-            geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-            energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-            application: Application::ForwardEuler,
-            ..Control::none()
-        };
-        let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
-        let mut sim = Simulation::new(&built.model, settings, &built.q0, &built.v0).expect("a simulation");
+        let mut sim = Simulation::new(&built.model, hand.settings(), &built.q0, &built.v0).expect("a simulation");
         let start = Instant::now();
         for _ in 0..steps {
             sim.step().expect("a step");
@@ -30,7 +24,6 @@ fn main() {
         println!("cdyn N = {n}: {:.1} µs per step", start.elapsed().as_secs_f64() / steps as f64 * 1e6);
     }
     if which != "cdyn" {
-        let mut hand = HandWrittenChain::new(n, 0.3, 1.0, h, 0.4 / h, 0.4 / h);
         let start = Instant::now();
         for _ in 0..steps {
             hand.step();

@@ -19,6 +19,7 @@
 //! cdyn's generic step against; a test holds it to cdyn's trajectory.
 
 use crate::spatial::rotation::{g_matrix, rotate_fixed};
+use crate::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings};
 
 /// What one body contributes to an evaluation.
 #[derive(Debug, Clone, Copy, Default)]
@@ -135,6 +136,19 @@ impl HandWrittenChain {
             stage_x: vec![0.0; 14 * n],
             steps: 0,
         }
+    }
+
+    /// cdyn's settings for what this integrator writes out: AB-3 at `h`,
+    /// CVSGF at `α_g` and the gradient energy control at `α_e`, applied by
+    /// a forward Euler step.
+    pub fn settings(&self) -> Settings {
+        let control = Control {
+            geometric: Geometric::Gradient(Gain::Rate(self.chain.alpha_g)),
+            energy: Energy::Gradient(EnergyGain::Rate { alpha_e: self.chain.alpha_e }),
+            application: Application::ForwardEuler,
+            ..Control::none()
+        };
+        Settings::new(Scheme::AdamsBashforth3, self.h, control)
     }
 
     /// Starts again from the state `x` (its energy the new `E₀`).
@@ -422,8 +436,8 @@ fn backward(l: &[[f64; 4]; 4], mut x: [f64; 4]) -> [f64; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Simulation;
     use crate::spatial::rotation::rotate;
-    use crate::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};
 
     #[test]
     fn the_rotation_jacobian_is_the_derivative_of_the_rotation() {
@@ -458,15 +472,8 @@ mod tests {
                 v0[7 * b + 3..7 * b + 7]
                     .copy_from_slice(&crate::spatial::rotation::rate_from_body(p, [0.0, 0.0, spin]));
             }
-            let control = Control {
-                geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-                energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-                application: Application::ForwardEuler,
-                ..Control::none()
-            };
-            let settings = Settings::new(Scheme::AdamsBashforth3, h, control);
-            let mut sim = Simulation::new(&built.model, settings, &built.q0, &v0).unwrap();
             let mut hand = HandWrittenChain::new(n, 0.3, 1.0, h, 0.4 / h, 0.4 / h);
+            let mut sim = Simulation::new(&built.model, hand.settings(), &built.q0, &v0).unwrap();
             let x0: Vec<f64> = built.q0.iter().chain(&v0).copied().collect();
             let distance = |a: &[f64], b: &[f64]| a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
             assert!(distance(&hand.x, &built.q0.iter().chain(&built.v0).copied().collect::<Vec<_>>()) < 1e-15);
