@@ -86,6 +86,11 @@ def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt():
     # returns in well under the bound; ignoring it, the run would finish
     # first (and the KeyboardInterrupt come only after) in far more.
     long_run = cdyn.model("pendulum", scheme="rk4", h=1e-6, t_end=400.0, every=1000000)
+    # Python's own Ctrl-C handler, whatever this process inherited: a job
+    # started in the background by a non-interactive shell (`cmd &`, as a
+    # CI harness may) starts with SIGINT ignored, and Python then installs
+    # none, so the signal would be lost and the run go on to its end.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
     start = time.monotonic()
     timer.start()
@@ -96,5 +101,6 @@ def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt():
         pass
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert time.monotonic() - start < 30.0, "the run went on after Ctrl-C"
     assert cdyn.run(SMALL).error is None  # and the next run is unaffected
