@@ -18,7 +18,7 @@
 //! cdyn's `Ė = λᵀΦ_t` is round-off. It is the floor the benchmark measures
 //! cdyn's generic step against; a test holds it to cdyn's trajectory.
 
-use crate::spatial::rotation::{g_matrix, rotate_fixed};
+use crate::spatial::rotation::{body_rate, g_matrix, rotate_fixed};
 use crate::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings};
 
 /// What one body contributes to an evaluation.
@@ -108,7 +108,9 @@ impl HandWrittenChain {
             x[7 * b + 3..7 * b + 7].copy_from_slice(&body.orientation);
         }
         let inertia = rod.inertia;
-        let quarter_inverse = inverse(&inertia).map(|row| row.map(|x| 0.25 * x));
+        let j = nalgebra::Matrix3::from_fn(|a, b| inertia[a][b]);
+        let j_inverse = j.try_inverse().expect("the chain's rods have a positive definite inertia");
+        let quarter_inverse = std::array::from_fn(|a| std::array::from_fn(|b| 0.25 * j_inverse[(a, b)]));
         let k = 4.0 * (inertia[0][0] + inertia[1][1] + inertia[2][2]) / 3.0;
         let mut chain = Chain {
             n,
@@ -196,18 +198,22 @@ impl Chain {
         (0..self.n)
             .map(|b| {
                 let (p, pd) = (quaternion(&q[7 * b + 3..]), quaternion(&v[7 * b + 3..]));
-                let rd = &v[7 * b..7 * b + 3];
-                let rotation = 0.5 * dot(&pd, &self.momentum(p, pd, &self.body_rate_inertia(p, pd)));
-                0.5 * self.mass * dot(rd, rd) + rotation + self.mass * self.gravity * q[7 * b + 2]
+                let momentum_p = self.momentum(p, pd, &self.body_rate_inertia(p, pd));
+                self.body_energy(q[7 * b + 2], &v[7 * b..7 * b + 3], pd, &momentum_p)
             })
             .sum()
+    }
+
+    /// One body's `T + V` at height `z`, from its velocities and `M_p ṗ`.
+    #[inline(always)]
+    fn body_energy(&self, z: f64, rd: &[f64], pd: [f64; 4], momentum_p: &[f64; 4]) -> f64 {
+        0.5 * self.mass * dot(rd, rd) + 0.5 * dot(&pd, momentum_p) + self.mass * self.gravity * z
     }
 
     /// `J′ω′`, `ω′ = 2 G(p) ṗ`.
     #[inline(always)]
     fn body_rate_inertia(&self, p: [f64; 4], pd: [f64; 4]) -> [f64; 3] {
-        let g = g_matrix(p);
-        let w: [f64; 3] = std::array::from_fn(|a| 2.0 * dot(&g[a], &pd));
+        let w = body_rate(p, pd);
         std::array::from_fn(|a| dot(&self.inertia[a], &w))
     }
 
@@ -219,7 +225,7 @@ impl Chain {
     }
 
     /// Evaluates `f = (v, A)` at `x`, and the control term `U` when asked.
-    fn eval(&mut self, x: &[f64], f: &mut [f64], u: Option<&mut [f64]>) {
+    fn eval(&mut self, x: &[f64], f: &mut [f64], mut u: Option<&mut [f64]>) {
         let n = self.n;
         let (q, v) = x.split_at(7 * n);
         let (fq, fv) = f.split_at_mut(7 * n);
@@ -250,7 +256,7 @@ impl Chain {
                 -4.0 * (0..3).map(|a| gd[a][j] * j_omega[a]).sum::<f64>() - self.k * pd2 * p[j]
             });
             let momentum_p = self.momentum(p, pd, &j_omega);
-            energy += 0.5 * self.mass * dot(rd, rd) + 0.5 * dot(&pd, &momentum_p) + self.mass * self.gravity * r[2];
+            energy += self.body_energy(r[2], rd, pd, &momentum_p);
             momentum2 += self.mass * self.mass * dot(rd, rd) + dot(&momentum_p, &momentum_p);
             let top = d_rotate(p, self.top);
             let bottom = d_rotate(p, self.bottom).map(|row| row.map(|x| -x));
@@ -321,7 +327,6 @@ impl Chain {
         }
         let psi = energy - self.e0;
         let kappa = if momentum2 > 1e-30 { self.alpha_e * psi / momentum2 } else { 0.0 };
-        let mut u = u;
         // Back up: the multipliers, the accelerations and the control term.
         for b in (0..n).rev() {
             let (lambda_below, weights_below) = match self.blocks.get(b + 1) {
@@ -389,16 +394,6 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 fn quaternion(x: &[f64]) -> [f64; 4] {
     [x[0], x[1], x[2], x[3]]
-}
-
-/// The inverse of a symmetric positive definite 3 × 3 matrix, by cofactors.
-fn inverse(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let cofactor = |i: usize, j: usize| {
-        let (r, c) = ([(i + 1) % 3, (i + 2) % 3], [(j + 1) % 3, (j + 2) % 3]);
-        a[r[0]][c[0]] * a[r[1]][c[1]] - a[r[0]][c[1]] * a[r[1]][c[0]]
-    };
-    let det: f64 = (0..3).map(|j| a[0][j] * cofactor(0, j)).sum();
-    std::array::from_fn(|i| std::array::from_fn(|j| cofactor(j, i) / det))
 }
 
 /// The Cholesky factor of the lower triangle of `s`.
