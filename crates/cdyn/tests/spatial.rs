@@ -970,3 +970,111 @@ fn the_stiff_flyball_governor_keeps_its_steady_state_momentum_and_energy_balance
     let (q, m, p, f) = run(1e-4, with_energy);
     println!("robust with its energy term: {m:.1e}, |Ψ| {p:.1e}, |Φ| {f:.1e}, to h/2 {:.1e}", gap(&q));
 }
+
+/// Plain renormalization, the common practice with Euler parameters (not
+/// a cdyn method): after every step of an uncontrolled run, each body's
+/// `p` is scaled to unit length and, with `rates`, `ṗ` is made tangent
+/// (`ṗ ← ṗ − (pᵀṗ) p`), so `pᵀp = 1` and its derivative hold exactly while
+/// the joints drift as without control. Stepped with the library's own
+/// integrator and right-hand side, so it differs from `none` by the
+/// renormalization alone.
+fn renormalized(built: &Built, scheme: Scheme, h: f64, t_end: f64, rates: bool) -> Vec<f64> {
+    let Built { model, q0, v0, .. } = built;
+    let n = model.n();
+    let e0 = model.kinetic(q0, v0) + model.potential(q0, None);
+    let mut system = cdyn::system::ControlledSystem::new(model, Control::none(), e0);
+    let mut integrator = cdyn::integrate::Integrator::new(scheme, Control::none().application, 2 * n + 1);
+    let mut x = [q0.as_slice(), v0.as_slice(), &[0.0]].concat();
+    let bodies = n / 7;
+    let steps = cdyn::simulate::steps_to(t_end, h).unwrap();
+    for k in 0..steps {
+        integrator.step(&mut system, &mut x, k as f64 * h, h).unwrap();
+        for b in 0..bodies {
+            let p = SpatialBody::of(b).euler_parameters();
+            let norm = p.iter().map(|&i| x[i] * x[i]).sum::<f64>().sqrt();
+            p.iter().for_each(|&i| x[i] /= norm);
+            if rates {
+                let along = p.iter().map(|&i| x[i] * x[n + i]).sum::<f64>();
+                p.iter().for_each(|&i| x[n + i] -= along * x[i]);
+            }
+        }
+    }
+    x.truncate(2 * n);
+    x
+}
+
+/// The same run under a cdyn control: the state at `t_end`.
+fn controlled(built: &Built, scheme: Scheme, h: f64, t_end: f64, control: Control) -> Vec<f64> {
+    let Built { model, q0, v0, .. } = built;
+    let mut sim = Simulation::new(model, Settings::new(scheme, h, control), q0, v0).unwrap();
+    sim.run::<Error>(t_end, u64::MAX, |_| Ok(())).unwrap();
+    [sim.q(), sim.v()].concat()
+}
+
+/// What each run ends with: the largest error of the positions against a
+/// converged run, `max ||p| − 1|`, `max |Φ|` and `|T + V − E₀|`.
+fn judged(built: &Built, x: &[f64], reference: &[f64]) -> [f64; 4] {
+    let model = &built.model;
+    let n = model.n();
+    let (q, v) = x.split_at(n);
+    let drift = (0..n / 7)
+        .map(|b| (SpatialBody::of(b).orientation(q).iter().map(|x| x * x).sum::<f64>().sqrt() - 1.0).abs())
+        .fold(0.0, f64::max);
+    let e0 = model.kinetic(&built.q0, &built.v0) + model.potential(&built.q0, None);
+    [
+        (0..n).map(|i| (q[i] - reference[i]).abs()).fold(0.0, f64::max),
+        drift,
+        phi(model, q).iter().fold(0.0, |a: f64, x| a.max(x.abs())),
+        (model.kinetic(q, v) + model.potential(q, None) - e0).abs(),
+    ]
+}
+
+/// Plain renormalization against cdyn's methods, on the heavy top, a free
+/// body and a chain of five rods, with AB-3 and RK-4 (the table is printed
+/// for the README). Renormalization holds `|p| = 1` exactly, as `robust`
+/// and `projection` do, but leaves the joints and the energy as without
+/// control; on the heavy top with AB-3 it makes the motion several times
+/// worse than no control at all (7.6× at h = 1e-4, the same at h/2 and
+/// h/4), where `robust` makes it 2.3× better.
+#[test]
+fn plain_renormalization_against_the_controls() {
+    let cases: [(&str, Mechanism, f64); 3] = [
+        ("heavy top", heavy_top(), 0.2),
+        ("free body", free_body(compose(about([0.0, 0.0, 1.0], 0.4), about(unit([1.0, 1.0, 0.0]), 0.9))), 10.0),
+        ("chain of 5 rods", cdyn::spatial::chain(5, 0.6, 9.81), 2.0),
+    ];
+    for (name, mechanism, t_end) in cases {
+        let built = mechanism.build().unwrap();
+        let h0 = if name == "heavy top" { 1e-4 } else { 2e-3 };
+        let reference = controlled(&built, Scheme::RungeKutta4, h0 / 8.0, t_end, Control::none());
+        for (scheme, h) in [(Scheme::AdamsBashforth3, h0), (Scheme::RungeKutta4, 4.0 * h0)] {
+            let mut rows: Vec<(&str, [f64; 4])> = methods::compare_cases(&methods::MethodGains::paper(), true)
+                .into_iter()
+                .map(|(method, control)| {
+                    (method, judged(&built, &controlled(&built, scheme, h, t_end, control), &reference))
+                })
+                .collect();
+            for (method, rates) in [("renormalize p", false), ("renormalize p, ṗ", true)] {
+                rows.push((method, judged(&built, &renormalized(&built, scheme, h, t_end, rates), &reference)));
+            }
+            println!("{name}, {scheme:?}, h = {h}, {t_end} s: error of q, ||p| − 1|, |Φ|, |T + V − E₀|");
+            for (method, [error, drift, phi, energy]) in &rows {
+                println!("  {method:>22} {error:9.2e} {drift:9.2e} {phi:9.2e} {energy:9.2e}");
+            }
+            let row = |method: &str| rows.iter().find(|(m, _)| *m == method).unwrap().1;
+            let (none, robust, renormalized) = (row("none"), row("robust"), row("renormalize p, ṗ"));
+            // `projection` to its default tolerance (1e-10).
+            for (method, bound) in [("renormalize p", 1e-15), ("robust", 1e-12), ("projection", 1e-10)] {
+                assert!(row(method)[1] <= bound, "{name}: {method} lets |p| drift: {:?}", row(method));
+            }
+            // Joints (more rows than normalizations): renormalization leaves them to drift, the controls hold them.
+            if built.model.m() > built.model.n() / 7 {
+                assert!(renormalized[2] > 1e3 * robust[2].max(1e-15), "{name}: {renormalized:?} vs {robust:?}");
+            }
+            if name == "heavy top" && scheme == Scheme::AdamsBashforth3 {
+                assert!(renormalized[0] > 5.0 * none[0], "{name}: renormalized {renormalized:?} vs none {none:?}");
+                assert!(robust[0] < none[0], "{name}: robust {robust:?} vs none {none:?}");
+            }
+        }
+    }
+}
