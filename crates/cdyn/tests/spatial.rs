@@ -1048,10 +1048,11 @@ fn judged(built: &Built, x: &[f64], reference: &[f64]) -> [f64; 4] {
 /// the README). Every kind holds `|p| = 1` exactly, as `robust` and
 /// `projection` do, but leaves the joints and the energy as without
 /// control. On the heavy top with AB-3, plain renormalization makes the
-/// motion 7.6× worse than no control at all (the same at h/2 and h/4): it
-/// scales the spin by `1/|p|` at every step. Lifted to `ṗ`, so that the
-/// angular velocity is kept, it makes the motion 7.5× better, and `robust`
-/// 2.3× better.
+/// motion 7.6× worse than no control at all (the same at h/2 and h/4): at
+/// every step it changes the angular velocity of the rotation `p`
+/// represents, `2G(p)ṗ/|p|²`, by the factor `|p|` it removes. Lifted to
+/// `ṗ`, so that the angular velocity is kept, it makes the motion 7.5×
+/// better, and `robust` 2.3× better.
 #[test]
 fn plain_renormalization_against_the_controls() {
     let cases: [(&str, Mechanism, f64); 3] = [
