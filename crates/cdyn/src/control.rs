@@ -6,6 +6,7 @@ use crate::error::{Result, non_negative, positive};
 use crate::integrate::Application;
 use crate::mass::MassMatrix;
 use crate::projection::Projection;
+use crate::unit_vector::{UnitVector, carry_rate};
 
 /// A gain either fixed, or set at every evaluation from a target decay rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -228,6 +229,11 @@ pub(crate) trait Evaluation {
     /// `Φ_t`.
     fn phi_t(&self) -> &[f64];
 
+    /// The model's unit vectors (see [`crate::unit_vector`]).
+    fn unit_vectors(&self) -> &[UnitVector] {
+        &[]
+    }
+
     /// `out = Φ_q x`.
     fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
         for (r, o) in out.iter_mut().enumerate() {
@@ -337,12 +343,13 @@ impl Control {
             // With the projected energy control, below: their solves share one pass.
             Geometric::Newton(_) if projected => {}
             Geometric::Newton(rate) => {
-                // U_q = −α_g M⁻¹ Φ_qᵀ S⁻¹ Φ
+                // U_q = −α_g M⁻¹ Φ_qᵀ S⁻¹ Φ, and the unit vectors' velocities carried along.
                 let alpha = rate.value();
                 for (b, p) in scratch.iter_mut().zip(d.phi()) {
                     *b = alpha * p;
                 }
                 d.add_constraint_response(scratch, u_q);
+                carry_rate(d.unit_vectors(), d.phi(), alpha, v, u_v);
             }
         }
         if let (Velocity::Gradient(rate), false) = (self.velocity, projected) {
@@ -459,6 +466,12 @@ impl Control {
                 }
             }
             d.solve_many(&mut rhs[..k]);
+        }
+        // The unit vectors' velocities carried along by U_q (whose energy
+        // part moves no unit vector's length), before the energy term
+        // reads U_v.
+        if let Some(a) = alpha_g {
+            carry_rate(d.unit_vectors(), d.phi(), a, v, u_v);
         }
         let (mut kappa, mut kappa_c) = (0.0, 0.0);
         if energy {

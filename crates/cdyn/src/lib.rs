@@ -50,6 +50,7 @@ mod sparse;
 pub mod spatial;
 pub mod system;
 pub mod timefn;
+pub mod unit_vector;
 
 pub use constraint::Constraint;
 pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};

@@ -8,6 +8,7 @@ use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, Pot
 use crate::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
+use crate::unit_vector::{UnitNorm, UnitVector};
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
 pub use crate::sparse::Pattern;
@@ -21,6 +22,7 @@ pub struct Model {
     pattern: Pattern,
     /// First row and first Jacobian entry of each constraint block.
     offsets: Vec<(usize, usize)>,
+    unit_vectors: Vec<UnitVector>,
 }
 
 /// Where the kinetic energy comes from, decided when the model is built.
@@ -45,6 +47,7 @@ pub struct ModelBuilder {
     constraints: Vec<Box<dyn ConstraintBlock>>,
     potentials: Vec<Box<dyn PotentialBlock>>,
     forces: Vec<Box<dyn ForceBlock>>,
+    unit_vectors: Vec<UnitVector>,
     error: Option<Error>,
 }
 
@@ -75,6 +78,19 @@ impl ModelBuilder {
                 Some(g) => g.items.push(item),
                 None => self.constraints.push(Box::new(ConstraintGroup { items: vec![item] })),
             }
+        }
+        self
+    }
+
+    /// Adds the row `|x|² − 1 = 0` on the coordinates `at` and makes them a
+    /// unit vector, of which only the direction is physical (a spatial
+    /// body's Euler parameters): cdyn's corrections of the positions carry
+    /// its velocities along (see [`crate::unit_vector`]).
+    pub fn unit_vector<const K: usize>(mut self, at: [usize; K]) -> Self {
+        let row = self.rows();
+        self = self.constrain(UnitNorm, at);
+        if self.error.is_none() {
+            self.unit_vectors.push(UnitVector { row, coordinates: at.map(|c| c as u32).to_vec() });
         }
         self
     }
@@ -192,6 +208,7 @@ impl ModelBuilder {
             forces: self.forces,
             pattern,
             offsets,
+            unit_vectors: self.unit_vectors,
         })
     }
 }
@@ -256,8 +273,14 @@ impl Model {
             constraints: Vec::new(),
             potentials: Vec::new(),
             forces: Vec::new(),
+            unit_vectors: Vec::new(),
             error: None,
         }
+    }
+
+    /// The unit vectors among the coordinates ([`ModelBuilder::unit_vector`]).
+    pub fn unit_vectors(&self) -> &[UnitVector] {
+        &self.unit_vectors
     }
 
     /// Number of coordinates `n`.

@@ -18,6 +18,7 @@ use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Result, positive};
 use crate::mass::MassMatrix;
 use crate::model::Model;
+use crate::unit_vector::carry_step;
 
 /// What to do when the projection does not converge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -132,15 +133,16 @@ fn worst(x: &[f64]) -> (usize, f64) {
 }
 
 /// Newton's method for `Φ(q, t) = 0` with the minimum-norm correction
-/// `Δq = −M⁻¹Φ_qᵀ(Φ_q M⁻¹Φ_qᵀ)⁻¹Φ`. Returns the iterations taken; `d` is
-/// left evaluated at the final `q` (with the `v` given). Stops early
-/// when `|Φ|` is not finite.
+/// `Δq = −M⁻¹Φ_qᵀ(Φ_q M⁻¹Φ_qᵀ)⁻¹Φ`, each carrying the unit vectors'
+/// velocities along ([`crate::unit_vector`]). Returns the iterations taken;
+/// `d` is left evaluated at the final `(q, v)`. Stops early when `|Φ|` is
+/// not finite.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn positions(
     model: &Model,
     d: &mut Dynamics,
     q: &mut [f64],
-    v: &[f64],
+    v: &mut [f64],
     t: f64,
     tolerance: f64,
     max_iterations: u32,
@@ -159,6 +161,7 @@ pub(crate) fn positions(
         work.rows.copy_from_slice(d.phi());
         work.correction.fill(0.0);
         d.add_constraint_response(model, &mut work.rows, &mut work.correction);
+        carry_step(model.unit_vectors(), q, &work.correction, v);
         for (q, c) in q.iter_mut().zip(&work.correction) {
             *q += c;
         }

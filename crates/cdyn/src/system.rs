@@ -290,4 +290,7 @@ impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
     fn add_weighted_jt_pair(&self, y: [&[f64]; 2], out: [&mut [f64]; 2]) {
         self.dynamics.add_weighted_jt_pair(self.model, y, out);
     }
+    fn unit_vectors(&self) -> &[crate::unit_vector::UnitVector] {
+        self.model.unit_vectors()
+    }
 }

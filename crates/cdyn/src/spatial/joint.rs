@@ -422,16 +422,6 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
     }
 }
 
-/// `pᵀp − 1 = 0`, the normalization of a body's Euler parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct UnitNorm;
-
-impl Constraint<4, 1> for UnitNorm {
-    fn eval<D: Scalar>(&self, p: [D; 4], _t: D) -> [D; 1] {
-        [p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3] - 1.0]
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

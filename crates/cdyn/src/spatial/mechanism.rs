@@ -2,7 +2,7 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation};
-use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows, UnitNorm};
+use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows};
 use super::load::{BodyRotaryDamper, BodyTorque, GroundRotaryDamper, LineDamper, Load, PointForce, SpringEnergy};
 use super::rotation::{cross, rate_from_body, unrotate};
 use crate::error::{Error, Part, Problem, Result};
@@ -219,7 +219,7 @@ impl Mechanism {
             let b = SpatialBody::of(i);
             builder = builder
                 .kinetic_map(Rotation::new(body.inertia), b.euler_parameters())
-                .constrain(UnitNorm, b.euler_parameters());
+                .unit_vector(b.euler_parameters());
             rows.push(Part::Body { index: i, name: body.name.clone() });
             if self.gravity != [0.0; 3] {
                 let weight = self.gravity.map(|g| g * body.mass);
