@@ -9,6 +9,7 @@ use crate::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup,
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 use crate::unit_vector::{UnitNorm, UnitVector};
+
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
 pub use crate::sparse::Pattern;
