@@ -349,7 +349,8 @@ impl Control {
                     *b = alpha * p;
                 }
                 d.add_constraint_response(scratch, u_q);
-                carry_rate(d.unit_vectors(), d.phi(), alpha, v, u_v);
+                // `scratch` is now S⁻¹ α Φ.
+                carry_rate(d.unit_vectors(), d.phi(), scratch, alpha, v, u_v);
             }
         }
         if let (Velocity::Gradient(rate), false) = (self.velocity, projected) {
@@ -471,7 +472,7 @@ impl Control {
         // part moves no unit vector's length), before the energy term
         // reads U_v.
         if let Some(a) = alpha_g {
-            carry_rate(d.unit_vectors(), d.phi(), a, v, u_v);
+            carry_rate(d.unit_vectors(), d.phi(), z_q, a, v, u_v);
         }
         let (mut kappa, mut kappa_c) = (0.0, 0.0);
         if energy {

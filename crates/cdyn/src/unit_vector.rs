@@ -42,13 +42,14 @@ pub struct UnitVector {
     pub coordinates: Vec<u32>,
 }
 
-/// For a control law that moves the positions at the rate `U_q` with
-/// `Φ_q U_q = −α Φ` on every unit vector's row (Newton's law, with or
-/// without the energy part, which keeps `Φ_q U_q` unchanged): adds the
-/// velocities' share, `U_v += ε ẋ` with `ε = xᵀU_q/|x|² = −α Φ / (2|x|²)`
-/// (the row's gradient is `2xᵀ`, and `|x|² = 1 + Φ`).
-pub(crate) fn carry_rate(units: &[UnitVector], phi: &[f64], alpha: f64, v: &[f64], u_v: &mut [f64]) {
-    for unit in units {
+/// For Newton's law, `U_q = −M⁻¹Φ_qᵀ z` with `z = S⁻¹ α Φ` (plus an
+/// energy part that keeps `Φ_q U_q` unchanged): adds the velocities' share,
+/// `U_v += ε ẋ` with `ε = xᵀU_q/|x|² = −α Φ / (2|x|²)` — the row's gradient
+/// is `2xᵀ`, `(Φ_q U_q)_r = −α Φ_r` and `|x|² = 1 + Φ`. A row dropped as
+/// dependent (`z_r = 0`: `DependentRows::Tolerate`) is not held by `U_q`, so
+/// that identity does not hold for it and its unit vector is left alone.
+pub(crate) fn carry_rate(units: &[UnitVector], phi: &[f64], z: &[f64], alpha: f64, v: &[f64], u_v: &mut [f64]) {
+    for unit in units.iter().filter(|u| z[u.row] != 0.0) {
         let phi = phi[unit.row];
         let epsilon = -alpha * phi / (2.0 * (1.0 + phi));
         for &c in &unit.coordinates {

@@ -3,7 +3,7 @@
 //! path against the dense one, and the rigid-body references (Euler's
 //! torque-free motion, the heavy top benchmark).
 
-use cdyn::dynamics::{Dynamics, LinearSolver};
+use cdyn::dynamics::{DependentRows, Dynamics, LinearSolver};
 use cdyn::reference::torque_free_rate;
 use cdyn::spatial::rotation::{about, body_rate, compose, rate_from_body, rotate, space_rate};
 use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
@@ -1115,34 +1115,51 @@ fn plain_renormalization_against_the_controls() {
     }
 }
 
-/// A unit vector's carried velocity, at a state off the sphere: Newton's
-/// law alone (no velocity or energy term) moves `p` at `U_q` and adds
-/// `U_v = ε ṗ` on the Euler parameters and nothing elsewhere, with
-/// `ε = pᵀU_q/|p|²` — the identity behind `carry_rate`, which computes `ε`
-/// from `Φ` alone (`Φ_q U_q = −α Φ` on the row `|p|² − 1`).
+/// Newton's law alone (no velocity or energy term, `α = 7`) at `(q, v)`:
+/// checks that it adds `U_v = ε ṗ` on the Euler parameters `p` and nothing
+/// elsewhere, with `ε = pᵀU_q/|p|²` — the identity behind `carry_rate`,
+/// which computes `ε` from `Φ` alone — and returns `ε`.
+fn carried_rate(model: &Model, q: &[f64], v: &[f64], p: [usize; 4], dependent: DependentRows) -> f64 {
+    let n = model.n();
+    let alpha = 7.0;
+    let control = Control { geometric: cdyn::Geometric::Newton(cdyn::Rate::Given(alpha)), ..Control::none() };
+    let e0 = model.kinetic(q, v) + model.potential(q, None);
+    let mut system = cdyn::system::ControlledSystem::new(model, control, e0);
+    system.set_dependent_rows(dependent);
+    let x = [q, v, &[0.0]].concat();
+    let (mut f, mut u) = (vec![0.0; 2 * n + 1], vec![0.0; 2 * n + 1]);
+    cdyn::integrate::Rhs::eval(&mut system, &x, 0.0, &mut f, Some(&mut u)).unwrap();
+    let (u_q, u_v) = (&u[..n], &u[n..2 * n]);
+    let norm2: f64 = p.iter().map(|&i| q[i] * q[i]).sum();
+    let epsilon = p.iter().map(|&i| q[i] * u_q[i]).sum::<f64>() / norm2;
+    // The row is |p|² − 1 = Φ: ε = −α Φ / (2|p|²).
+    assert!((epsilon + alpha * (norm2 - 1.0) / (2.0 * norm2)).abs() < 1e-12, "ε = {epsilon}");
+    for i in 0..n {
+        let expected = if p.contains(&i) { epsilon * v[i] } else { 0.0 };
+        assert!((u_v[i] - expected).abs() <= 1e-12 * v[i].abs().max(1.0), "U_v[{i}] = {} ≠ {expected}", u_v[i]);
+    }
+    epsilon
+}
+
+/// A unit vector's carried velocity at a state off the sphere (|p| = 1.02)
+/// and off the joint; and with the normalization entered twice, the second
+/// row dropped as dependent, the unit vector is carried once, not twice.
 #[test]
 fn newton_carries_the_euler_parameters_rates_along_its_rescaling() {
     let Built { model, mut q0, v0, .. } = heavy_top().build().unwrap();
     let p = SpatialBody::of(0).euler_parameters();
     p.iter().for_each(|&i| q0[i] *= 1.02);
-    q0[0] += 1e-3; // and off the joint
-    let n = model.n();
-    let alpha = 7.0;
-    let control = Control { geometric: cdyn::Geometric::Newton(cdyn::Rate::Given(alpha)), ..Control::none() };
-    let e0 = model.kinetic(&q0, &v0) + model.potential(&q0, None);
-    let mut system = cdyn::system::ControlledSystem::new(&model, control, e0);
-    let x = [q0.as_slice(), v0.as_slice(), &[0.0]].concat();
-    let (mut f, mut u) = (vec![0.0; 2 * n + 1], vec![0.0; 2 * n + 1]);
-    cdyn::integrate::Rhs::eval(&mut system, &x, 0.0, &mut f, Some(&mut u)).unwrap();
-    let (u_q, u_v) = (&u[..n], &u[n..2 * n]);
-    let norm2: f64 = p.iter().map(|&i| q0[i] * q0[i]).sum();
-    let epsilon = p.iter().map(|&i| q0[i] * u_q[i]).sum::<f64>() / norm2;
-    // Φ of the row is |p|² − 1 = 0.0404: ε = −α Φ / (2|p|²) = −0.136.
-    assert!((epsilon + alpha * (norm2 - 1.0) / (2.0 * norm2)).abs() < 1e-12, "ε = {epsilon}");
-    for i in 0..n {
-        let expected = if p.contains(&i) { epsilon * v0[i] } else { 0.0 };
-        assert!((u_v[i] - expected).abs() <= 1e-12 * v0[i].abs().max(1.0), "U_v[{i}] = {} ≠ {expected}", u_v[i]);
-    }
+    q0[0] += 1e-3;
+    assert!(carried_rate(&model, &q0, &v0, p, DependentRows::Error) < -0.1);
+    let inertia = heavy_top().bodies[0].inertia;
+    let twice = Model::builder(vec![15.0, 15.0, 15.0, 0.0, 0.0, 0.0, 0.0])
+        .kinetic_map(cdyn::spatial::Rotation::new(inertia), p)
+        .unit_vector(p)
+        .unit_vector(p)
+        .build()
+        .unwrap();
+    assert_eq!(twice.unit_vectors().len(), 2);
+    carried_rate(&twice, &q0, &v0, p, DependentRows::Tolerate);
 }
 
 /// Projecting a free body's `p` back to unit length (assembly, as the
