@@ -5,6 +5,7 @@
 use crate::error::{Result, non_negative, positive};
 use crate::integrate::Application;
 use crate::mass::MassMatrix;
+use crate::momentum::Momenta;
 use crate::projection::Projection;
 use crate::unit_vector::{UnitVector, carry_rate};
 
@@ -167,6 +168,23 @@ pub enum Energy {
     },
 }
 
+/// What the corrections do to the momenta the system keeps
+/// ([`crate::momentum`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Invariants {
+    /// Every correction is made M-orthogonal to the momentum directions the
+    /// run finds or is told of, so that what the uncontrolled scheme keeps
+    /// (a linear momentum, a cyclic rate) stays kept. Where there are none
+    /// — the paper's examples — the laws are exactly as published.
+    #[default]
+    Keep,
+    /// The corrections as the laws write them, whatever they do to the
+    /// momenta: the paper's methods as published on any model.
+    Free,
+}
+
 /// The default `position_weight` of [`Energy::Projected`]: `c = 16/α_e²`,
 /// the suite's choice (README).
 pub const POSITION_WEIGHT: f64 = 16.0;
@@ -187,6 +205,8 @@ pub struct Control {
     /// Exact projection onto the invariants after every step (the
     /// `projection` method), if any.
     pub projection: Option<Projection>,
+    /// Whether the corrections keep the system's momenta.
+    pub invariants: Invariants,
 }
 
 /// What the control laws read of one evaluation of the dynamics.
@@ -234,6 +254,12 @@ pub(crate) trait Evaluation {
         &[]
     }
 
+    /// The momenta the run keeps, with `M E` at this state (see
+    /// [`crate::momentum`]): every correction is made M-orthogonal to them.
+    fn momenta(&self) -> &Momenta {
+        &NO_MOMENTA
+    }
+
     /// `out = Φ_q x`.
     fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
         for (r, o) in out.iter_mut().enumerate() {
@@ -242,6 +268,8 @@ pub(crate) trait Evaluation {
         }
     }
 }
+
+static NO_MOMENTA: Momenta = Momenta::NONE;
 
 /// Buffers the control laws work in.
 pub(crate) struct Workspace<'a> {
@@ -254,6 +282,11 @@ pub(crate) struct Workspace<'a> {
 /// Below this `|Ψ_v|²` (or `vᵀMv`) the energy control has no direction to
 /// act along — the system is at rest — and is skipped rather than divided by zero.
 const REST: f64 = 1e-30;
+
+/// With momenta kept, the energy laws act on the kinetic energy relative
+/// to them, `2T − pᵀ(EᵀME)⁻¹p`, a difference: below this fraction of `2T`
+/// it is round-off (a rigid translation), and the law is skipped.
+const RELATIVE_REST: f64 = 1e-12;
 
 impl Control {
     /// No control at all (Eq. 8).
@@ -361,8 +394,34 @@ impl Control {
             }
             d.add_constraint_response(scratch, u_v);
         }
+        // What the terms so far move along the momenta is taken out before
+        // the energy laws read U (a no-op where it is M-orthogonal already).
+        let momenta = d.momenta();
+        momenta.project(u_q);
+        momenta.project(u_v);
         match self.energy {
             Energy::None => {}
+            Energy::Gradient(gain) if !momenta.is_empty() => {
+                // Along P_E Ψ_vᵀ = P_E M v, the rate law's gain set on what that
+                // moves Ψ by, so that Ψ̇ = −α_e Ψ still holds.
+                let w = work.w;
+                mass.mul(v, w);
+                momenta.project(w);
+                let (rho_q, rho_v) = match gain {
+                    EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
+                    EnergyGain::Rate { alpha_e } => {
+                        let g2 = mass.psi_v_dot(v, |i| w[i], |_| 0.0, 0.0);
+                        (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
+                    }
+                };
+                if rho_q != 0.0 {
+                    for (u, g) in u_q.iter_mut().zip(d.grad_potential()) {
+                        *u -= 2.0 * rho_q * psi * g;
+                    }
+                }
+                let scale = -(2.0 * rho_v * psi);
+                u_v.iter_mut().zip(w.iter()).for_each(|(u, w)| *u += scale * w);
+            }
             Energy::Gradient(gain) => {
                 let (rho_q, rho_v) = match gain {
                     EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
@@ -382,14 +441,18 @@ impl Control {
             Energy::Baumgarte { eta } => {
                 // μ = [Ψ_v A_geo + Ψ_q v − Ė + η Ψ] / (Ψ_v M⁻¹ Ψ_vᵀ), with
                 // A_geo = A + U_v so far and Ψ_v M⁻¹ Ψ_vᵀ = vᵀ M v = 2T (Eqs. 17–19).
-                let two_t = 2.0 * mass.kinetic(v);
-                if two_t > REST {
+                // With momenta kept, μ acts along P_E v, and Ψ_v P_E v = |P_E v|²_M.
+                let (along, kept) = momenta.split(v);
+                let whole = 2.0 * mass.kinetic(v);
+                let two_t = whole - kept;
+                if two_t > REST && (momenta.is_empty() || two_t > RELATIVE_REST * whole) {
                     let (acc, grad) = (d.acc(), d.grad_potential());
                     let geometric = |i: usize| acc[i] + u_v[i];
                     let num = mass.psi_v_dot(v, geometric, |i| grad[i] * v[i], eta * psi - e_dot);
                     let mu = num / two_t;
                     // U_v −= μ M⁻¹ Ψ_vᵀ   (Eq. 19)
                     mass.add_inverse_psi_v(v, -mu, u_v);
+                    momenta.add_directions(&along, mu, u_v);
                 }
             }
             Energy::Projected { alpha_e, position_weight } => {
@@ -397,6 +460,9 @@ impl Control {
                 self.coupled_terms(d, v, psi, alpha_e.value(), position_weight, u_q, u_v, rows, work.w);
             }
         }
+        // Round-off left along the momenta by terms M-orthogonal to them in exact arithmetic.
+        momenta.project(u_q);
+        momenta.project(u_v);
     }
 
     /// [`Energy::Projected`] with the other terms whose gain matrix is
@@ -475,6 +541,8 @@ impl Control {
             carry_rate(d.unit_vectors(), d.phi(), z_q, a, v, u_v);
         }
         let (mut kappa, mut kappa_c) = (0.0, 0.0);
+        let momenta = d.momenta();
+        let (along, kept) = momenta.split(v);
         if energy {
             let y_v: &[f64] = if separate_y_v { y_v } else { z_dot };
             let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
@@ -490,8 +558,10 @@ impl Control {
             // vᵀM(−α_v M⁻¹Φ_qᵀ z_Φ̇) = −α_v (Φ_q v)·z_Φ̇
             others -= alpha_v * (0..z_dot.len()).map(|r| phi_q_v(r) * z_dot[r]).sum::<f64>();
             let target = alpha_e * psi + others;
-            // N = c|P M⁻¹∇V|²_M + |P v|²_M, |P v|²_M = vᵀMv − (Φ_q v)·y_v.
-            let mut norm = 2.0 * mass.kinetic(v) - (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>();
+            // N = c|P M⁻¹∇V|²_M + |P_E P v|²_M, |P_E P v|²_M = vᵀMv − (Φ_q v)·y_v − pᵀ(EᵀME)⁻¹p
+            // (P_E and P commute, since Φ_q E = 0).
+            let whole = 2.0 * mass.kinetic(v);
+            let mut norm = whole - (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>() - kept;
             if positions {
                 norm += c * (dot(grad, w) - dot(phi_q_w, y_w));
             }
@@ -501,7 +571,8 @@ impl Control {
             // rest at an extremum of V on the constraint surface) the gain is
             // capped so that |U| stays bounded (README).
             let scale = target / norm.max(target.abs() / alpha_e);
-            if norm > REST && scale.is_finite() {
+            let relative = momenta.is_empty() || norm > RELATIVE_REST * whole;
+            if norm > REST && relative && scale.is_finite() {
                 (kappa, kappa_c) = (scale, scale * c);
             }
         }
@@ -522,6 +593,7 @@ impl Control {
         }
         if kappa != 0.0 {
             mass.add_inverse_psi_v(v, -kappa, u_v);
+            momenta.add_directions(&along, kappa, u_v);
         }
         // Both products in one pass over the Jacobian.
         d.add_weighted_jt_pair([z_q, z_dot], [u_q, u_v]);

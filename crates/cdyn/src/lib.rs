@@ -38,6 +38,7 @@ pub mod mass;
 pub mod methods;
 pub mod model;
 pub mod models;
+pub mod momentum;
 pub mod nonholonomic;
 pub mod planar;
 pub mod projection;
@@ -53,7 +54,7 @@ pub mod timefn;
 pub mod unit_vector;
 
 pub use constraint::Constraint;
-pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
+pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Invariants, Rate, Velocity};
 pub use error::{Error, Result};
 pub use force::{Force, Potential};
 pub use integrate::{Application, Scheme};

@@ -3,7 +3,9 @@
 //! named cases of the paper's comparison, for `cdyn paper`, `compare`,
 //! `bench` and benchmarks. A simulation itself needs only a [`Control`].
 
-use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity, baumgarte_gains};
+use crate::control::{
+    Control, Energy, EnergyGain, Gain, Geometric, Invariants, POSITION_WEIGHT, Rate, Velocity, baumgarte_gains,
+};
 use crate::error::{Error, KeyProblem, Result, non_negative};
 use crate::integrate::Application;
 use crate::projection::{OnFailure, Projection};
@@ -173,6 +175,9 @@ pub struct MethodKeys {
     pub max_iterations: Option<u32>,
     /// Projection: `stop` (default) or `continue` when it does not converge.
     pub on_failure: Option<OnFailure>,
+    /// `keep` (default): corrections keep the momenta the system keeps;
+    /// `free`: the laws as written (the paper's, as published).
+    pub invariants: Option<Invariants>,
 }
 
 const CVSGF: &str = "geometric = \"cvsgf\"";
@@ -300,7 +305,14 @@ impl MethodKeys {
                 position_weight: non_negative("position_weight", self.position_weight.unwrap_or(POSITION_WEIGHT))?,
             },
         };
-        Ok(Control { geometric, velocity, energy, application: self.apply.unwrap_or_default(), projection: None })
+        Ok(Control {
+            geometric,
+            velocity,
+            energy,
+            application: self.apply.unwrap_or_default(),
+            projection: None,
+            invariants: self.invariants.unwrap_or_default(),
+        })
     }
 
     /// The control of a preset, refusing every key the preset sets itself.
@@ -337,8 +349,9 @@ impl MethodKeys {
         if let Some((key, _)) = keys.into_iter().find(|(_, set)| *set) {
             return Err(KeyProblem::Preset { preset: name, key }.into());
         }
+        let invariants = self.invariants.unwrap_or_default();
         Ok(match preset {
-            Preset::Robust => robust(),
+            Preset::Robust => Control { invariants, ..robust() },
             Preset::Projection => {
                 let d = Projection::default();
                 let p = Projection {
@@ -348,7 +361,7 @@ impl MethodKeys {
                     ..d
                 };
                 p.validate()?;
-                Control { projection: Some(p), ..Control::none() }
+                Control { projection: Some(p), invariants, ..Control::none() }
             }
         })
     }
@@ -436,6 +449,7 @@ pub fn robust() -> Control {
         energy: Energy::Projected { alpha_e: Rate::Auto, position_weight: POSITION_WEIGHT },
         application: Application::PostStep,
         projection: None,
+        invariants: Invariants::Keep,
     }
 }
 

@@ -7,6 +7,7 @@ use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
 use crate::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
+use crate::momentum::Direction;
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 use crate::unit_vector::{UnitNorm, UnitVector};
 
@@ -24,6 +25,8 @@ pub struct Model {
     /// First row and first Jacobian entry of each constraint block.
     offsets: Vec<(usize, usize)>,
     unit_vectors: Vec<UnitVector>,
+    momenta: Vec<Direction>,
+    names: Option<Vec<String>>,
 }
 
 /// Where the kinetic energy comes from, decided when the model is built.
@@ -49,6 +52,8 @@ pub struct ModelBuilder {
     potentials: Vec<Box<dyn PotentialBlock>>,
     forces: Vec<Box<dyn ForceBlock>>,
     unit_vectors: Vec<UnitVector>,
+    momenta: Vec<Direction>,
+    names: Option<Vec<String>>,
     error: Option<Error>,
 }
 
@@ -92,6 +97,59 @@ impl ModelBuilder {
         self = self.constrain(UnitNorm, at);
         if self.error.is_none() {
             self.unit_vectors.push(UnitVector { row, coordinates: at.map(|c| c as u32).to_vec() });
+        }
+        self
+    }
+
+    /// Names the coordinates (`body.x`, …), one per coordinate, for what a
+    /// run reports of them (a cyclic coordinate's momentum).
+    pub fn coordinate_names(mut self, names: Vec<String>) -> Self {
+        if self.error.is_none() && names.len() != self.mass.len() {
+            self.error = Some(Error::InvalidParameter {
+                name: "coordinate names",
+                value: names.len() as f64,
+                reason: "must name every coordinate once",
+            });
+        }
+        self.names = Some(names);
+        self
+    }
+
+    /// Declares that the model keeps the generalized momentum `eᵀ ∂T/∂v`
+    /// along the constant direction `e` given by its non-zero entries
+    /// (coordinate, weight). A run checks it like the directions it finds
+    /// itself ([`crate::momentum::detect`]) and reports it when the model
+    /// breaks it, instead of holding it.
+    pub fn momentum(self, name: &str, direction: &[(usize, f64)]) -> Self {
+        self.momentum_direction(name, direction, true)
+    }
+
+    /// A direction a mechanism builder proposes (a rigid translation):
+    /// kept where the model turns out symmetric along it, else dropped silently.
+    pub(crate) fn momentum_candidate(self, name: &str, direction: &[(usize, f64)]) -> Self {
+        self.momentum_direction(name, direction, false)
+    }
+
+    fn momentum_direction(mut self, name: &str, direction: &[(usize, f64)], declared: bool) -> Self {
+        if self.error.is_some() {
+            return self;
+        }
+        let n = self.mass.len();
+        let what = Part::Block { what: "a momentum" };
+        if let Some(&(index, _)) = direction.iter().find(|(i, _)| *i >= n) {
+            self.error = Some(Problem::NoSuchCoordinate { index, n }.at(what));
+        } else if let Some(&(_, w)) = direction.iter().find(|(_, w)| !w.is_finite()) {
+            self.error =
+                Some(Error::InvalidParameter { name: "momentum direction", value: w, reason: "must be finite" });
+        } else if direction.iter().all(|(_, w)| *w == 0.0) {
+            self.error = Some(Error::InvalidParameter {
+                name: "momentum direction",
+                value: 0.0,
+                reason: "must have a non-zero entry",
+            });
+        } else {
+            let entries = direction.iter().map(|&(i, w)| (i as u32, w)).collect();
+            self.momenta.push(Direction { name: name.to_string(), entries, declared });
         }
         self
     }
@@ -210,6 +268,8 @@ impl ModelBuilder {
             pattern,
             offsets,
             unit_vectors: self.unit_vectors,
+            momenta: self.momenta,
+            names: self.names,
         })
     }
 }
@@ -275,8 +335,22 @@ impl Model {
             potentials: Vec::new(),
             forces: Vec::new(),
             unit_vectors: Vec::new(),
+            momenta: Vec::new(),
+            names: None,
             error: None,
         }
+    }
+
+    /// The coordinates' names, where the builder gave them.
+    pub fn coordinate_names(&self) -> Option<&[String]> {
+        self.names.as_deref()
+    }
+
+    /// The momentum directions declared or proposed by a mechanism
+    /// builder ([`ModelBuilder::momentum`]); which of them, and which cyclic
+    /// coordinates, the model keeps is found when a run starts.
+    pub fn momentum_directions(&self) -> &[Direction] {
+        &self.momenta
     }
 
     /// The unit vectors among the coordinates ([`ModelBuilder::unit_vector`]).

@@ -18,6 +18,7 @@ use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Result, positive};
 use crate::mass::MassMatrix;
 use crate::model::Model;
+use crate::momentum::Momenta;
 use crate::unit_vector::carry_step;
 
 /// What to do when the projection does not converge.
@@ -187,6 +188,7 @@ pub(crate) fn velocities(model: &Model, d: &Dynamics, v: &mut [f64], work: &mut 
 pub(crate) fn invariants(
     model: &Model,
     d: &mut Dynamics,
+    momenta: &mut Momenta,
     q: &mut [f64],
     v: &mut [f64],
     t: f64,
@@ -235,6 +237,12 @@ pub(crate) fn invariants(
         d.jac_mul(model, v, &mut work.rows_2);
         d.solve_many(&mut [&mut work.rows, &mut work.rows_2]);
         d.add_weighted_jt_pair(model, [&work.rows, &work.rows_2], [&mut work.correction, &mut work.direction]);
+        // The velocities move along P_E P v, leaving the momenta the system
+        // keeps as they are (P M⁻¹ Ψ_q is M-orthogonal to them already).
+        if momenta.stale() {
+            momenta.update(&mass);
+        }
+        momenta.project(&mut work.direction);
         let b: f64 = d.psi_q().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
         let a = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
         let slope = c * b + a;

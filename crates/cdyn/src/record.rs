@@ -307,6 +307,35 @@ pub struct Record {
     /// Why the run stopped early; `None` when it reached the end.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub error: Option<Error>,
+    /// The momenta the system keeps, and the declared ones it breaks, over the samples.
+    pub momenta: Vec<MomentumRecord>,
+}
+
+/// A momentum over a run: its value at the first and last sample and its
+/// largest drift from the first.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct MomentumRecord {
+    /// Its name ("linear momentum x").
+    pub name: String,
+    /// Whether the system keeps it; a declared one it breaks is measured only.
+    pub kept: bool,
+    /// What breaks a declared one.
+    pub reason: Option<String>,
+    /// Linear in the state, so kept to round-off by every explicit scheme.
+    pub linear: bool,
+    /// `|e|_M |v₀|_M`, the size its round-off is judged against.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
+    pub scale: f64,
+    /// At the first sample.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
+    pub initial: f64,
+    /// At the last sample.
+    #[cfg_attr(feature = "serde", serde(rename = "final", serialize_with = "crate::json_float::serialize"))]
+    pub last: f64,
+    /// Largest `|p − p₀|` over the samples.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json_float::serialize"))]
+    pub max_drift: f64,
 }
 
 /// What a sample observes besides the violations.
@@ -372,6 +401,7 @@ fn empty_record(has_reference: bool) -> Record {
         v_end: Vec::new(),
         series: None,
         error: None,
+        momenta: Vec::new(),
     }
 }
 
@@ -416,6 +446,7 @@ impl<'a, K: Sink> Recorder<'a, K> {
     /// Samples the current state of `sim`: updates the statistics and
     /// series and hands the sample to the sink.
     pub fn sample<S: System>(&mut self, sim: &mut Stepper<S>) -> Result<(), K::Error> {
+        self.track_momenta(sim);
         let measures = sim.measure();
         let (t, q, v) = (sim.t(), sim.q(), sim.v());
         let (observables, error) = match &mut self.observed {
@@ -440,6 +471,46 @@ impl<'a, K: Sink> Recorder<'a, K> {
             s.push(t, measures.phi, measures.psi, error);
         }
         self.sink.sample(&Sample { step: sim.steps(), t, observables, measures, error })
+    }
+
+    /// The momenta of the system at the current sample: set up at the first.
+    fn track_momenta<S: System>(&mut self, sim: &mut Stepper<S>) {
+        if sim.steps() == 0 && self.record.momenta.is_empty() {
+            let symmetries = sim.symmetries();
+            let kept = symmetries.kept.iter().map(|m| MomentumRecord {
+                name: m.name.clone(),
+                kept: true,
+                reason: None,
+                linear: m.linear,
+                scale: m.scale,
+                initial: 0.0,
+                last: 0.0,
+                max_drift: 0.0,
+            });
+            let broken = symmetries.broken.iter().map(|b| MomentumRecord {
+                name: b.name.clone(),
+                kept: false,
+                reason: Some(b.reason.clone()),
+                linear: false,
+                scale: 0.0,
+                initial: 0.0,
+                last: 0.0,
+                max_drift: 0.0,
+            });
+            let momenta: Vec<MomentumRecord> = kept.chain(broken).collect();
+            self.record.momenta = momenta;
+            for j in 0..self.record.momenta.len() {
+                let p = sim.momentum(j);
+                (self.record.momenta[j].initial, self.record.momenta[j].last) = (p, p);
+            }
+        } else {
+            for j in 0..self.record.momenta.len() {
+                let p = sim.momentum(j);
+                let m = &mut self.record.momenta[j];
+                m.last = p;
+                m.max_drift = m.max_drift.max((p - m.initial).abs());
+            }
+        }
     }
 
     /// The record so far, with the end state of `sim`.

@@ -11,6 +11,7 @@ use crate::error::{Error, Part, Problem, Result, positive};
 use crate::gains::{Operators, Tuning, resolve};
 use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
+use crate::momentum::{self, Symmetries};
 use crate::projection::{Failure, OnFailure};
 use crate::system::{ControlledSystem, EvalError, System};
 
@@ -111,6 +112,7 @@ impl<'m> Simulation<'m> {
         let e0 = model.kinetic(q0, v0) + model.potential(q0, None);
         let mut system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
         system.set_dependent_rows(settings.dependent_rows);
+        system.set_symmetries(momentum::detect(model, q0, v0));
         Self::start(system, settings, q0, v0)
     }
 
@@ -223,6 +225,18 @@ impl<S: System> Stepper<S> {
     /// Right-hand-side evaluations so far.
     pub fn evaluations(&self) -> u64 {
         self.system.evaluations()
+    }
+
+    /// The momenta the system keeps, found at the start, and the declared
+    /// ones it breaks ([`crate::momentum::detect`]).
+    pub fn symmetries(&self) -> &Symmetries {
+        self.system.symmetries()
+    }
+
+    /// The value `eᵀ M v` of momentum `j` at the current state: the kept
+    /// ones, then the declared ones the model breaks ([`Symmetries::direction`]).
+    pub fn momentum(&mut self, j: usize) -> f64 {
+        self.system.momentum(j, self.x.as_slice())
     }
 
     /// Violations at the current state.

@@ -9,6 +9,7 @@ use crate::gains::Operators;
 use crate::integrate::{Buffer, Rhs};
 use crate::mass::{MassAt, MassMatrix};
 use crate::model::Model;
+use crate::momentum::{self, Momenta, Symmetries};
 use crate::projection::{self, Failure, Projection};
 
 /// A failed evaluation of the right-hand side.
@@ -75,7 +76,18 @@ pub trait System: Rhs<Error = EvalError> {
     /// Projects the state `x` at time `t` onto the invariants (the
     /// `projection` method); returns the Newton iterations taken.
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure>;
+    /// The momenta the system keeps ([`crate::momentum`]); none unless it finds them.
+    fn symmetries(&self) -> &Symmetries {
+        &NO_SYMMETRIES
+    }
+    /// The value at the state `x` of momentum `j` of [`Symmetries::direction`].
+    fn momentum(&mut self, j: usize, x: &[f64]) -> f64 {
+        let _ = (j, x);
+        0.0
+    }
 }
+
+static NO_SYMMETRIES: Symmetries = Symmetries::NONE;
 
 /// Splits a state into `(q, v, e)`.
 pub fn split_state(x: &[f64], n: usize) -> (&[f64], &[f64], f64) {
@@ -100,6 +112,10 @@ pub struct ControlledSystem<'m> {
     /// Most rows dropped as dependent by an evaluation since the last
     /// [`System::take_dependent_rows`].
     dependent: usize,
+    /// The momenta the model keeps ([`crate::momentum::detect`]).
+    symmetries: Symmetries,
+    /// Those the corrections keep (none with [`Invariants::Free`](crate::control::Invariants::Free)).
+    momenta: Momenta,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -121,7 +137,22 @@ impl<'m> ControlledSystem<'m> {
             projection: projection::Work::new(model),
             evaluations: 0,
             dependent: 0,
+            symmetries: Symmetries::default(),
+            momenta: Momenta::NONE,
         }
+    }
+
+    /// The momenta the model keeps; the control's corrections are made
+    /// M-orthogonal to them unless it says [`Invariants::Free`](crate::control::Invariants::Free).
+    pub fn set_symmetries(&mut self, symmetries: Symmetries) {
+        self.momenta = match self.control.invariants {
+            crate::control::Invariants::Keep => {
+                let constant = self.model.mass().is_some() || symmetries.kept.iter().all(|m| m.linear);
+                Momenta::new(&symmetries.kept, self.model.n(), constant)
+            }
+            crate::control::Invariants::Free => Momenta::NONE,
+        };
+        self.symmetries = symmetries;
     }
 
     /// Sets what a dependent constraint row does (default: an error).
@@ -174,19 +205,22 @@ impl Rhs for ControlledSystem<'_> {
             u_e[0] = 0.0;
             let [r0, r1, r2, r3, r4] = &mut self.rows;
             let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work };
-            let (model, dynamics) = (self.model, &self.dynamics);
+            if self.momenta.stale() {
+                self.momenta.update(&self.dynamics.mass(self.model));
+            }
+            let (model, dynamics, momenta) = (self.model, &self.dynamics, &self.momenta);
             // The laws are compiled once per kind of mass, so that a constant
             // diagonal `M` runs its loops without a match per product
             // (Example 1 took 6.6 % more instructions per step with one).
             match dynamics.mass(model) {
                 MassAt::Diagonal(mass) => {
-                    self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
+                    self.control.terms(&Evaluated { model, dynamics, mass, momenta }, v, psi, e_dot, u_q, u_v, work)
                 }
                 MassAt::Dense(mass) => {
-                    self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
+                    self.control.terms(&Evaluated { model, dynamics, mass, momenta }, v, psi, e_dot, u_q, u_v, work)
                 }
                 MassAt::Blocks(mass) => {
-                    self.control.terms(&Evaluated { model, dynamics, mass }, v, psi, e_dot, u_q, u_v, work)
+                    self.control.terms(&Evaluated { model, dynamics, mass, momenta }, v, psi, e_dot, u_q, u_v, work)
                 }
             }
         }
@@ -222,7 +256,7 @@ impl System for ControlledSystem<'_> {
         let (q, v, _) = split_state(x, self.model.n());
         let (model, n) = (self.model, self.model.n());
         self.dynamics.evaluate(model, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let d = Evaluated { model, dynamics: &self.dynamics, mass: &self.dynamics.mass(model) };
+        let d = Evaluated { model, dynamics: &self.dynamics, mass: &self.dynamics.mass(model), momenta: &self.momenta };
         let rows = (0..model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
         let damping = |w: &[f64], out: &mut [f64]| {
             out.fill(0.0);
@@ -237,12 +271,20 @@ impl System for ControlledSystem<'_> {
     fn set_control(&mut self, control: Control) {
         self.control = control;
     }
+    fn symmetries(&self) -> &Symmetries {
+        &self.symmetries
+    }
+    fn momentum(&mut self, j: usize, x: &[f64]) -> f64 {
+        let (q, v, _) = split_state(x, self.model.n());
+        momentum::value(self.model, q, v, self.symmetries.direction(j), &mut self.work)
+    }
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
         let n = self.model.n();
         let (q, rest) = x.split_at_mut(n);
         let (v, e) = rest.split_at_mut(n);
         let target = self.e0 + e[0];
-        projection::invariants(self.model, &mut self.dynamics, q, v, t, target, h, settings, &mut self.projection)
+        let (model, d) = (self.model, &mut self.dynamics);
+        projection::invariants(model, d, &mut self.momenta, q, v, t, target, h, settings, &mut self.projection)
     }
 }
 
@@ -252,6 +294,7 @@ struct Evaluated<'a, M> {
     model: &'a Model,
     dynamics: &'a Dynamics,
     mass: &'a M,
+    momenta: &'a Momenta,
 }
 
 impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
@@ -292,5 +335,8 @@ impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
     }
     fn unit_vectors(&self) -> &[crate::unit_vector::UnitVector] {
         self.model.unit_vectors()
+    }
+    fn momenta(&self) -> &Momenta {
+        self.momenta
     }
 }

@@ -151,7 +151,7 @@ fn robust_controls() -> Vec<Control> {
         (Geometric::Gradient(Gain::Auto), Velocity::Gradient(Rate::Auto), projected(Rate::Auto, POSITION_WEIGHT)),
     ] {
         for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-            out.push(Control { geometric, velocity, energy, application, projection: None });
+            out.push(Control { geometric, velocity, energy, application, ..Control::none() });
         }
     }
     out.push(methods::robust());

@@ -141,7 +141,7 @@ fn all_controls() -> Vec<Control> {
                 for a in
                     [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler, Application::PostStep]
                 {
-                    out.push(Control { geometric: g, velocity, energy: e, application: a, projection: None });
+                    out.push(Control { geometric: g, velocity, energy: e, application: a, ..Control::none() });
                 }
             }
         }

@@ -55,7 +55,14 @@ impl Mechanism {
                 names.push(format!("{}.angle", b.name));
             }
         }
-        let mut builder = Model::builder(mass);
+        let mut builder = Model::builder(mass).coordinate_names(names.clone());
+        // The rigid translations: kept where nothing holds the mechanism in place.
+        for (axis, name) in
+            ["linear momentum x", "linear momentum y"].into_iter().enumerate().filter(|_| !offsets.is_empty())
+        {
+            let direction: Vec<(usize, f64)> = offsets.iter().map(|&o| (o + axis, 1.0)).collect();
+            builder = builder.momentum_candidate(name, &direction);
+        }
         for (i, b) in self.bodies.iter().enumerate() {
             if self.gravity != [0.0, 0.0] {
                 let w = [-b.mass * self.gravity[0], -b.mass * self.gravity[1]];

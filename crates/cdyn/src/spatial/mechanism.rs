@@ -214,7 +214,19 @@ impl Mechanism {
             crate::error::finite("gravity", g)?;
         }
         let mut rows = Vec::new();
-        let mut builder = Model::builder(mass);
+        let names = self.bodies.iter().flat_map(|b| coordinate_names(&b.name)).collect();
+        let mut builder = Model::builder(mass).coordinate_names(names);
+        // The rigid translations: kept where nothing holds the mechanism in place.
+        let axes = if self.bodies.is_empty() {
+            &[][..]
+        } else {
+            &["linear momentum x", "linear momentum y", "linear momentum z"]
+        };
+        for (axis, name) in axes.iter().enumerate() {
+            let direction: Vec<(usize, f64)> =
+                (0..self.bodies.len()).map(|i| (SpatialBody::of(i).first + axis, 1.0)).collect();
+            builder = builder.momentum_candidate(name, &direction);
+        }
         for (i, body) in self.bodies.iter().enumerate() {
             let b = SpatialBody::of(i);
             builder = builder

@@ -1,0 +1,480 @@
+//! Momenta the system keeps, and corrections that leave them alone.
+//!
+//! A constant direction `e` in the coordinates is a symmetry when moving
+//! the whole state along it changes nothing the dynamics reads: the
+//! constraints (`Φ_q e = 0`, and `A e = 0` for nonholonomic rows), the
+//! energy (`∇V·e = 0`, `∂T/∂q·e = 0`) and the applied and damping forces
+//! (`Q·e = 0`). Its generalized momentum `p = eᵀ M v` is then conserved:
+//! `d/dt (∂T/∂v·e) = ∂T/∂q·e − ∇V·e + Q·e − λᵀΦ_q e = 0`. Rigid
+//! translations of a free-floating system (its linear momentum) and cyclic
+//! coordinates (a sled's heading rate) are such directions.
+//!
+//! Where `M e` is constant (`M` constant on the coordinates `e` moves)
+//! `p` is linear in the state, `dp/dt = eᵀ M f_v(x) = 0` at every state,
+//! and every explicit scheme keeps it to round-off; so does `eᵀ M q − p t`
+//! (the centre of mass moves on a straight line). A control term `U`
+//! keeps them too exactly when `Eᵀ M U_q = 0` and `Eᵀ M U_v = 0`: it is
+//! M-orthogonal to the momentum directions. [`Momenta::project`] applies
+//! the M-orthogonal projector `P_E = I − E (EᵀME)⁻¹ EᵀM` onto that
+//! complement. Since `Φ_q E = 0`, `Φ_q P_E U = Φ_q U`: projecting a
+//! correction changes nothing of what it does to the constraints.
+//! The energy laws move the velocities along `P_E` of their direction,
+//! with their gain set on what is left (`|P_E v|²_M = 2T − pᵀ(EᵀME)⁻¹p`,
+//! the kinetic energy of the motion relative to the momenta), so that `Ψ`
+//! still decays at its rate (docs: "Corrections that keep the momenta").
+
+use crate::dynamics::Dynamics;
+use crate::mass::MassMatrix;
+use crate::model::Model;
+
+/// The most momentum directions a run holds.
+pub const MAX_MOMENTA: usize = 12;
+
+/// Relative size below which a symmetry condition counts as met: `|r·e|`
+/// against `|r| |e|` for a constraint row `r`, `|Ψ_q·e|` and `|Q·e|`
+/// against `(|Ψ_q| + |Q|) |e|`.
+pub const TOLERANCE: f64 = 1e-9;
+
+/// A direction along which a model may keep its momentum: added by a
+/// mechanism builder (rigid translations) or declared by the user.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Direction {
+    /// What its momentum is called ("linear momentum x").
+    pub name: String,
+    /// Its non-zero entries: coordinate and weight.
+    pub entries: Vec<(u32, f64)>,
+    /// Declared by the user: reported when the model does not keep it.
+    pub declared: bool,
+}
+
+/// A momentum the system keeps, found when a run starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Momentum {
+    /// Its name: the direction's, or `momentum of sled.angle` for a cyclic
+    /// coordinate by its name (`momentum of coordinate i` for a model
+    /// without names).
+    pub name: String,
+    /// The direction `e`, one entry per coordinate.
+    pub direction: Vec<f64>,
+    /// The cyclic coordinate it is, if it is one.
+    pub coordinate: Option<usize>,
+    /// Declared by the user.
+    pub declared: bool,
+    /// `p = eᵀ M v` is linear in the state (`M e` constant): every explicit
+    /// scheme keeps it to round-off. Otherwise it drifts at the scheme's
+    /// truncation error, and the controls only do not add to that.
+    pub linear: bool,
+    /// `|e|_M |v₀|_M`: the largest `|p|` the initial kinetic energy allows,
+    /// the size against which round-off in `p` is judged.
+    pub scale: f64,
+}
+
+/// A declared direction whose momentum the model does not keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Broken {
+    /// The direction's name.
+    pub name: String,
+    /// What breaks it, in a few words ("constraint row 3", "a force").
+    pub reason: String,
+    /// The direction `e`, one entry per coordinate.
+    pub direction: Vec<f64>,
+}
+
+/// What [`detect`] found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Symmetries {
+    /// The momenta kept, linearly independent, declared ones first.
+    pub kept: Vec<Momentum>,
+    /// Declared directions the model breaks (not held).
+    pub broken: Vec<Broken>,
+}
+
+impl Symmetries {
+    /// None found.
+    pub const NONE: Symmetries = Symmetries { kept: Vec::new(), broken: Vec::new() };
+
+    /// The direction of momentum `j`: the kept ones, then the broken declared ones.
+    pub fn direction(&self, j: usize) -> &[f64] {
+        match self.kept.get(j) {
+            Some(m) => &m.direction,
+            None => &self.broken[j - self.kept.len()].direction,
+        }
+    }
+}
+
+/// A small deterministic generator for the sample states.
+struct Lcg(u64);
+
+impl Lcg {
+    /// Uniform in `[−1, 1)`.
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// Times at which the random samples are taken (time-dependent forces
+/// and drives are seen there).
+const SAMPLE_TIMES: [f64; 3] = [0.613, 1.37, 3.1];
+
+/// One evaluated sample state: its data the checks read.
+struct Sample {
+    /// `Φ_q` in the model's pattern order.
+    jac: Vec<f64>,
+    /// `Ψ_q = ∇V + ∂T/∂q`.
+    psi_q: Vec<f64>,
+    /// The non-conservative forces `Q`.
+    force: Vec<f64>,
+    /// `M e` for every candidate, to compare across samples.
+    mass_e: Vec<Vec<f64>>,
+    /// `M v`.
+    mass_v: Vec<f64>,
+}
+
+/// The consistent states the symmetry conditions are checked at: the
+/// initial one, and random ones around it projected onto `Φ = 0` and
+/// `Φ̇ = 0` (a sample whose projection fails is left out).
+fn sample_states(model: &Model, q0: &[f64], v0: &[f64]) -> Vec<(Vec<f64>, Vec<f64>, f64)> {
+    let mut states = vec![(q0.to_vec(), v0.to_vec(), 0.0)];
+    let mut d = Dynamics::new(model);
+    let mut work = crate::projection::Work::new(model);
+    let mut rng = Lcg(0x5eed_cafe);
+    let q_scale = 0.05 * (1.0 + q0.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
+    let v_scale = 0.5 * (1.0 + v0.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
+    for t in SAMPLE_TIMES {
+        let mut q: Vec<f64> = q0.iter().map(|x| x + q_scale * rng.next()).collect();
+        let mut v: Vec<f64> = v0.iter().map(|x| x + v_scale * rng.next()).collect();
+        if crate::projection::positions(model, &mut d, &mut q, &mut v, t, 1e-12, 30, &mut work).is_err() {
+            continue;
+        }
+        crate::projection::velocities(model, &d, &mut v, &mut work);
+        states.push((q, v, t));
+    }
+    states
+}
+
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// What breaks the symmetry along `e` (dense) at sample `s`, if anything.
+fn breaks(model: &Model, s: &Sample, e: &[f64]) -> Option<String> {
+    let size = norm(e);
+    let pattern = model.pattern();
+    for r in 0..model.m() {
+        let range = pattern.row(r);
+        let (jac, cols) = (&s.jac[range.clone()], &pattern.cols[range]);
+        let along: f64 = jac.iter().zip(cols).map(|(j, &c)| j * e[c as usize]).sum();
+        if along.abs() > TOLERANCE * norm(jac) * size {
+            return Some(format!("constraint row {r}"));
+        }
+    }
+    let scale = TOLERANCE * (norm(&s.psi_q) + norm(&s.force)) * size;
+    if dot(&s.psi_q, e).abs() > scale {
+        return Some("the potential or kinetic energy".into());
+    }
+    if dot(&s.force, e).abs() > scale {
+        return Some("a force".into());
+    }
+    None
+}
+
+/// Finds the momenta `model` keeps: its declared and mechanism directions
+/// and every single coordinate (a cyclic one), checked at the initial state
+/// `(q0, v0)` and at random consistent states around it. A direction that
+/// one constraint row, the energy or a force breaks at any sample is not
+/// kept; the kept ones are made linearly independent in the metric `M`
+/// (a coordinate that is also a translation is named once).
+pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
+    let n = model.n();
+    let mut candidates: Vec<(Direction, Option<usize>)> =
+        model.momentum_directions().iter().map(|d| (d.clone(), None)).collect();
+    candidates.sort_by_key(|(d, _)| !d.declared);
+    let names = model.coordinate_names();
+    candidates.extend((0..n).map(|i| {
+        let name = match names {
+            Some(names) => format!("momentum of {}", names[i]),
+            None => format!("momentum of coordinate {i}"),
+        };
+        (Direction { name, entries: vec![(i as u32, 1.0)], declared: false }, Some(i))
+    }));
+    let dense: Vec<Vec<f64>> = candidates
+        .iter()
+        .map(|(d, _)| {
+            let mut e = vec![0.0; n];
+            d.entries.iter().for_each(|&(c, w)| e[c as usize] += w);
+            e
+        })
+        .collect();
+    let mut d = Dynamics::new(model);
+    let mut samples = Vec::new();
+    for (q, v, t) in sample_states(model, q0, v0) {
+        if d.evaluate(model, &q, &v, t).is_err() {
+            continue;
+        }
+        let mut force = vec![0.0; n];
+        model.add_forces(&q, &v, t, &mut force);
+        let mass = d.mass(model);
+        let mass_e = dense
+            .iter()
+            .map(|e| {
+                let mut out = vec![0.0; n];
+                mass.mul(e, &mut out);
+                out
+            })
+            .collect();
+        let mut mass_v = vec![0.0; n];
+        mass.mul(&v, &mut mass_v);
+        samples.push(Sample { jac: d.jac().to_vec(), psi_q: d.psi_q().to_vec(), force, mass_e, mass_v });
+    }
+    let mut found = Symmetries::default();
+    let Some(first) = samples.first() else { return found };
+    // A coordinate breaks when its column of Φ_q is not negligible in some
+    // row: found for all coordinates in one pass over the pattern.
+    let pattern = model.pattern();
+    let mut column_used = vec![false; n];
+    for s in &samples {
+        for r in 0..model.m() {
+            let range = pattern.row(r);
+            let jac = &s.jac[range.clone()];
+            let limit = TOLERANCE * norm(jac);
+            for (j, &c) in jac.iter().zip(&pattern.cols[range]) {
+                column_used[c as usize] |= j.abs() > limit;
+            }
+        }
+    }
+    // The kept directions, with `M e` at the first sample, made independent
+    // by Gram–Schmidt in the metric `M`.
+    let mut basis: Vec<Vec<f64>> = Vec::new();
+    for (k, ((direction, coordinate), e)) in candidates.into_iter().zip(&dense).enumerate() {
+        let reason = match coordinate {
+            Some(i) if column_used[i] => Some(format!("constraint row reading coordinate {i}")),
+            _ => samples.iter().find_map(|s| breaks(model, s, e)),
+        };
+        if let Some(reason) = reason {
+            if direction.declared {
+                found.broken.push(Broken { name: direction.name, reason, direction: e.clone() });
+            }
+            continue;
+        }
+        let mut residual_m = first.mass_e[k].clone();
+        let mut residual = e.clone();
+        for b in &basis {
+            // b is stored as (e_b, M e_b) normalized in the metric.
+            let (be, bm) = b.split_at(n);
+            let c = dot(be, &residual_m);
+            residual.iter_mut().zip(be).for_each(|(r, x)| *r -= c * x);
+            residual_m.iter_mut().zip(bm).for_each(|(r, x)| *r -= c * x);
+        }
+        let size = dot(e, &first.mass_e[k]);
+        let left = dot(&residual, &residual_m);
+        if !(left > 1e-16 * size) || found.kept.len() == MAX_MOMENTA {
+            continue;
+        }
+        let scale = left.sqrt();
+        basis.push(residual.iter().chain(&residual_m).map(|x| x / scale).collect());
+        let scale = (size * dot(v0, &first.mass_v)).max(0.0).sqrt();
+        let linear = samples.iter().all(|s| {
+            let tolerance = 1e-12 * norm(&first.mass_e[k]);
+            s.mass_e[k].iter().zip(&first.mass_e[k]).all(|(a, b)| (a - b).abs() <= tolerance)
+        });
+        found.kept.push(Momentum {
+            name: direction.name,
+            direction: e.clone(),
+            coordinate,
+            declared: direction.declared,
+            linear,
+            scale,
+        });
+    }
+    found
+}
+
+/// `p = eᵀ M(q) v` for a dense direction `e`: exact for a constant `M`;
+/// otherwise `(T(q, v + s e) − T(q, v − s e)) / 2s`, exact for a quadratic
+/// `T`, with `s = |v|_M / |e|_M` so both terms are of the size of `T`.
+/// `work` has `n` entries.
+pub fn value(model: &Model, q: &[f64], v: &[f64], e: &[f64], work: &mut [f64]) -> f64 {
+    if let Some(mass) = model.mass() {
+        return mass.diagonal().iter().zip(e).zip(v).map(|((m, e), v)| m * e * v).sum();
+    }
+    let (tv, te) = (model.kinetic(q, v), model.kinetic(q, e));
+    if te == 0.0 {
+        return 0.0;
+    }
+    let s = if tv > 0.0 { (tv / te).sqrt() } else { 1.0 };
+    let mut at = |sign: f64| {
+        work.iter_mut().zip(v).zip(e).for_each(|((w, v), e)| *w = v + sign * s * e);
+        model.kinetic(q, work)
+    };
+    (at(1.0) - at(-1.0)) / (2.0 * s)
+}
+
+/// The kept momentum directions at run time: `E`, `M E` at the latest
+/// evaluation and the inverse of `EᵀME`, so that a correction is made
+/// M-orthogonal to them with `k` dot products and `k` updates.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Momenta {
+    /// `k × n`: the directions, row by row.
+    e: Vec<f64>,
+    /// `k × n`: `M e_j`.
+    mass_e: Vec<f64>,
+    /// `k × k`: `(EᵀME)⁻¹`.
+    gram_inverse: Vec<f64>,
+    /// `M e` is the same at every state: set once.
+    constant: bool,
+    /// `M E` has been formed.
+    ready: bool,
+    n: usize,
+}
+
+impl Momenta {
+    /// No directions: every operation is a no-op.
+    pub(crate) const NONE: Momenta =
+        Momenta { e: Vec::new(), mass_e: Vec::new(), gram_inverse: Vec::new(), constant: true, ready: true, n: 0 };
+
+    /// The directions of `kept`, for a model of `n` coordinates; `M e` is
+    /// set by [`update`](Self::update).
+    pub(crate) fn new(kept: &[Momentum], n: usize, constant: bool) -> Self {
+        let k = kept.len();
+        Self {
+            e: kept.iter().flat_map(|m| m.direction.iter().copied()).collect(),
+            mass_e: vec![0.0; k * n],
+            gram_inverse: vec![0.0; k * k],
+            constant,
+            ready: k == 0,
+            n,
+        }
+    }
+
+    /// Number of directions.
+    #[inline(always)]
+    pub(crate) fn len(&self) -> usize {
+        self.gram_inverse.len().isqrt()
+    }
+
+    /// Whether there are none.
+    #[inline(always)]
+    pub(crate) fn is_empty(&self) -> bool {
+        self.gram_inverse.is_empty()
+    }
+
+    /// Whether `M E` must be formed (again) at the current state.
+    #[inline(always)]
+    pub(crate) fn stale(&self) -> bool {
+        !self.is_empty() && (!self.ready || !self.constant)
+    }
+
+    /// `M E` and `(EᵀME)⁻¹` from the mass matrix at the current state.
+    pub(crate) fn update(&mut self, mass: &impl MassMatrix) {
+        let (k, n) = (self.len(), self.n);
+        for j in 0..k {
+            mass.mul(&self.e[j * n..(j + 1) * n], &mut self.mass_e[j * n..(j + 1) * n]);
+        }
+        let mut gram = [0.0; MAX_MOMENTA * MAX_MOMENTA];
+        for a in 0..k {
+            for b in 0..k {
+                gram[a * k + b] = dot(&self.e[a * n..(a + 1) * n], &self.mass_e[b * n..(b + 1) * n]);
+            }
+        }
+        invert(&mut gram[..k * k], k, &mut self.gram_inverse);
+        self.ready = true;
+    }
+
+    /// `a = (EᵀME)⁻¹ Eᵀ M x`: the coefficients of `x`'s part along the
+    /// momentum directions.
+    #[inline]
+    pub(crate) fn coefficients(&self, x: &[f64]) -> [f64; MAX_MOMENTA] {
+        let (k, n) = (self.len(), self.n);
+        let mut p = [0.0; MAX_MOMENTA];
+        for j in 0..k {
+            p[j] = dot(&self.mass_e[j * n..(j + 1) * n], x);
+        }
+        let mut a = [0.0; MAX_MOMENTA];
+        for i in 0..k {
+            a[i] = (0..k).map(|j| self.gram_inverse[i * k + j] * p[j]).sum();
+        }
+        a
+    }
+
+    /// `out += scale · E a`.
+    #[inline]
+    pub(crate) fn add_directions(&self, a: &[f64; MAX_MOMENTA], scale: f64, out: &mut [f64]) {
+        let n = self.n;
+        for (j, &aj) in a.iter().enumerate().take(self.len()) {
+            let s = scale * aj;
+            out.iter_mut().zip(&self.e[j * n..(j + 1) * n]).for_each(|(o, e)| *o += s * e);
+        }
+    }
+
+    /// `x ← P_E x = x − E (EᵀME)⁻¹ EᵀM x`: no part left along any momentum
+    /// direction in the metric `M`.
+    #[inline]
+    pub(crate) fn project(&self, x: &mut [f64]) {
+        if self.is_empty() {
+            return;
+        }
+        let a = self.coefficients(x);
+        self.add_directions(&a, -1.0, x);
+    }
+
+    /// `x`'s coefficients `a` along the momentum directions and the part
+    /// of `|x|²_M` along them, `(EᵀMx)ᵀ (EᵀME)⁻¹ (EᵀMx) = aᵀ EᵀMx`.
+    #[inline]
+    pub(crate) fn split(&self, x: &[f64]) -> ([f64; MAX_MOMENTA], f64) {
+        if self.is_empty() {
+            return ([0.0; MAX_MOMENTA], 0.0);
+        }
+        let a = self.coefficients(x);
+        let n = self.n;
+        (a, (0..self.len()).map(|j| a[j] * dot(&self.mass_e[j * n..(j + 1) * n], x)).sum())
+    }
+}
+
+/// `out = a⁻¹` for a symmetric positive definite `k × k` matrix `a`
+/// (overwritten), by Gauss–Jordan elimination; `k` is small.
+fn invert(a: &mut [f64], k: usize, out: &mut [f64]) {
+    out.fill(0.0);
+    for i in 0..k {
+        out[i * k + i] = 1.0;
+    }
+    for c in 0..k {
+        let pivot = a[c * k + c];
+        for j in 0..k {
+            a[c * k + j] /= pivot;
+            out[c * k + j] /= pivot;
+        }
+        for r in (0..k).filter(|&r| r != c) {
+            let f = a[r * k + c];
+            if f != 0.0 {
+                for j in 0..k {
+                    a[r * k + j] -= f * a[c * k + j];
+                    out[r * k + j] -= f * out[c * k + j];
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_inverse_of_a_small_gram_matrix() {
+        let mut a = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0];
+        let original = a;
+        let mut inv = [0.0; 9];
+        invert(&mut a, 3, &mut inv);
+        for i in 0..3 {
+            for j in 0..3 {
+                let x: f64 = (0..3).map(|l| original[i * 3 + l] * inv[l * 3 + j]).sum();
+                assert!((x - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14);
+            }
+        }
+    }
+}
