@@ -116,6 +116,7 @@ pub fn table(cases: &[CaseResult]) -> String {
             c.error.as_ref().map_or(String::new(), |e| format!("  FAILED: {e}")),
         );
     }
+    out += &momenta_lines(cases);
     for c in cases {
         if let Some(t) = c.tuning.filter(|t| t.energy_left_out) {
             let projected = c.control.is_some_and(|c| c.projection.is_some());
@@ -126,6 +127,40 @@ pub fn table(cases: &[CaseResult]) -> String {
                 t.dissipation_h,
                 cdyn::gains::STIFF_DISSIPATION_H
             );
+        }
+    }
+    out
+}
+
+/// What the momenta did: the ones the system keeps (from the first case
+/// that has any), a note for each case that lost one which the scheme keeps
+/// to round-off, and a warning for each declared one the model breaks.
+fn momenta_lines(cases: &[CaseResult]) -> String {
+    let mut out = String::new();
+    if let Some(c) = cases.iter().find(|c| c.record.momenta.iter().any(|m| m.kept)) {
+        let kept: Vec<&str> = c.record.momenta.iter().filter(|m| m.kept).map(|m| m.name.as_str()).collect();
+        out += &format!("keeps: {}\n", kept.join(", "));
+    }
+    for c in cases {
+        for m in &c.record.momenta {
+            if !m.kept {
+                out += &format!(
+                    "warning: {}: the declared {} is not kept by the model ({} breaks it), so it is not held: it drifted by {:.3e}\n",
+                    c.name,
+                    m.name,
+                    m.reason.as_deref().unwrap_or("something"),
+                    m.max_drift
+                );
+            } else if m.linear && m.max_drift > cdyn::momentum::ROUND_OFF * m.scale {
+                out += &format!(
+                    "note: {}: {} drifted by {:.3e}, above round-off ({:.1e} of its scale {:.3e})\n",
+                    c.name,
+                    m.name,
+                    m.max_drift,
+                    cdyn::momentum::ROUND_OFF,
+                    m.scale
+                );
+            }
         }
     }
     out

@@ -36,10 +36,53 @@ pub struct Scenario {
     pub forces: Vec<Element<String>>,
     /// Axes of a parameter sweep (`cdyn sweep`): key → values.
     pub sweep: Option<toml::Table>,
+    /// Momenta the model is declared to keep (`[[invariants]]`): checked
+    /// and held like those a run finds, reported where the model breaks them.
+    #[serde(default)]
+    pub invariants: Vec<InvariantSpec>,
     /// The `[[bodies]]` and `[[joints]]` of a spatial mechanism (`kind =
     /// "spatial"`), read by the spatial types instead of the planar ones.
     #[serde(skip)]
     pub spatial: Option<SpatialEntries>,
+}
+
+/// A declared invariant: `kind = "momentum"` with an `axis` (every body
+/// translated along it), or `kind = "coordinate"` with the `coordinate`'s
+/// name (its generalized momentum); `name` names it in the output.
+#[derive(Debug, Deserialize, Clone)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum InvariantSpec {
+    Momentum { axis: Vec<f64>, name: Option<String> },
+    Coordinate { coordinate: String, name: Option<String> },
+}
+
+impl InvariantSpec {
+    /// Its name and direction on `example`'s coordinates.
+    fn direction(&self, example: &Example) -> std::result::Result<(String, Vec<(usize, f64)>), String> {
+        let names = example.model.coordinate_names().ok_or("needs a mechanism, whose coordinates have names")?;
+        match self {
+            InvariantSpec::Momentum { axis, name } => {
+                let suffixes: &[&str] = if example.sketch.is_some() { &[".x", ".y", ".z"] } else { &[".x", ".y"] };
+                if axis.len() != suffixes.len() || axis.iter().any(|a| !a.is_finite()) || axis.iter().all(|a| *a == 0.0)
+                {
+                    return Err(format!("axis = {axis:?}: must be {} finite numbers, not all zero", suffixes.len()));
+                }
+                let direction = names
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, n)| suffixes.iter().position(|s| n.ends_with(s)).map(|k| (i, axis[k])))
+                    .filter(|(_, w)| *w != 0.0)
+                    .collect();
+                Ok((name.clone().unwrap_or_else(|| format!("linear momentum along {axis:?}")), direction))
+            }
+            InvariantSpec::Coordinate { coordinate, name } => {
+                let i = names.iter().position(|n| n == coordinate).ok_or_else(|| {
+                    format!("coordinate = \"{coordinate}\": no such coordinate (they are {})", names.join(", "))
+                })?;
+                Ok((name.clone().unwrap_or_else(|| format!("momentum of {coordinate}")), vec![(i, 1.0)]))
+            }
+        }
+    }
 }
 
 /// A spatial mechanism's entries, bodies named by the joints.
@@ -344,6 +387,11 @@ impl Scenario {
             settings.consistency_tolerance = None;
         }
         let (mut example, rows) = self.example(file)?;
+        for (k, spec) in self.invariants.iter().enumerate() {
+            let at = |e: String| anyhow!("{file}: invariants[{k}]: {e}");
+            let (name, direction) = spec.direction(&example).map_err(at)?;
+            example.model.declare_momentum(&name, &direction).map_err(|e| at(e.to_string()))?;
+        }
         for (key, given, default) in [("q", &init.q, &mut example.q0), ("v", &init.v, &mut example.v0)] {
             if let Some(given) = given {
                 if given.len() != default.len() {

@@ -131,25 +131,11 @@ impl ModelBuilder {
     }
 
     fn momentum_direction(mut self, name: &str, direction: &[(usize, f64)], declared: bool) -> Self {
-        if self.error.is_some() {
-            return self;
-        }
-        let n = self.mass.len();
-        let what = Part::Block { what: "a momentum" };
-        if let Some(&(index, _)) = direction.iter().find(|(i, _)| *i >= n) {
-            self.error = Some(Problem::NoSuchCoordinate { index, n }.at(what));
-        } else if let Some(&(_, w)) = direction.iter().find(|(_, w)| !w.is_finite()) {
-            self.error =
-                Some(Error::InvalidParameter { name: "momentum direction", value: w, reason: "must be finite" });
-        } else if direction.iter().all(|(_, w)| *w == 0.0) {
-            self.error = Some(Error::InvalidParameter {
-                name: "momentum direction",
-                value: 0.0,
-                reason: "must have a non-zero entry",
-            });
-        } else {
-            let entries = direction.iter().map(|&(i, w)| (i as u32, w)).collect();
-            self.momenta.push(Direction { name: name.to_string(), entries, declared });
+        if self.error.is_none() {
+            match checked_direction(name, direction, declared, self.mass.len()) {
+                Ok(d) => self.momenta.push(d),
+                Err(e) => self.error = Some(e),
+            }
         }
         self
     }
@@ -316,6 +302,23 @@ fn block_layout(mass: &[f64], kinetic: &[Box<dyn KineticBlock>], pattern: &Patte
     Some(blocks)
 }
 
+/// A momentum direction on `n` coordinates, checked: coordinates that
+/// exist, finite weights, not all zero.
+fn checked_direction(name: &str, direction: &[(usize, f64)], declared: bool, n: usize) -> Result<Direction> {
+    if let Some(&(index, _)) = direction.iter().find(|(i, _)| *i >= n) {
+        return Err(Problem::NoSuchCoordinate { index, n }.at(Part::Block { what: "a momentum" }));
+    }
+    let bad = |value, reason| Err(Error::InvalidParameter { name: "momentum direction", value, reason });
+    if let Some(&(_, w)) = direction.iter().find(|(_, w)| !w.is_finite()) {
+        return bad(w, "must be finite");
+    }
+    if direction.iter().all(|(_, w)| *w == 0.0) {
+        return bad(0.0, "must have a non-zero entry");
+    }
+    let entries = direction.iter().map(|&(i, w)| (i as u32, w)).collect();
+    Ok(Direction { name: name.to_string(), entries, declared })
+}
+
 /// Checks there are no more constraint rows `m` than coordinates `n`
 /// (`m = n` is allowed: a fully driven, kinematic mechanism).
 pub(crate) fn check_rows(m: usize, n: usize) -> Result<()> {
@@ -339,6 +342,13 @@ impl Model {
             names: None,
             error: None,
         }
+    }
+
+    /// Declares, on a built model, that it keeps the momentum along
+    /// `direction` (as [`ModelBuilder::momentum`]).
+    pub fn declare_momentum(&mut self, name: &str, direction: &[(usize, f64)]) -> Result<()> {
+        self.momenta.push(checked_direction(name, direction, true, self.n())?);
+        Ok(())
     }
 
     /// The coordinates' names, where the builder gave them.

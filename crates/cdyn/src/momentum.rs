@@ -35,6 +35,10 @@ pub const MAX_MOMENTA: usize = 12;
 /// against `(|Ψ_q| + |Q|) |e|`.
 pub const TOLERANCE: f64 = 1e-9;
 
+/// How far a linear momentum may drift, relative to its [`Momentum::scale`],
+/// and still count as kept to round-off: `10³ ε`.
+pub const ROUND_OFF: f64 = 1e3 * f64::EPSILON;
+
 /// A direction along which a model may keep its momentum: added by a
 /// mechanism builder (rigid translations) or declared by the user.
 #[derive(Debug, Clone, PartialEq)]
