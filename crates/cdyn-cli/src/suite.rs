@@ -37,7 +37,7 @@ const LIGHT: [&str; 4] = ["example1", "pendulum_rest", "mixed_masses", "slider_c
 const LIGHT_T_END: f64 = 0.5;
 
 /// The checks, by letter, as the summary states them.
-pub const CHECKS: [(&str, &str); 4] = [
+pub const CHECKS: [(&str, &str); 6] = [
     ("a", "robust error <= 2 x projection error"),
     ("b", "robust error <= none error, where projection error <= none error"),
     ("c", "robust error <= none error / 10, where none error > 1e-4"),
@@ -45,6 +45,8 @@ pub const CHECKS: [(&str, &str); 4] = [
         "d",
         "robust max|phi|, max|psi| <= none's / 10, where none's > 1e-8 (psi: where some motion is free and robust's energy term is on)",
     ),
+    ("e", "every method keeps each linear momentum the model keeps to 1e3 eps of its scale"),
+    ("f", "robust's momentum drift <= none's (or round-off), where the model keeps a momentum"),
 ];
 
 /// The shipped suite, `examples/suite` of the source tree the binary was built from.
@@ -106,6 +108,13 @@ pub struct Run {
     /// The tolerance of its projection, if it projects.
     #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub projection_tolerance: Option<f64>,
+    /// Largest drift of a kept momentum linear in the state, over its
+    /// scale (`None` where the model keeps none).
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub linear_momentum_drift: Option<f64>,
+    /// Largest drift of any kept momentum over its scale (`None` where the model keeps none).
+    #[serde(serialize_with = "cdyn::json_float::serialize")]
+    pub momentum_drift: Option<f64>,
     /// Why it stopped, if it did.
     pub error: Option<String>,
 }
@@ -256,7 +265,7 @@ fn run_model(model: &Model) -> Result<Vec<Group>> {
             reference_h: model.h / REFERENCE_DIVISOR as f64,
             baseline: cases[none].name.clone(),
             free_motion,
-            verdicts: verdicts(&runs[none], &runs[robust], &runs[projection], free_motion),
+            verdicts: verdicts(&runs, none, robust, projection, free_motion),
             runs,
         });
     }
@@ -301,6 +310,8 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
         energy_left_out: false,
         projection_iterations_per_step: None,
         projection_tolerance: projection.map(|p| p.tolerance),
+        linear_momentum_drift: None,
+        momentum_drift: None,
         error: None,
     };
     let ex = &case.example;
@@ -316,6 +327,9 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
     let m = sim.measure();
     run.initial = vec![m.phi.abs(), m.phi_dot, m.psi.abs()];
     let mut error = distance(sim.q(), &reference[0]);
+    let kept = sim.symmetries().kept.clone();
+    let p0: Vec<f64> = (0..kept.len()).map(|j| sim.momentum(j)).collect();
+    let mut drift = vec![0.0_f64; kept.len()];
     // Whole steps were checked when the case was made.
     let steps = steps_to(case.t_end, case.settings.h).unwrap_or(0);
     while sim.steps() < steps {
@@ -332,7 +346,15 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
         if sim.steps().is_multiple_of(every) {
             error = error.max(distance(sim.q(), &reference[(sim.steps() / every) as usize]));
         }
+        for j in 0..kept.len() {
+            drift[j] = drift[j].max((sim.momentum(j) - p0[j]).abs() / kept[j].scale.max(f64::MIN_POSITIVE));
+        }
     }
+    let largest = |linear_only: bool| {
+        let mut d = kept.iter().zip(&drift).filter(|(k, _)| k.linear || !linear_only).map(|(_, d)| *d).peekable();
+        d.peek().is_some().then(|| d.fold(0.0, f64::max))
+    };
+    (run.linear_momentum_drift, run.momentum_drift) = (largest(true), largest(false));
     run.steps = sim.steps();
     if run.error.is_none() {
         run.max_error = error;
@@ -345,7 +367,8 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
 
 /// The checks of [`CHECKS`] on one group. A robust run that stopped fails
 /// every check that applies.
-fn verdicts(none: &Run, robust: &Run, projection: &Run, free_motion: bool) -> Vec<Verdict> {
+fn verdicts(runs: &[Run], none: usize, robust: usize, projection: usize, free_motion: bool) -> Vec<Verdict> {
+    let (none, robust, projection) = (&runs[none], &runs[robust], &runs[projection]);
     let ok = robust.error.is_none();
     let (r, n, p) = (robust.max_error, none.max_error, projection.max_error);
     let verdict =
@@ -366,6 +389,22 @@ fn verdicts(none: &Run, robust: &Run, projection: &Run, free_motion: bool) -> Ve
                 robust.max_abs_phi, none.max_abs_phi, robust.max_abs_psi, none.max_abs_psi
             ),
         ),
+        {
+            let worst =
+                runs.iter().filter(|r| r.error.is_none()).filter_map(|r| r.linear_momentum_drift.map(|d| (d, r)));
+            let worst = worst.max_by(|a, b| a.0.total_cmp(&b.0));
+            let numbers = worst.map_or(String::new(), |(d, r)| format!("largest {d:.3e} of its scale ({})", r.method));
+            let applies = none.linear_momentum_drift.is_some();
+            verdict(applies, worst.is_none_or(|(d, _)| d <= cdyn::momentum::ROUND_OFF), numbers)
+        },
+        match (robust.momentum_drift, none.momentum_drift) {
+            (Some(r), Some(n)) => verdict(
+                true,
+                r <= n.max(cdyn::momentum::ROUND_OFF),
+                format!("robust {r:.3e}, none {n:.3e} of the scale"),
+            ),
+            _ => verdict(false, true, String::new()),
+        },
     ]
 }
 

@@ -156,7 +156,10 @@ fn every_correction_is_m_orthogonal_to_the_momenta_at_random_states() {
                 if free {
                     worst_free = worst_free.max(pq.abs().max(pv.abs()) / size);
                 } else {
-                    assert!(pq.abs() <= 1e-14 * size && pv.abs() <= 1e-14 * size, "{name}: {pq:.3e} {pv:.3e} of {size:.3e}");
+                    assert!(
+                        pq.abs() <= 1e-14 * size && pv.abs() <= 1e-14 * size,
+                        "{name}: {pq:.3e} {pv:.3e} of {size:.3e}"
+                    );
                 }
             }
             // The test could fail: the laws as written do move the momentum

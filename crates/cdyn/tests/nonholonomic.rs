@@ -338,8 +338,8 @@ fn sleds_keep_their_heading_rate_under_every_control() {
         let (t_end, h) = (50.0, 1e-2);
         let heading = |control: Control| {
             let b = m.build().unwrap();
-            let mut sim = Simulation::new(&b.model, Settings::new(Scheme::AdamsBashforth3, h, control), &b.q0, &b.v0)
-                .unwrap();
+            let mut sim =
+                Simulation::new(&b.model, Settings::new(Scheme::AdamsBashforth3, h, control), &b.q0, &b.v0).unwrap();
             assert!(sim.symmetries().kept.iter().any(|p| p.name == "momentum of sled.angle"), "sled {k}");
             for _ in 0..(t_end / h).round() as u64 {
                 sim.step().unwrap();
