@@ -276,7 +276,7 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         }
         let size = dot(e, &first.mass_e[k]);
         let left = dot(&residual, &residual_m);
-        if !(left > 1e-16 * size) || found.kept.len() == MAX_MOMENTA {
+        if left.is_nan() || left <= 1e-16 * size || found.kept.len() == MAX_MOMENTA {
             continue;
         }
         let scale = left.sqrt();
