@@ -123,16 +123,16 @@ const SAMPLE_TIMES: [f64; 3] = [0.613, 1.37, 3.1];
 
 /// One evaluated sample state: its data the checks read.
 struct Sample {
+    /// The state.
+    q: Vec<f64>,
+    v: Vec<f64>,
+    t: f64,
     /// `Φ_q` in the model's pattern order.
     jac: Vec<f64>,
     /// `Ψ_q = ∇V + ∂T/∂q`.
     psi_q: Vec<f64>,
     /// The non-conservative forces `Q`.
     force: Vec<f64>,
-    /// `M e` for every candidate, to compare across samples.
-    mass_e: Vec<Vec<f64>>,
-    /// `M v`.
-    mass_v: Vec<f64>,
 }
 
 /// The consistent states the symmetry conditions are checked at: the
@@ -192,28 +192,14 @@ fn breaks(model: &Model, s: &Sample, e: &[f64]) -> Option<String> {
 /// `(q0, v0)` and at random consistent states around it. A direction that
 /// one constraint row, the energy or a force breaks at any sample is not
 /// kept; the kept ones are made linearly independent in the metric `M`
-/// (a coordinate that is also a translation is named once).
+/// (a coordinate that is also a translation is named once), at most
+/// [`MAX_MOMENTA`]. Memory and work are linear in the model's size: a
+/// coordinate is checked from its column, and only a direction that passes
+/// is formed densely.
 pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
     let n = model.n();
-    let mut candidates: Vec<(Direction, Option<usize>)> =
-        model.momentum_directions().iter().map(|d| (d.clone(), None)).collect();
-    candidates.sort_by_key(|(d, _)| !d.declared);
-    let names = model.coordinate_names();
-    candidates.extend((0..n).map(|i| {
-        let name = match names {
-            Some(names) => format!("momentum of {}", names[i]),
-            None => format!("momentum of coordinate {i}"),
-        };
-        (Direction { name, entries: vec![(i as u32, 1.0)], declared: false }, Some(i))
-    }));
-    let dense: Vec<Vec<f64>> = candidates
-        .iter()
-        .map(|(d, _)| {
-            let mut e = vec![0.0; n];
-            d.entries.iter().for_each(|&(c, w)| e[c as usize] += w);
-            e
-        })
-        .collect();
+    let mut named: Vec<Direction> = model.momentum_directions().to_vec();
+    named.sort_by_key(|d| !d.declared);
     let mut d = Dynamics::new(model);
     let mut samples = Vec::new();
     for (q, v, t) in sample_states(model, q0, v0) {
@@ -222,77 +208,102 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         }
         let mut force = vec![0.0; n];
         model.add_forces(&q, &v, t, &mut force);
-        let mass = d.mass(model);
-        let mass_e = dense
-            .iter()
-            .map(|e| {
-                let mut out = vec![0.0; n];
-                mass.mul(e, &mut out);
-                out
-            })
-            .collect();
-        let mut mass_v = vec![0.0; n];
-        mass.mul(&v, &mut mass_v);
-        samples.push(Sample { jac: d.jac().to_vec(), psi_q: d.psi_q().to_vec(), force, mass_e, mass_v });
+        samples.push(Sample { jac: d.jac().to_vec(), psi_q: d.psi_q().to_vec(), force, q, v, t });
     }
     let mut found = Symmetries::default();
-    let Some(first) = samples.first() else { return found };
+    if samples.is_empty() {
+        return found;
+    }
     // A coordinate breaks when its column of Φ_q is not negligible in some
-    // row: found for all coordinates in one pass over the pattern.
+    // row, or the energy or a force acts on it: found for all coordinates
+    // in one pass over each sample.
     let pattern = model.pattern();
-    let mut column_used = vec![false; n];
+    let mut coordinate_broken: Vec<Option<String>> = vec![None; n];
     for s in &samples {
         for r in 0..model.m() {
             let range = pattern.row(r);
             let jac = &s.jac[range.clone()];
             let limit = TOLERANCE * norm(jac);
             for (j, &c) in jac.iter().zip(&pattern.cols[range]) {
-                column_used[c as usize] |= j.abs() > limit;
+                if j.abs() > limit && coordinate_broken[c as usize].is_none() {
+                    coordinate_broken[c as usize] = Some(format!("constraint row {r}"));
+                }
+            }
+        }
+        let scale = TOLERANCE * (norm(&s.psi_q) + norm(&s.force));
+        for i in 0..n {
+            if coordinate_broken[i].is_none() && (s.psi_q[i].abs() > scale || s.force[i].abs() > scale) {
+                coordinate_broken[i] = Some("the energy or a force".into());
             }
         }
     }
-    // The kept directions, with `M e` at the first sample, made independent
-    // by Gram–Schmidt in the metric `M`.
-    let mut basis: Vec<Vec<f64>> = Vec::new();
-    for (k, ((direction, coordinate), e)) in candidates.into_iter().zip(&dense).enumerate() {
-        let reason = match coordinate {
-            Some(i) if column_used[i] => Some(format!("constraint row reading coordinate {i}")),
-            _ => samples.iter().find_map(|s| breaks(model, s, e)),
+    let names = model.coordinate_names();
+    let coordinates = (0..n).filter(|&i| coordinate_broken[i].is_none()).map(|i| {
+        let name = match names {
+            Some(names) => format!("momentum of {}", names[i]),
+            None => format!("momentum of coordinate {i}"),
         };
-        if let Some(reason) = reason {
+        (Direction { name, entries: vec![(i as u32, 1.0)], declared: false }, Some(i))
+    });
+    let candidates = named.into_iter().map(|d| (d, None)).chain(coordinates);
+    // The kept directions, made independent by Gram–Schmidt in the metric
+    // `M` at the first sample: each basis vector stored as (e_b, M e_b),
+    // normalized.
+    let mut basis: Vec<Vec<f64>> = Vec::new();
+    for (direction, coordinate) in candidates {
+        let mut e = vec![0.0; n];
+        direction.entries.iter().for_each(|&(c, w)| e[c as usize] += w);
+        if coordinate.is_none()
+            && let Some(reason) = samples.iter().find_map(|s| breaks(model, s, &e))
+        {
             if direction.declared {
-                found.broken.push(Broken { name: direction.name, reason, direction: e.clone() });
+                found.broken.push(Broken { name: direction.name, reason, direction: e });
             }
             continue;
         }
-        let mut residual_m = first.mass_e[k].clone();
+        if found.kept.len() == MAX_MOMENTA {
+            continue;
+        }
+        // `M e` and `M v` at every sample.
+        let mut mass_e = Vec::with_capacity(samples.len());
+        let mut mass_v = vec![0.0; n];
+        for (k, s) in samples.iter().enumerate() {
+            if d.evaluate(model, &s.q, &s.v, s.t).is_err() {
+                continue;
+            }
+            let mass = d.mass(model);
+            let mut out = vec![0.0; n];
+            mass.mul(&e, &mut out);
+            mass_e.push(out);
+            if k == 0 {
+                mass.mul(v0, &mut mass_v);
+            }
+        }
+        let Some(first) = mass_e.first() else { continue };
+        let mut residual_m = first.clone();
         let mut residual = e.clone();
         for b in &basis {
-            // b is stored as (e_b, M e_b) normalized in the metric.
             let (be, bm) = b.split_at(n);
             let c = dot(be, &residual_m);
             residual.iter_mut().zip(be).for_each(|(r, x)| *r -= c * x);
             residual_m.iter_mut().zip(bm).for_each(|(r, x)| *r -= c * x);
         }
-        let size = dot(e, &first.mass_e[k]);
+        let size = dot(&e, first);
         let left = dot(&residual, &residual_m);
-        if left.is_nan() || left <= 1e-16 * size || found.kept.len() == MAX_MOMENTA {
+        if left.is_nan() || left <= 1e-16 * size {
             continue;
         }
         let scale = left.sqrt();
         basis.push(residual.iter().chain(&residual_m).map(|x| x / scale).collect());
-        let scale = (size * dot(v0, &first.mass_v)).max(0.0).sqrt();
-        let linear = samples.iter().all(|s| {
-            let tolerance = 1e-12 * norm(&first.mass_e[k]);
-            s.mass_e[k].iter().zip(&first.mass_e[k]).all(|(a, b)| (a - b).abs() <= tolerance)
-        });
+        let tolerance = 1e-12 * norm(first);
+        let linear = mass_e.iter().all(|m| m.iter().zip(first).all(|(a, b)| (a - b).abs() <= tolerance));
         found.kept.push(Momentum {
             name: direction.name,
-            direction: e.clone(),
             coordinate,
             declared: direction.declared,
             linear,
-            scale,
+            scale: (size * dot(v0, &mass_v)).max(0.0).sqrt(),
+            direction: e,
         });
     }
     found
