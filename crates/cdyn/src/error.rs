@@ -248,6 +248,9 @@ pub enum Problem {
         /// Coordinates of the model.
         n: usize,
     },
+    /// A rotation whose angular momentum is declared does not fit the model.
+    #[error("{0}")]
+    Rotation(String),
     /// An element reads one coordinate twice.
     #[error("reads coordinate {index} twice")]
     CoordinateTwice {

@@ -17,6 +17,7 @@ macro_rules! with_const {
 }
 pub(crate) use with_const;
 
+pub mod angular;
 pub mod assemble;
 #[doc(hidden)] // for benchmarks only; see its module head
 pub mod baseline;

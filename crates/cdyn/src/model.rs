@@ -2,6 +2,7 @@
 //! diagonal, or from kinetic-energy elements: see [`crate::mass`]),
 //! holonomic constraint elements, potentials and non-conservative forces.
 
+use crate::angular::Generator;
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
@@ -26,6 +27,7 @@ pub struct Model {
     offsets: Vec<(usize, usize)>,
     unit_vectors: Vec<UnitVector>,
     momenta: Vec<Direction>,
+    rotations: Vec<Generator>,
     names: Option<Vec<String>>,
 }
 
@@ -53,6 +55,7 @@ pub struct ModelBuilder {
     forces: Vec<Box<dyn ForceBlock>>,
     unit_vectors: Vec<UnitVector>,
     momenta: Vec<Direction>,
+    rotations: Vec<Generator>,
     names: Option<Vec<String>>,
     error: Option<Error>,
 }
@@ -128,6 +131,33 @@ impl ModelBuilder {
     /// kept where the model turns out symmetric along it, else dropped silently.
     pub(crate) fn momentum_candidate(self, name: &str, direction: &[(usize, f64)]) -> Self {
         self.momentum_direction(name, direction, false)
+    }
+
+    /// Declares that the model keeps the momentum `L = ξ(q)ᵀ M v` of the
+    /// rigid rotation `generator` (see [`crate::angular`];
+    /// [`Generator::rotation`] makes one from a mechanism's coordinate
+    /// names). A run checks it like those it finds, holds it where the
+    /// control does, and reports it when the model breaks it.
+    pub fn angular_momentum(self, generator: Generator) -> Self {
+        self.rotation(Generator { declared: true, ..generator })
+    }
+
+    /// A rotation a mechanism builder proposes: kept where the model turns
+    /// out symmetric under it, else dropped silently.
+    pub(crate) fn rotation_candidate(self, generator: Generator) -> Self {
+        self.rotation(Generator { declared: false, ..generator })
+    }
+
+    fn rotation(mut self, generator: Generator) -> Self {
+        if self.error.is_none() {
+            match generator.check(self.mass.len()) {
+                Ok(()) => self.rotations.push(generator),
+                Err(reason) => {
+                    self.error = Some(Problem::Rotation(reason).at(Part::Block { what: "an angular momentum" }))
+                }
+            }
+        }
+        self
     }
 
     fn momentum_direction(mut self, name: &str, direction: &[(usize, f64)], declared: bool) -> Self {
@@ -255,6 +285,7 @@ impl ModelBuilder {
             offsets,
             unit_vectors: self.unit_vectors,
             momenta: self.momenta,
+            rotations: self.rotations,
             names: self.names,
         })
     }
@@ -339,6 +370,7 @@ impl Model {
             forces: Vec::new(),
             unit_vectors: Vec::new(),
             momenta: Vec::new(),
+            rotations: Vec::new(),
             names: None,
             error: None,
         }
@@ -349,6 +381,22 @@ impl Model {
     pub fn declare_momentum(&mut self, name: &str, direction: &[(usize, f64)]) -> Result<()> {
         self.momenta.push(checked_direction(name, direction, true, self.n())?);
         Ok(())
+    }
+
+    /// Declares, on a built model, that it keeps the momentum of the
+    /// rotation `generator` (as [`ModelBuilder::angular_momentum`]).
+    pub fn declare_angular_momentum(&mut self, generator: Generator) -> Result<()> {
+        generator
+            .check(self.n())
+            .map_err(|reason| Problem::Rotation(reason).at(Part::Block { what: "an angular momentum" }))?;
+        self.rotations.push(Generator { declared: true, ..generator });
+        Ok(())
+    }
+
+    /// The rotations declared or proposed by a mechanism builder, whose
+    /// angular momenta a run checks ([`crate::momentum::detect`]).
+    pub fn rotations(&self) -> &[Generator] {
+        &self.rotations
     }
 
     /// The coordinates' names, where the builder gave them.

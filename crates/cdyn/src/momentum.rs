@@ -23,6 +23,7 @@
 //! the kinetic energy of the motion relative to the momenta), so that `Ψ`
 //! still decays at its rate (docs: "Corrections that keep the momenta").
 
+use crate::angular::{Generator, MAX_ROTATIONS};
 use crate::dynamics::Dynamics;
 use crate::mass::MassMatrix;
 use crate::model::Model;
@@ -71,6 +72,11 @@ pub struct Momentum {
     /// `|e|_M |v₀|_M`: the largest `|p|` the initial kinetic energy allows,
     /// the size against which round-off in `p` is judged.
     pub scale: f64,
+    /// The rigid rotation whose (angular) momentum `ξ(q)ᵀ M v` this is, if
+    /// it is one ([`crate::angular`]); `direction` is then `ξ(q₀)`.
+    pub generator: Option<Generator>,
+    /// Its value at the initial state.
+    pub initial: f64,
 }
 
 /// A declared direction whose momentum the model does not keep.
@@ -80,8 +86,10 @@ pub struct Broken {
     pub name: String,
     /// What breaks it, in a few words ("constraint row 3", "a force").
     pub reason: String,
-    /// The direction `e`, one entry per coordinate.
+    /// The direction `e`, one entry per coordinate (`ξ(q₀)` for a rotation).
     pub direction: Vec<f64>,
+    /// The rotation, if it is one.
+    pub generator: Option<Generator>,
 }
 
 /// What [`detect`] found.
@@ -97,11 +105,15 @@ impl Symmetries {
     /// None found.
     pub const NONE: Symmetries = Symmetries { kept: Vec::new(), broken: Vec::new() };
 
-    /// The direction of momentum `j`: the kept ones, then the broken declared ones.
-    pub fn direction(&self, j: usize) -> &[f64] {
+    /// The direction of momentum `j` and its rotation if it is one: the
+    /// kept ones, then the broken declared ones.
+    pub fn direction(&self, j: usize) -> (&[f64], Option<&Generator>) {
         match self.kept.get(j) {
-            Some(m) => &m.direction,
-            None => &self.broken[j - self.kept.len()].direction,
+            Some(m) => (&m.direction, m.generator.as_ref()),
+            None => {
+                let b = &self.broken[j - self.kept.len()];
+                (&b.direction, b.generator.as_ref())
+            }
         }
     }
 }
@@ -133,6 +145,8 @@ struct Sample {
     psi_q: Vec<f64>,
     /// The non-conservative forces `Q`.
     force: Vec<f64>,
+    /// `M v`.
+    mass_v: Vec<f64>,
 }
 
 /// The consistent states the symmetry conditions are checked at: the
@@ -166,7 +180,9 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// What breaks the symmetry along `e` (dense) at sample `s`, if anything.
-fn breaks(model: &Model, s: &Sample, e: &[f64]) -> Option<String> {
+/// `lifted` is what the velocities' own change adds to the energy's rate
+/// (`(M v)·(B v)` for a rotation, [`crate::angular`]; 0 for a constant `e`).
+fn breaks(model: &Model, s: &Sample, e: &[f64], lifted: f64) -> Option<String> {
     let size = norm(e);
     let pattern = model.pattern();
     for r in 0..model.m() {
@@ -177,14 +193,22 @@ fn breaks(model: &Model, s: &Sample, e: &[f64]) -> Option<String> {
             return Some(format!("constraint row {r}"));
         }
     }
-    let scale = TOLERANCE * (norm(&s.psi_q) + norm(&s.force)) * size;
-    if dot(&s.psi_q, e).abs() > scale {
+    let scale = TOLERANCE * ((norm(&s.psi_q) + norm(&s.force)) * size + lifted.abs());
+    if (dot(&s.psi_q, e) + lifted).abs() > scale {
         return Some("the potential or kinetic energy".into());
     }
     if dot(&s.force, e).abs() > scale {
         return Some("a force".into());
     }
     None
+}
+
+/// What breaks the symmetry under the rotation `g` at sample `s`, if
+/// anything: `Φ_q ξ`, the energy's change under the rotation lifted to
+/// the velocities, `Ψ_q·ξ + (M v)·(B v)`, or `Q·ξ`. `xi` has `n` entries.
+fn breaks_rotation(model: &Model, s: &Sample, g: &Generator, xi: &mut [f64]) -> Option<String> {
+    g.at(&s.q, xi);
+    breaks(model, s, xi, g.form(&s.mass_v, &s.v))
 }
 
 /// Finds the momenta `model` keeps: its declared and mechanism directions
@@ -208,7 +232,9 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         }
         let mut force = vec![0.0; n];
         model.add_forces(&q, &v, t, &mut force);
-        samples.push(Sample { jac: d.jac().to_vec(), psi_q: d.psi_q().to_vec(), force, q, v, t });
+        let mut mass_v = vec![0.0; n];
+        d.mass(model).mul(&v, &mut mass_v);
+        samples.push(Sample { jac: d.jac().to_vec(), psi_q: d.psi_q().to_vec(), force, mass_v, q, v, t });
     }
     let mut found = Symmetries::default();
     if samples.is_empty() {
@@ -245,23 +271,48 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         };
         (Direction { name, entries: vec![(i as u32, 1.0)], declared: false }, Some(i))
     });
-    let candidates = named.into_iter().map(|d| (d, None)).chain(coordinates);
+    let mut rotations: Vec<Generator> = model.rotations().to_vec();
+    rotations.sort_by_key(|g| !g.declared);
+    let candidates = named
+        .into_iter()
+        .map(|d| Candidate::Direction(d, None))
+        .chain(coordinates.map(|(d, i)| Candidate::Direction(d, i)))
+        .chain(rotations.into_iter().map(Candidate::Rotation));
     // The kept directions, made independent by Gram–Schmidt in the metric
     // `M` at the first sample: each basis vector stored as (e_b, M e_b),
-    // normalized.
+    // normalized. A rotation takes part with ξ(q₀).
     let mut basis: Vec<Vec<f64>> = Vec::new();
-    for (direction, coordinate) in candidates {
+    let mut work = vec![0.0; n];
+    let mut turning = 0;
+    for candidate in candidates {
         let mut e = vec![0.0; n];
-        direction.entries.iter().for_each(|&(c, w)| e[c as usize] += w);
-        if coordinate.is_none()
-            && let Some(reason) = samples.iter().find_map(|s| breaks(model, s, &e))
-        {
-            if direction.declared {
-                found.broken.push(Broken { name: direction.name, reason, direction: e });
+        let (name, declared, coordinate, generator) = match candidate {
+            Candidate::Direction(direction, coordinate) => {
+                direction.entries.iter().for_each(|&(c, w)| e[c as usize] += w);
+                (direction.name, direction.declared, coordinate, None)
+            }
+            Candidate::Rotation(g) => (g.name.clone(), g.declared, None, Some(g)),
+        };
+        let broken = match (&generator, coordinate) {
+            (Some(g), _) => samples.iter().find_map(|s| breaks_rotation(model, s, g, &mut work)),
+            (None, None) => samples.iter().find_map(|s| breaks(model, s, &e, 0.0)),
+            // Checked from its column above.
+            (None, Some(_)) => None,
+        };
+        if let Some(g) = &generator {
+            g.at(q0, &mut e);
+        }
+        if let Some(reason) = broken {
+            if declared {
+                found.broken.push(Broken { name, reason, direction: e, generator });
             }
             continue;
         }
-        if found.kept.len() == MAX_MOMENTA {
+        let full = match generator {
+            Some(_) => turning == MAX_ROTATIONS,
+            None => found.kept.len() - turning == MAX_MOMENTA,
+        };
+        if full {
             continue;
         }
         // `M e` and `M v` at every sample.
@@ -296,17 +347,28 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         let scale = left.sqrt();
         basis.push(residual.iter().chain(&residual_m).map(|x| x / scale).collect());
         let tolerance = 1e-12 * norm(first);
-        let linear = mass_e.iter().all(|m| m.iter().zip(first).all(|(a, b)| (a - b).abs() <= tolerance));
+        let linear =
+            generator.is_none() && mass_e.iter().all(|m| m.iter().zip(first).all(|(a, b)| (a - b).abs() <= tolerance));
+        turning += usize::from(generator.is_some());
         found.kept.push(Momentum {
-            name: direction.name,
+            name,
             coordinate,
-            declared: direction.declared,
+            declared,
             linear,
             scale: (size * dot(v0, &mass_v)).max(0.0).sqrt(),
+            initial: value(model, q0, v0, &e, &mut work),
             direction: e,
+            generator,
         });
     }
     found
+}
+
+/// A direction or a rotation to check.
+enum Candidate {
+    /// A constant direction; a single coordinate's index when it is one.
+    Direction(Direction, Option<usize>),
+    Rotation(Generator),
 }
 
 /// `p = eᵀ M(q) v` for a dense direction `e`: exact for a constant `M`;
@@ -352,12 +414,13 @@ impl Momenta {
     pub(crate) const NONE: Momenta =
         Momenta { e: Vec::new(), mass_e: Vec::new(), gram_inverse: Vec::new(), constant: true, ready: true, n: 0 };
 
-    /// The directions of `kept`, for a model of `n` coordinates; `M e` is
+    /// The constant directions of `kept` (not the rotations), for a model of `n` coordinates; `M e` is
     /// set by [`update`](Self::update).
     pub(crate) fn new(kept: &[Momentum], n: usize, constant: bool) -> Self {
-        let k = kept.len();
+        let constant_directions = || kept.iter().filter(|m| m.generator.is_none());
+        let k = constant_directions().count();
         Self {
-            e: kept.iter().flat_map(|m| m.direction.iter().copied()).collect(),
+            e: constant_directions().flat_map(|m| m.direction.iter().copied()).collect(),
             mass_e: vec![0.0; k * n],
             gram_inverse: vec![0.0; k * k],
             constant,

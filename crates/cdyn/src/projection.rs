@@ -14,6 +14,7 @@
 //! projected states of the last steps; nothing is re-evaluated (as
 //! manifold-projection callbacks of ODE libraries do).
 
+use crate::angular::Rotations;
 use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Result, positive};
 use crate::mass::MassMatrix;
@@ -189,6 +190,7 @@ pub(crate) fn invariants(
     model: &Model,
     d: &mut Dynamics,
     momenta: &mut Momenta,
+    rotations: &mut Rotations,
     q: &mut [f64],
     v: &mut [f64],
     t: f64,
@@ -206,6 +208,15 @@ pub(crate) fn invariants(
         let remaining = settings.max_iterations.saturating_sub(iterations);
         iterations += positions(model, d, q, v, t, tol, remaining.max(1), work)?;
         velocities(model, d, v, work);
+        if momenta.stale() {
+            momenta.update(&d.mass(model));
+        }
+        // The angular momenta held: restored by the velocities alone, along
+        // directions the constraints and the linear momenta leave free.
+        if !rotations.is_empty() {
+            rotations.update(model, d, momenta, q, v, false);
+            rotations.restore(v);
+        }
         let (kinetic, potential) = (d.mass(model).kinetic(v), d.potential());
         let psi = kinetic + potential - e0_plus_e;
         // Ψ is a difference of energies: its round-off grows with them.
@@ -239,10 +250,8 @@ pub(crate) fn invariants(
         d.add_weighted_jt_pair(model, [&work.rows, &work.rows_2], [&mut work.correction, &mut work.direction]);
         // The velocities move along P_E P v, leaving the momenta the system
         // keeps as they are (P M⁻¹ Ψ_q is M-orthogonal to them already).
-        if momenta.stale() {
-            momenta.update(&mass);
-        }
         momenta.project(&mut work.direction);
+        rotations.orthogonalize(&mut work.direction);
         let b: f64 = d.psi_q().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
         let a = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
         let slope = c * b + a;

@@ -1,6 +1,7 @@
 //! The controlled state equation `ẋ = f(x, t) + U(x, t)` of a model, with
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
+use crate::angular::Rotations;
 use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
@@ -116,6 +117,10 @@ pub struct ControlledSystem<'m> {
     symmetries: Symmetries,
     /// Those the corrections keep (none with [`Invariants::Free`](crate::control::Invariants::Free)).
     momenta: Momenta,
+    /// The angular momenta `robust` and `projection` hold (none with `Free`).
+    rotations: Rotations,
+    /// A rotation's field `ξ(q)`, for [`System::momentum`].
+    turned: Vec<f64>,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -139,6 +144,8 @@ impl<'m> ControlledSystem<'m> {
             dependent: 0,
             symmetries: Symmetries::default(),
             momenta: Momenta::NONE,
+            rotations: Rotations::default(),
+            turned: vec![0.0; model.n()],
         }
     }
 
@@ -152,6 +159,10 @@ impl<'m> ControlledSystem<'m> {
             }
             crate::control::Invariants::Free => Momenta::NONE,
         };
+        let turning = symmetries.kept.iter().filter_map(|m| Some((m.generator.clone()?, m.initial)));
+        let (generators, targets) =
+            turning.filter(|_| self.control.invariants == crate::control::Invariants::Keep).unzip();
+        self.rotations = Rotations::new(generators, targets, self.model.n(), self.model.m());
         self.symmetries = symmetries;
     }
 
@@ -204,10 +215,17 @@ impl Rhs for ControlledSystem<'_> {
             let (u_v, u_e) = rest.split_at_mut(n);
             u_e[0] = 0.0;
             let [r0, r1, r2, r3, r4] = &mut self.rows;
-            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work };
             if self.momenta.stale() {
                 self.momenta.update(&self.dynamics.mass(self.model));
             }
+            let holds = matches!(self.control.energy, crate::control::Energy::Projected { .. });
+            let rotations = if holds && !self.rotations.is_empty() {
+                self.rotations.update(self.model, &self.dynamics, &self.momenta, q, v, true);
+                Some(&mut self.rotations)
+            } else {
+                None
+            };
+            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work, rotations };
             let (model, dynamics, momenta) = (self.model, &self.dynamics, &self.momenta);
             // The laws are compiled once per kind of mass, so that a constant
             // diagonal `M` runs its loops without a match per product
@@ -276,7 +294,14 @@ impl System for ControlledSystem<'_> {
     }
     fn momentum(&mut self, j: usize, x: &[f64]) -> f64 {
         let (q, v, _) = split_state(x, self.model.n());
-        momentum::value(self.model, q, v, self.symmetries.direction(j), &mut self.work)
+        let direction = match self.symmetries.direction(j) {
+            (_, Some(g)) => {
+                g.at(q, &mut self.turned);
+                &self.turned
+            }
+            (e, None) => e,
+        };
+        momentum::value(self.model, q, v, direction, &mut self.work)
     }
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
         let n = self.model.n();
@@ -284,7 +309,8 @@ impl System for ControlledSystem<'_> {
         let (v, e) = rest.split_at_mut(n);
         let target = self.e0 + e[0];
         let (model, d) = (self.model, &mut self.dynamics);
-        projection::invariants(model, d, &mut self.momenta, q, v, t, target, h, settings, &mut self.projection)
+        let (momenta, rotations) = (&mut self.momenta, &mut self.rotations);
+        projection::invariants(model, d, momenta, rotations, q, v, t, target, h, settings, &mut self.projection)
     }
 }
 

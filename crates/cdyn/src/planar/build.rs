@@ -8,6 +8,7 @@ use super::element::{Coordinate, Element};
 use super::ends::{End, idx_array, with_k};
 use super::loads::{Damper, Gravity, PointLoad, RotaryDamper, Spring, Torque, Torsion};
 use super::mechanism::Mechanism;
+use crate::angular::Generator;
 use crate::error::{Error, Part, Problem, Result, finite, non_negative, positive};
 use crate::model::{Model, ModelBuilder};
 use crate::timefn::TimeFn;
@@ -62,6 +63,10 @@ impl Mechanism {
         {
             let direction: Vec<(usize, f64)> = offsets.iter().map(|&o| (o + axis, 1.0)).collect();
             builder = builder.momentum_candidate(name, &direction);
+        }
+        // The rigid rotation about the origin: kept where nothing turns it.
+        if let Ok(g) = Generator::rotation("angular momentum z", &names, [0.0, 0.0, 1.0], [0.0; 3], false) {
+            builder = builder.rotation_candidate(g);
         }
         for (i, b) in self.bodies.iter().enumerate() {
             if self.gravity != [0.0, 0.0] {

@@ -5,6 +5,7 @@ use super::body::{Body, Rotation};
 use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows};
 use super::load::{BodyRotaryDamper, BodyTorque, GroundRotaryDamper, LineDamper, Load, PointForce, SpringEnergy};
 use super::rotation::{cross, rate_from_body, unrotate};
+use crate::angular::Generator;
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::Potential;
 use crate::model::{Model, ModelBuilder};
@@ -214,8 +215,8 @@ impl Mechanism {
             crate::error::finite("gravity", g)?;
         }
         let mut rows = Vec::new();
-        let names = self.bodies.iter().flat_map(|b| coordinate_names(&b.name)).collect();
-        let mut builder = Model::builder(mass).coordinate_names(names);
+        let names: Vec<String> = self.bodies.iter().flat_map(|b| coordinate_names(&b.name)).collect();
+        let mut builder = Model::builder(mass).coordinate_names(names.clone());
         // The rigid translations: kept where nothing holds the mechanism in place.
         let axes = if self.bodies.is_empty() {
             &[][..]
@@ -226,6 +227,14 @@ impl Mechanism {
             let direction: Vec<(usize, f64)> =
                 (0..self.bodies.len()).map(|i| (SpatialBody::of(i).first + axis, 1.0)).collect();
             builder = builder.momentum_candidate(name, &direction);
+        }
+        // The rigid rotations about the axes through the origin.
+        for (axis, name) in axes.iter().enumerate() {
+            let (unit, name) =
+                (std::array::from_fn(|i| f64::from(u8::from(i == axis))), name.replace("linear", "angular"));
+            if let Ok(g) = Generator::rotation(&name, &names, unit, [0.0; 3], false) {
+                builder = builder.rotation_candidate(g);
+            }
         }
         for (i, body) in self.bodies.iter().enumerate() {
             let b = SpatialBody::of(i);
