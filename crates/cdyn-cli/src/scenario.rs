@@ -47,22 +47,26 @@ pub struct Scenario {
 }
 
 /// A declared invariant: `kind = "momentum"` with an `axis` (every body
-/// translated along it), or `kind = "coordinate"` with the `coordinate`'s
-/// name (its generalized momentum); `name` names it in the output.
+/// translated along it), `kind = "angular_momentum"` with an `axis`
+/// (default z) and a `point` on it (default the origin), or
+/// `kind = "coordinate"` with the `coordinate`'s name (its generalized
+/// momentum); `name` names it in the output.
 #[derive(Debug, Deserialize, Clone)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum InvariantSpec {
     Momentum { axis: Vec<f64>, name: Option<String> },
+    AngularMomentum { axis: Option<Vec<f64>>, point: Option<Vec<f64>>, name: Option<String> },
     Coordinate { coordinate: String, name: Option<String> },
 }
 
 impl InvariantSpec {
-    /// Its name and direction on `example`'s coordinates.
-    fn direction(&self, example: &Example) -> std::result::Result<(String, Vec<(usize, f64)>), String> {
+    /// Declares it on `example`'s model.
+    fn declare(&self, example: &mut Example) -> std::result::Result<(), String> {
         let names = example.model.coordinate_names().ok_or("needs a mechanism, whose coordinates have names")?;
-        match self {
+        let spatial = example.sketch.is_some();
+        let (name, direction) = match self {
             InvariantSpec::Momentum { axis, name } => {
-                let suffixes: &[&str] = if example.sketch.is_some() { &[".x", ".y", ".z"] } else { &[".x", ".y"] };
+                let suffixes: &[&str] = if spatial { &[".x", ".y", ".z"] } else { &[".x", ".y"] };
                 if axis.len() != suffixes.len() || axis.iter().any(|a| !a.is_finite()) || axis.iter().all(|a| *a == 0.0)
                 {
                     return Err(format!("axis = {axis:?}: must be {} finite numbers, not all zero", suffixes.len()));
@@ -73,15 +77,36 @@ impl InvariantSpec {
                     .filter_map(|(i, n)| suffixes.iter().position(|s| n.ends_with(s)).map(|k| (i, axis[k])))
                     .filter(|(_, w)| *w != 0.0)
                     .collect();
-                Ok((name.clone().unwrap_or_else(|| format!("linear momentum along {axis:?}")), direction))
+                (name.clone().unwrap_or_else(|| format!("linear momentum along {axis:?}")), direction)
+            }
+            InvariantSpec::AngularMomentum { axis, point, name } => {
+                let axis = match axis.as_deref() {
+                    None => [0.0, 0.0, 1.0],
+                    Some(&[x, y, z]) if spatial => [x, y, z],
+                    Some(a) => {
+                        let expected = if spatial { "3 numbers" } else { "left out: a planar mechanism turns about z" };
+                        return Err(format!("axis = {a:?}: must be {expected}"));
+                    }
+                };
+                let width = if spatial { 3 } else { 2 };
+                let point = match point.as_deref() {
+                    None => [0.0; 3],
+                    Some(p) if p.len() == width => std::array::from_fn(|i| p.get(i).copied().unwrap_or(0.0)),
+                    Some(p) => return Err(format!("point = {p:?}: must be {width} numbers")),
+                };
+                let label =
+                    name.clone().unwrap_or_else(|| format!("angular momentum about {axis:?} through {point:?}"));
+                let g = cdyn::angular::Generator::rotation(&label, names, axis, point, true)?;
+                return example.model.declare_angular_momentum(g).map_err(|e| e.to_string());
             }
             InvariantSpec::Coordinate { coordinate, name } => {
                 let i = names.iter().position(|n| n == coordinate).ok_or_else(|| {
                     format!("coordinate = \"{coordinate}\": no such coordinate (they are {})", names.join(", "))
                 })?;
-                Ok((name.clone().unwrap_or_else(|| format!("momentum of {coordinate}")), vec![(i, 1.0)]))
+                (name.clone().unwrap_or_else(|| format!("momentum of {coordinate}")), vec![(i, 1.0)])
             }
-        }
+        };
+        example.model.declare_momentum(&name, &direction).map_err(|e| e.to_string())
     }
 }
 
@@ -388,9 +413,7 @@ impl Scenario {
         }
         let (mut example, rows) = self.example(file)?;
         for (k, spec) in self.invariants.iter().enumerate() {
-            let at = |e: String| anyhow!("{file}: invariants[{k}]: {e}");
-            let (name, direction) = spec.direction(&example).map_err(at)?;
-            example.model.declare_momentum(&name, &direction).map_err(|e| at(e.to_string()))?;
+            spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
         }
         for (key, given, default) in [("q", &init.q, &mut example.q0), ("v", &init.v, &mut example.v0)] {
             if let Some(given) = given {
