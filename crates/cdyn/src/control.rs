@@ -2,7 +2,7 @@
 //! data (Eqs. 13, 19, 20–27, 28–40, 48–53) and the control term `U(x, t)`
 //! they add to the uncontrolled state equations.
 
-use crate::angular::Rotations;
+use crate::held::Held;
 use crate::error::{Result, non_negative, positive};
 use crate::integrate::Application;
 use crate::mass::MassMatrix;
@@ -278,9 +278,9 @@ pub(crate) struct Workspace<'a> {
     pub rows: [&'a mut [f64]; 5],
     /// Length `n`.
     pub w: &'a mut [f64],
-    /// The angular momenta the projected energy law holds beside the
-    /// energy, updated at this state ([`crate::angular`]).
-    pub rotations: Option<&'a mut Rotations>,
+    /// The invariants the projected energy law holds beside the energy,
+    /// updated at this state ([`crate::held`]).
+    pub held: Option<&'a mut Held>,
 }
 
 /// Below this `|Ψ_v|²` (or `vᵀMv`) the energy control has no direction to
@@ -461,9 +461,9 @@ impl Control {
             }
             Energy::Projected { alpha_e, position_weight } => {
                 let rows = [scratch, r_v, y_v, y_w, phi_q_w];
-                let (alpha_e, rotations) = (alpha_e.value(), work.rotations);
-                match rotations.filter(|r| !r.is_empty() && alpha_e > 0.0) {
-                    Some(rotations) => {
+                let (alpha_e, held) = (alpha_e.value(), work.held);
+                match held.filter(|r| !r.is_empty() && alpha_e > 0.0) {
+                    Some(held) => {
                         // The other terms first, then the energy and the
                         // angular momenta held together.
                         let [a, b, r2, r3, r4] = rows;
@@ -472,7 +472,7 @@ impl Control {
                         let c = position_weight / (alpha_e * alpha_e);
                         let free =
                             |norm: f64, whole: f64| norm > REST && (momenta.is_empty() || norm > RELATIVE_REST * whole);
-                        rotations.hold(d, v, psi, alpha_e, c, free, u_q, u_v, [a, b], work.w);
+                        held.hold(d, v, psi, alpha_e, c, free, u_q, u_v, [a, b], work.w);
                     }
                     None => self.coupled_terms(d, v, psi, alpha_e, position_weight, u_q, u_v, rows, work.w),
                 }

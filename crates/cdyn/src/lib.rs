@@ -29,7 +29,9 @@ pub mod energy;
 pub mod error;
 pub mod force;
 pub mod gains;
+pub mod held;
 pub mod integrate;
+pub mod invariant;
 mod jet;
 #[cfg(feature = "serde")]
 pub mod json_float;
@@ -59,6 +61,7 @@ pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Invariants, Rate
 pub use error::{Error, Result};
 pub use force::{Force, Potential};
 pub use integrate::{Application, Scheme};
+pub use invariant::Invariant;
 pub use kinetic::Kinetic;
 pub use model::Model;
 pub use nonholonomic::Nonholonomic;

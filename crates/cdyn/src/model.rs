@@ -3,6 +3,7 @@
 //! holonomic constraint elements, potentials and non-conservative forces.
 
 use crate::angular::Generator;
+use crate::invariant::{Declared, Invariant};
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
@@ -28,6 +29,7 @@ pub struct Model {
     unit_vectors: Vec<UnitVector>,
     momenta: Vec<Direction>,
     rotations: Vec<Generator>,
+    invariants: Vec<Declared>,
     names: Option<Vec<String>>,
 }
 
@@ -56,6 +58,7 @@ pub struct ModelBuilder {
     unit_vectors: Vec<UnitVector>,
     momenta: Vec<Direction>,
     rotations: Vec<Generator>,
+    invariants: Vec<Declared>,
     names: Option<Vec<String>>,
     error: Option<Error>,
 }
@@ -140,6 +143,18 @@ impl ModelBuilder {
     /// control does, and reports it when the model breaks it.
     pub fn angular_momentum(self, generator: Generator) -> Self {
         self.rotation(Generator { declared: true, ..generator })
+    }
+
+    /// Declares that the model keeps `I(q, v)` of the coordinates `at`, a
+    /// function written once generic over the scalar (its gradients by AD).
+    /// A run checks it at sample states, holds it beside the energy where
+    /// the control does (`robust`, `projection`), and reports it, with its
+    /// drift, when the motion changes it.
+    pub fn invariant<I: Invariant<K>, const K: usize>(mut self, name: &str, invariant: I, at: [usize; K]) -> Self {
+        if self.check_indices("an invariant", &at) {
+            self.invariants.push(Declared::new(name, invariant, at));
+        }
+        self
     }
 
     /// A rotation a mechanism builder proposes: kept where the model turns
@@ -286,6 +301,7 @@ impl ModelBuilder {
             unit_vectors: self.unit_vectors,
             momenta: self.momenta,
             rotations: self.rotations,
+            invariants: self.invariants,
             names: self.names,
         })
     }
@@ -371,6 +387,7 @@ impl Model {
             unit_vectors: Vec::new(),
             momenta: Vec::new(),
             rotations: Vec::new(),
+            invariants: Vec::new(),
             names: None,
             error: None,
         }
@@ -397,6 +414,33 @@ impl Model {
     /// angular momenta a run checks ([`crate::momentum::detect`]).
     pub fn rotations(&self) -> &[Generator] {
         &self.rotations
+    }
+
+    /// Declares, on a built model, that it keeps `I(q, v)` of the
+    /// coordinates `at` (as [`ModelBuilder::invariant`]).
+    pub fn declare_invariant<I: Invariant<K>, const K: usize>(
+        &mut self,
+        name: &str,
+        invariant: I,
+        at: [usize; K],
+    ) -> Result<()> {
+        let n = self.n();
+        for (j, &index) in at.iter().enumerate() {
+            let what = Part::Block { what: "an invariant" };
+            if index >= n {
+                return Err(Problem::NoSuchCoordinate { index, n }.at(what));
+            }
+            if at[..j].contains(&index) {
+                return Err(Problem::CoordinateTwice { index }.at(what));
+            }
+        }
+        self.invariants.push(Declared::new(name, invariant, at));
+        Ok(())
+    }
+
+    /// The invariants declared with [`ModelBuilder::invariant`].
+    pub fn declared_invariants(&self) -> &[Declared] {
+        &self.invariants
     }
 
     /// The coordinates' names, where the builder gave them.

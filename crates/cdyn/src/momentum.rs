@@ -23,7 +23,8 @@
 //! the kinetic energy of the motion relative to the momenta), so that `Ψ`
 //! still decays at its rate (docs: "Corrections that keep the momenta").
 
-use crate::angular::{Generator, MAX_ROTATIONS};
+use crate::angular::Generator;
+use crate::held::MAX_HELD;
 use crate::dynamics::Dynamics;
 use crate::mass::MassMatrix;
 use crate::model::Model;
@@ -72,11 +73,23 @@ pub struct Momentum {
     /// `|e|_M |v₀|_M`: the largest `|p|` the initial kinetic energy allows,
     /// the size against which round-off in `p` is judged.
     pub scale: f64,
-    /// The rigid rotation whose (angular) momentum `ξ(q)ᵀ M v` this is, if
-    /// it is one ([`crate::angular`]); `direction` is then `ξ(q₀)`.
-    pub generator: Option<Generator>,
+    /// What it is: a constant direction's momentum, a rotation's angular
+    /// momentum (`direction` is then `ξ(q₀)`), or a declared invariant
+    /// (`direction` is `M⁻¹ ∂I/∂v` at the initial state).
+    pub kind: Kind,
     /// Its value at the initial state.
     pub initial: f64,
+}
+
+/// What a momentum is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Kind {
+    /// `eᵀ M v` along a constant direction `e`.
+    Constant,
+    /// `ξ(q)ᵀ M v`, the angular momentum of a rigid rotation ([`crate::angular`]).
+    Rotation(Generator),
+    /// The model's declared invariant of this index ([`crate::invariant`]).
+    Declared(usize),
 }
 
 /// A declared direction whose momentum the model does not keep.
@@ -86,10 +99,10 @@ pub struct Broken {
     pub name: String,
     /// What breaks it, in a few words ("constraint row 3", "a force").
     pub reason: String,
-    /// The direction `e`, one entry per coordinate (`ξ(q₀)` for a rotation).
+    /// The direction `e`, one entry per coordinate (as [`Momentum::direction`]).
     pub direction: Vec<f64>,
-    /// The rotation, if it is one.
-    pub generator: Option<Generator>,
+    /// What it is.
+    pub kind: Kind,
 }
 
 /// What [`detect`] found.
@@ -105,14 +118,14 @@ impl Symmetries {
     /// None found.
     pub const NONE: Symmetries = Symmetries { kept: Vec::new(), broken: Vec::new() };
 
-    /// The direction of momentum `j` and its rotation if it is one: the
-    /// kept ones, then the broken declared ones.
-    pub fn direction(&self, j: usize) -> (&[f64], Option<&Generator>) {
+    /// The direction and kind of momentum `j`: the kept ones, then the
+    /// broken declared ones.
+    pub fn direction(&self, j: usize) -> (&[f64], &Kind) {
         match self.kept.get(j) {
-            Some(m) => (&m.direction, m.generator.as_ref()),
+            Some(m) => (&m.direction, &m.kind),
             None => {
                 let b = &self.broken[j - self.kept.len()];
-                (&b.direction, b.generator.as_ref())
+                (&b.direction, &b.kind)
             }
         }
     }
@@ -147,6 +160,8 @@ struct Sample {
     force: Vec<f64>,
     /// `M v`.
     mass_v: Vec<f64>,
+    /// The uncontrolled acceleration `v̇`.
+    acc: Vec<f64>,
 }
 
 /// The consistent states the symmetry conditions are checked at: the
@@ -181,8 +196,9 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// What breaks the symmetry along `e` (dense) at sample `s`, if anything.
 /// `lifted` is what the velocities' own change adds to the energy's rate
-/// (`(M v)·(B v)` for a rotation, [`crate::angular`]; 0 for a constant `e`).
-fn breaks(model: &Model, s: &Sample, e: &[f64], lifted: f64) -> Option<String> {
+/// (`(M v)·(B v)` for a rotation, [`crate::angular`]; 0 for a constant `e`)
+/// and the size its round-off is judged against (`|M v| |B v|`).
+fn breaks(model: &Model, s: &Sample, e: &[f64], [lifted, lifted_size]: [f64; 2]) -> Option<String> {
     let size = norm(e);
     let pattern = model.pattern();
     for r in 0..model.m() {
@@ -193,7 +209,7 @@ fn breaks(model: &Model, s: &Sample, e: &[f64], lifted: f64) -> Option<String> {
             return Some(format!("constraint row {r}"));
         }
     }
-    let scale = TOLERANCE * ((norm(&s.psi_q) + norm(&s.force)) * size + lifted.abs());
+    let scale = TOLERANCE * ((norm(&s.psi_q) + norm(&s.force)) * size + lifted_size);
     if (dot(&s.psi_q, e) + lifted).abs() > scale {
         return Some("the potential or kinetic energy".into());
     }
@@ -207,8 +223,24 @@ fn breaks(model: &Model, s: &Sample, e: &[f64], lifted: f64) -> Option<String> {
 /// anything: `Φ_q ξ`, the energy's change under the rotation lifted to
 /// the velocities, `Ψ_q·ξ + (M v)·(B v)`, or `Q·ξ`. `xi` has `n` entries.
 fn breaks_rotation(model: &Model, s: &Sample, g: &Generator, xi: &mut [f64]) -> Option<String> {
+    g.turn(&s.v, xi);
+    let lifted = [dot(&s.mass_v, xi), norm(&s.mass_v) * norm(xi)];
     g.at(&s.q, xi);
-    breaks(model, s, xi, g.form(&s.mass_v, &s.v))
+    breaks(model, s, xi, lifted)
+}
+
+/// Whether the uncontrolled motion moves declared invariant `i` at
+/// sample `s`: `dI/dt = ∂I/∂q·v + ∂I/∂v·v̇` against the size of its terms.
+fn breaks_declared(model: &Model, s: &Sample, i: usize) -> Option<String> {
+    let n = model.n();
+    let (mut grad_q, mut grad_v) = (vec![0.0; n], vec![0.0; n]);
+    model.declared_invariants()[i].block.gradients(&s.q, &s.v, &mut grad_q, &mut grad_v);
+    let rate = dot(&grad_q, &s.v) + dot(&grad_v, &s.acc);
+    let size = norm(&grad_q) * norm(&s.v) + norm(&grad_v) * norm(&s.acc);
+    if size == 0.0 {
+        return Some("it reads nothing that moves".into());
+    }
+    (rate.abs() > TOLERANCE * size).then(|| format!("the motion changes it (dI/dt = {rate:.3e} at t = {})", s.t))
 }
 
 /// Finds the momenta `model` keeps: its declared and mechanism directions
@@ -222,8 +254,7 @@ fn breaks_rotation(model: &Model, s: &Sample, g: &Generator, xi: &mut [f64]) -> 
 /// is formed densely.
 pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
     let n = model.n();
-    let mut named: Vec<Direction> = model.momentum_directions().to_vec();
-    named.sort_by_key(|d| !d.declared);
+    let named: Vec<Direction> = model.momentum_directions().to_vec();
     let mut d = Dynamics::new(model);
     let mut samples = Vec::new();
     for (q, v, t) in sample_states(model, q0, v0) {
@@ -234,7 +265,8 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         model.add_forces(&q, &v, t, &mut force);
         let mut mass_v = vec![0.0; n];
         d.mass(model).mul(&v, &mut mass_v);
-        samples.push(Sample { jac: d.jac().to_vec(), psi_q: d.psi_q().to_vec(), force, mass_v, q, v, t });
+        let (jac, psi_q, acc) = (d.jac().to_vec(), d.psi_q().to_vec(), d.acc().to_vec());
+        samples.push(Sample { jac, psi_q, force, mass_v, acc, q, v, t });
     }
     let mut found = Symmetries::default();
     if samples.is_empty() {
@@ -271,46 +303,69 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         };
         (Direction { name, entries: vec![(i as u32, 1.0)], declared: false }, Some(i))
     });
-    let mut rotations: Vec<Generator> = model.rotations().to_vec();
-    rotations.sort_by_key(|g| !g.declared);
-    let candidates = named
+    let rotations: Vec<Generator> = model.rotations().to_vec();
+    // What the user declared first (its name wins over a builder's
+    // proposal of the same momentum), then the builder's, then the cyclic
+    // coordinates.
+    let (declared_directions, proposed): (Vec<_>, Vec<_>) = named.into_iter().partition(|d| d.declared);
+    let (declared_rotations, proposed_rotations): (Vec<_>, Vec<_>) = rotations.into_iter().partition(|g| g.declared);
+    let candidates = declared_directions
         .into_iter()
         .map(|d| Candidate::Direction(d, None))
+        .chain(declared_rotations.into_iter().map(Candidate::Rotation))
+        .chain((0..model.declared_invariants().len()).map(Candidate::Declared))
+        .chain(proposed.into_iter().map(|d| Candidate::Direction(d, None)))
         .chain(coordinates.map(|(d, i)| Candidate::Direction(d, i)))
-        .chain(rotations.into_iter().map(Candidate::Rotation));
+        .chain(proposed_rotations.into_iter().map(Candidate::Rotation));
     // The kept directions, made independent by Gram–Schmidt in the metric
     // `M` at the first sample: each basis vector stored as (e_b, M e_b),
-    // normalized. A rotation takes part with ξ(q₀).
+    // normalized. A rotation takes part with ξ(q₀), a declared invariant
+    // with M⁻¹ ∂I/∂v at the initial state.
     let mut basis: Vec<Vec<f64>> = Vec::new();
     let mut work = vec![0.0; n];
-    let mut turning = 0;
+    let mut held = 0;
     for candidate in candidates {
         let mut e = vec![0.0; n];
-        let (name, declared, coordinate, generator) = match candidate {
+        let (name, declared, coordinate, kind) = match candidate {
             Candidate::Direction(direction, coordinate) => {
                 direction.entries.iter().for_each(|&(c, w)| e[c as usize] += w);
-                (direction.name, direction.declared, coordinate, None)
+                (direction.name, direction.declared, coordinate, Kind::Constant)
             }
-            Candidate::Rotation(g) => (g.name.clone(), g.declared, None, Some(g)),
+            Candidate::Rotation(g) => (g.name.clone(), g.declared, None, Kind::Rotation(g)),
+            Candidate::Declared(i) => (model.declared_invariants()[i].name.clone(), true, None, Kind::Declared(i)),
         };
-        let broken = match (&generator, coordinate) {
-            (Some(g), _) => samples.iter().find_map(|s| breaks_rotation(model, s, g, &mut work)),
-            (None, None) => samples.iter().find_map(|s| breaks(model, s, &e, 0.0)),
+        let broken = match (&kind, coordinate) {
+            (Kind::Rotation(g), _) => samples.iter().find_map(|s| breaks_rotation(model, s, g, &mut work)),
+            (Kind::Declared(i), _) => samples.iter().find_map(|s| breaks_declared(model, s, *i)),
+            (Kind::Constant, None) => samples.iter().find_map(|s| breaks(model, s, &e, [0.0; 2])),
             // Checked from its column above.
-            (None, Some(_)) => None,
+            (Kind::Constant, Some(_)) => None,
         };
-        if let Some(g) = &generator {
-            g.at(q0, &mut e);
-        }
+        let initial = match &kind {
+            Kind::Rotation(g) => {
+                g.at(q0, &mut e);
+                value(model, q0, v0, &e, &mut work)
+            }
+            Kind::Declared(i) => {
+                let mut grad_q = vec![0.0; n];
+                let block = &model.declared_invariants()[*i].block;
+                let initial = block.gradients(q0, v0, &mut grad_q, &mut work);
+                if d.evaluate(model, q0, v0, 0.0).is_ok() {
+                    d.mass(model).solve(&work, &mut e);
+                }
+                initial
+            }
+            Kind::Constant => value(model, q0, v0, &e, &mut work),
+        };
         if let Some(reason) = broken {
             if declared {
-                found.broken.push(Broken { name, reason, direction: e, generator });
+                found.broken.push(Broken { name, reason, direction: e, kind });
             }
             continue;
         }
-        let full = match generator {
-            Some(_) => turning == MAX_ROTATIONS,
-            None => found.kept.len() - turning == MAX_MOMENTA,
+        let full = match kind {
+            Kind::Constant => found.kept.len() - held == MAX_MOMENTA,
+            _ => held == MAX_HELD,
         };
         if full {
             continue;
@@ -347,28 +402,29 @@ pub fn detect(model: &Model, q0: &[f64], v0: &[f64]) -> Symmetries {
         let scale = left.sqrt();
         basis.push(residual.iter().chain(&residual_m).map(|x| x / scale).collect());
         let tolerance = 1e-12 * norm(first);
-        let linear =
-            generator.is_none() && mass_e.iter().all(|m| m.iter().zip(first).all(|(a, b)| (a - b).abs() <= tolerance));
-        turning += usize::from(generator.is_some());
+        let constant = kind == Kind::Constant;
+        let linear = constant && mass_e.iter().all(|m| m.iter().zip(first).all(|(a, b)| (a - b).abs() <= tolerance));
+        held += usize::from(!constant);
         found.kept.push(Momentum {
             name,
             coordinate,
             declared,
             linear,
             scale: (size * dot(v0, &mass_v)).max(0.0).sqrt(),
-            initial: value(model, q0, v0, &e, &mut work),
+            initial,
             direction: e,
-            generator,
+            kind,
         });
     }
     found
 }
 
-/// A direction or a rotation to check.
+/// A direction, a rotation or a declared invariant to check.
 enum Candidate {
     /// A constant direction; a single coordinate's index when it is one.
     Direction(Direction, Option<usize>),
     Rotation(Generator),
+    Declared(usize),
 }
 
 /// `p = eᵀ M(q) v` for a dense direction `e`: exact for a constant `M`;
@@ -417,7 +473,7 @@ impl Momenta {
     /// The constant directions of `kept` (not the rotations), for a model of `n` coordinates; `M e` is
     /// set by [`update`](Self::update).
     pub(crate) fn new(kept: &[Momentum], n: usize, constant: bool) -> Self {
-        let constant_directions = || kept.iter().filter(|m| m.generator.is_none());
+        let constant_directions = || kept.iter().filter(|m| m.kind == Kind::Constant);
         let k = constant_directions().count();
         Self {
             e: constant_directions().flat_map(|m| m.direction.iter().copied()).collect(),

@@ -14,7 +14,7 @@
 //! projected states of the last steps; nothing is re-evaluated (as
 //! manifold-projection callbacks of ODE libraries do).
 
-use crate::angular::Rotations;
+use crate::held::Held;
 use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Result, positive};
 use crate::mass::MassMatrix;
@@ -190,7 +190,7 @@ pub(crate) fn invariants(
     model: &Model,
     d: &mut Dynamics,
     momenta: &mut Momenta,
-    rotations: &mut Rotations,
+    held: &mut Held,
     q: &mut [f64],
     v: &mut [f64],
     t: f64,
@@ -213,9 +213,9 @@ pub(crate) fn invariants(
         }
         // The angular momenta held: restored by the velocities alone, along
         // directions the constraints and the linear momenta leave free.
-        if !rotations.is_empty() {
-            rotations.update(model, d, momenta, q, v, false);
-            rotations.restore(v);
+        if !held.is_empty() {
+            held.update(model, d, momenta, q, v, false);
+            held.restore(v);
         }
         let (kinetic, potential) = (d.mass(model).kinetic(v), d.potential());
         let psi = kinetic + potential - e0_plus_e;
@@ -252,7 +252,7 @@ pub(crate) fn invariants(
         // keeps as they are (P M⁻¹ Ψ_q is M-orthogonal to them already).
         momenta.project(&mut work.direction);
         let free = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
-        rotations.orthogonalize(&mut work.direction);
+        held.orthogonalize(&mut work.direction);
         let b: f64 = d.psi_q().iter().zip(&work.correction).map(|(g, w)| g * w).sum();
         let a = mass.psi_v_dot(v, |i| work.direction[i], |_| 0.0, 0.0);
         let slope = c * b + a;
@@ -262,7 +262,7 @@ pub(crate) fn invariants(
         // step of the positions alone, with the velocities then restoring
         // the momenta, moves Ψ against its predicted slope (measured: |Ψ|
         // tripled at each iteration on a free body).
-        if !rotations.is_empty() && a <= 1e-8 * free {
+        if !held.is_empty() && a <= 1e-8 * free {
             return Ok(iterations);
         }
         if slope.is_nan() || slope <= 0.0 {

@@ -382,7 +382,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
             let (u_v, u_e) = rest.split_at_mut(N);
             u_e[0] = 0.0;
             let [r0, r1, r2, r3, r4] = &mut self.rows;
-            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.w, rotations: None };
+            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.w, held: None };
             self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, work);
         }
         Ok(())

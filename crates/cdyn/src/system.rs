@@ -1,7 +1,7 @@
 //! The controlled state equation `ẋ = f(x, t) + U(x, t)` of a model, with
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
-use crate::angular::Rotations;
+use crate::held::Held;
 use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
@@ -10,7 +10,7 @@ use crate::gains::Operators;
 use crate::integrate::{Buffer, Rhs};
 use crate::mass::{MassAt, MassMatrix};
 use crate::model::Model;
-use crate::momentum::{self, Momenta, Symmetries};
+use crate::momentum::{self, Kind, Momenta, Symmetries};
 use crate::projection::{self, Failure, Projection};
 
 /// A failed evaluation of the right-hand side.
@@ -117,8 +117,9 @@ pub struct ControlledSystem<'m> {
     symmetries: Symmetries,
     /// Those the corrections keep (none with [`Invariants::Free`](crate::control::Invariants::Free)).
     momenta: Momenta,
-    /// The angular momenta `robust` and `projection` hold (none with `Free`).
-    rotations: Rotations,
+    /// The angular momenta and declared invariants `robust` and
+    /// `projection` hold beside the energy (none with `Free`).
+    held: Held,
     /// A rotation's field `ξ(q)`, for [`System::momentum`].
     turned: Vec<f64>,
 }
@@ -144,7 +145,7 @@ impl<'m> ControlledSystem<'m> {
             dependent: 0,
             symmetries: Symmetries::default(),
             momenta: Momenta::NONE,
-            rotations: Rotations::default(),
+            held: Held::default(),
             turned: vec![0.0; model.n()],
         }
     }
@@ -154,15 +155,15 @@ impl<'m> ControlledSystem<'m> {
     pub fn set_symmetries(&mut self, symmetries: Symmetries) {
         self.momenta = match self.control.invariants {
             crate::control::Invariants::Keep => {
-                let constant = self.model.mass().is_some() || symmetries.kept.iter().all(|m| m.linear);
+                let constant = self.model.mass().is_some()
+                    || symmetries.kept.iter().filter(|m| m.kind == Kind::Constant).all(|m| m.linear);
                 Momenta::new(&symmetries.kept, self.model.n(), constant)
             }
             crate::control::Invariants::Free => Momenta::NONE,
         };
-        let turning = symmetries.kept.iter().filter_map(|m| Some((m.generator.clone()?, m.initial)));
-        let (generators, targets) =
-            turning.filter(|_| self.control.invariants == crate::control::Invariants::Keep).unzip();
-        self.rotations = Rotations::new(generators, targets, self.model.n(), self.model.m());
+        let held = symmetries.kept.iter().filter(|m| m.kind != Kind::Constant).map(|m| (m.kind.clone(), m.initial));
+        let (kinds, targets) = held.filter(|_| self.control.invariants == crate::control::Invariants::Keep).unzip();
+        self.held = Held::new(kinds, targets, self.model.n(), self.model.m());
         self.symmetries = symmetries;
     }
 
@@ -219,13 +220,13 @@ impl Rhs for ControlledSystem<'_> {
                 self.momenta.update(&self.dynamics.mass(self.model));
             }
             let holds = matches!(self.control.energy, crate::control::Energy::Projected { .. });
-            let rotations = if holds && !self.rotations.is_empty() {
-                self.rotations.update(self.model, &self.dynamics, &self.momenta, q, v, true);
-                Some(&mut self.rotations)
+            let held = if holds && !self.held.is_empty() {
+                self.held.update(self.model, &self.dynamics, &self.momenta, q, v, true);
+                Some(&mut self.held)
             } else {
                 None
             };
-            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work, rotations };
+            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work, held };
             let (model, dynamics, momenta) = (self.model, &self.dynamics, &self.momenta);
             // The laws are compiled once per kind of mass, so that a constant
             // diagonal `M` runs its loops without a match per product
@@ -295,11 +296,12 @@ impl System for ControlledSystem<'_> {
     fn momentum(&mut self, j: usize, x: &[f64]) -> f64 {
         let (q, v, _) = split_state(x, self.model.n());
         let direction = match self.symmetries.direction(j) {
-            (_, Some(g)) => {
+            (_, Kind::Declared(i)) => return self.model.declared_invariants()[*i].value(q, v),
+            (_, Kind::Rotation(g)) => {
                 g.at(q, &mut self.turned);
                 &self.turned
             }
-            (e, None) => e,
+            (e, Kind::Constant) => e,
         };
         momentum::value(self.model, q, v, direction, &mut self.work)
     }
@@ -309,8 +311,8 @@ impl System for ControlledSystem<'_> {
         let (v, e) = rest.split_at_mut(n);
         let target = self.e0 + e[0];
         let (model, d) = (self.model, &mut self.dynamics);
-        let (momenta, rotations) = (&mut self.momenta, &mut self.rotations);
-        projection::invariants(model, d, momenta, rotations, q, v, t, target, h, settings, &mut self.projection)
+        let (momenta, held) = (&mut self.momenta, &mut self.held);
+        projection::invariants(model, d, momenta, held, q, v, t, target, h, settings, &mut self.projection)
     }
 }
 
