@@ -237,3 +237,40 @@ fn a_run_without_dependent_rows_reports_none() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(summary(dir.path())["cases"][0]["dependent_rows"].is_null());
 }
+
+/// `[[invariants]]` of kind `angular_momentum` on the free planar
+/// satellite: about any point it is kept (and printed first, as declared);
+/// a mistaken key or axis is a one-line error naming file and entry; under
+/// gravity it is broken, and the run warns with its drift.
+#[test]
+fn declared_angular_momenta_are_kept_refused_or_reported() {
+    let satellite = std::fs::read_to_string(examples().join("suite/satellite_planar.toml")).unwrap();
+    let declared = |entry: &str| format!("{satellite}\n[[invariants]]\nkind = \"angular_momentum\"\n{entry}");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mech.toml");
+    std::fs::write(&path, declared("point = [1.0, 2.0]\nname = \"L about (1, 2)\"\n")).unwrap();
+    let out = cdyn(&["run"], &path, &dir.path().join("out"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("keeps: L about (1, 2), linear momentum x, linear momentum y\n"), "{stdout}");
+    let momenta = &summary(&dir.path().join("out"))["cases"][0]["momenta"];
+    let held = momenta.as_array().unwrap().iter().find(|m| m["name"] == "L about (1, 2)").unwrap();
+    assert_eq!(held["kept"], true);
+    assert!(held["max_drift"].as_f64().unwrap() <= 1e-12 * held["scale"].as_f64().unwrap(), "{held}");
+    for (entry, needles) in [
+        ("pont = [0.0, 0.0]\n", &["invariants[0]", "pont"][..]),
+        ("axis = [1.0, 0.0, 0.0]\n", &["invariants[0]", "turns about z"][..]),
+        ("point = [0.0]\n", &["invariants[0]", "2 numbers"][..]),
+    ] {
+        let line = error_of(&declared(entry));
+        for n in needles {
+            assert!(line.contains(n), "{line:?} should mention {n:?}");
+        }
+    }
+    let heavy = declared("name = \"L_z\"\n").replace("gravity = [0.0, 0.0]", "gravity = [0.0, -9.81]");
+    std::fs::write(&path, heavy).unwrap();
+    let out = cdyn(&["run"], &path, &dir.path().join("heavy"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("warning: ") && stdout.contains("L_z is not kept"), "{stdout}");
+}

@@ -139,4 +139,3 @@ impl Generator {
         self.linear.iter().for_each(|&(r, c, w)| out[r as usize] += w * v[c as usize]);
     }
 }
-

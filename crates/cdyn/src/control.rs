@@ -2,8 +2,8 @@
 //! data (Eqs. 13, 19, 20–27, 28–40, 48–53) and the control term `U(x, t)`
 //! they add to the uncontrolled state equations.
 
-use crate::held::Held;
 use crate::error::{Result, non_negative, positive};
+use crate::held::Held;
 use crate::integrate::Application;
 use crate::mass::MassMatrix;
 use crate::momentum::Momenta;

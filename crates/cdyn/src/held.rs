@@ -157,7 +157,9 @@ impl Held {
                         model.kinetic_and_gradient(q, &self.energy_v, Some(buffer));
                     }
                     let scale = 0.5 / s;
-                    grad.iter_mut().zip(self.plus.iter().zip(&self.minus)).for_each(|(g, (p, m))| *g += scale * (p - m));
+                    grad.iter_mut()
+                        .zip(self.plus.iter().zip(&self.minus))
+                        .for_each(|(g, (p, m))| *g += scale * (p - m));
                 }
             }
         }
@@ -183,7 +185,8 @@ impl Held {
         let n = self.n;
         let (field, grad_v) = (&self.field[j * n..(j + 1) * n], &self.grad_v[j * n..(j + 1) * n]);
         let i = first + j;
-        if !(a[i * size + i] > 1e-12 * dot(field, grad_v)) {
+        let diagonal = a[i * size + i];
+        if diagonal.is_nan() || diagonal <= 1e-12 * dot(field, grad_v) {
             for l in 0..size {
                 a[i * size + l] = 0.0;
                 a[l * size + i] = 0.0;
@@ -358,7 +361,7 @@ pub(crate) fn solve_independent(a: &mut [f64], k: usize, b: &mut [f64], x: &mut 
                 }
             }
         }
-        if !(best.0 > DEPENDENT) {
+        if best.0.is_nan() || best.0 <= DEPENDENT {
             break;
         }
         rows.swap(rank, best.1);

@@ -3,10 +3,10 @@
 //! holonomic constraint elements, potentials and non-conservative forces.
 
 use crate::angular::Generator;
-use crate::invariant::{Declared, Invariant};
 use crate::constraint::{Constraint, ConstraintBlock, ConstraintGroup, ConstraintValues};
 use crate::error::{Error, Part, Problem, Result};
 use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
+use crate::invariant::{Declared, Invariant};
 use crate::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
 use crate::momentum::Direction;

@@ -24,8 +24,8 @@
 //! still decays at its rate (docs: "Corrections that keep the momenta").
 
 use crate::angular::Generator;
-use crate::held::MAX_HELD;
 use crate::dynamics::Dynamics;
+use crate::held::MAX_HELD;
 use crate::mass::MassMatrix;
 use crate::model::Model;
 

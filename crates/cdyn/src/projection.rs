@@ -14,9 +14,9 @@
 //! projected states of the last steps; nothing is re-evaluated (as
 //! manifold-projection callbacks of ODE libraries do).
 
-use crate::held::Held;
 use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Result, positive};
+use crate::held::Held;
 use crate::mass::MassMatrix;
 use crate::model::Model;
 use crate::momentum::Momenta;

@@ -1,12 +1,12 @@
 //! The controlled state equation `ẋ = f(x, t) + U(x, t)` of a model, with
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
-use crate::held::Held;
 use crate::control::{Control, Evaluation, Workspace};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::energy;
 use crate::gains::Operators;
+use crate::held::Held;
 use crate::integrate::{Buffer, Rhs};
 use crate::mass::{MassAt, MassMatrix};
 use crate::model::Model;

@@ -11,7 +11,9 @@ use cdyn::momentum::{self, Kind, ROUND_OFF};
 use cdyn::spatial::rotation::{about, body_rate, compose, e_matrix, rotate};
 use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
 use cdyn::system::{ControlledSystem, System};
-use cdyn::{Control, Energy, Geometric, Invariant, Model, Rate, Scalar, Scheme, Settings, Simulation, Velocity, methods};
+use cdyn::{
+    Control, Energy, Geometric, Invariant, Model, Rate, Scalar, Scheme, Settings, Simulation, Velocity, methods,
+};
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
