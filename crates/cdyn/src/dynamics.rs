@@ -21,6 +21,14 @@ pub struct Dynamics {
     lambda: Vec<f64>,
     acc: Vec<f64>,
     solver: Solver,
+    /// With a constant `M`, `S` depends on `(q, t)` alone: the positions and
+    /// time of its latest factorization, so that an evaluation at the same
+    /// ones (the next step's first, at the state the projection left)
+    /// solves with it instead of factoring again; the results are the same
+    /// to the bit.
+    factored_at: Option<f64>,
+    /// The positions of that factorization (allocated once).
+    factored_q: Vec<f64>,
 }
 
 /// How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied: decided by the model's mass.
@@ -251,12 +259,15 @@ impl Dynamics {
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
             solver,
+            factored_at: None,
+            factored_q: vec![0.0; n],
         }
     }
 
     /// Sets what a dependent constraint row does in the next evaluations
     /// (default: [`DependentRows::Error`]).
     pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.factored_at = None;
         match &mut self.solver {
             Solver::Constant(schur) => schur.set_dependent_rows(dependent),
             Solver::General(g) => g.schur.set_dependent_rows(dependent),
@@ -307,7 +318,16 @@ impl Dynamics {
             return Ok(());
         }
         match &mut self.solver {
-            Solver::Constant(schur) => schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
+            Solver::Constant(schur) => {
+                if self.factored_at == Some(t) && self.factored_q == q {
+                    schur.solve(&mut self.lambda);
+                } else {
+                    self.factored_at = None;
+                    schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
+                    self.factored_q.copy_from_slice(q);
+                    self.factored_at = Some(t);
+                }
+            }
             Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
             Solver::Blocks(b) => b.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
         }
