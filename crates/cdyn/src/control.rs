@@ -404,7 +404,17 @@ impl Control {
         momenta.project(u_q);
         momenta.project(u_v);
         match self.energy {
-            Energy::None => {}
+            // Without an energy law (robust's, left out where dampers are
+            // stiff) the held invariants decay at the constraints' rate: a
+            // damper between bodies changes none of them.
+            Energy::None => {
+                if let (Some(held), Geometric::Newton(rate)) = (work.held, self.geometric)
+                    && !held.is_empty()
+                    && rate.value() > 0.0
+                {
+                    held.hold(d, v, 0.0, rate.value(), 0.0, |_, _| false, u_q, u_v, [scratch, r_v], work.w);
+                }
+            }
             Energy::Gradient(gain) if !momenta.is_empty() => {
                 // Along P_E Ψ_vᵀ = P_E M v, the rate law's gain set on what that
                 // moves Ψ by, so that Ψ̇ = −α_e Ψ still holds.
