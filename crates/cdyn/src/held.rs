@@ -194,10 +194,11 @@ impl Held {
         }
     }
 
-    /// Moves the velocities along the `g_j` so that every `L_j` is back at
-    /// its target: exact, since `L` is linear in `v` at fixed `q`, and
-    /// `Φ_q g_j = 0` leaves `Φ̇` as it is. For the `projection` method, at a
-    /// state where [`update`](Self::update) was just called.
+    /// Moves the velocities along the `g_j` so that every `I_j` is back at
+    /// its target, leaving `Φ̇` as it is (`Φ_q g_j = 0`): exact for a
+    /// momentum, which is linear in `v` at fixed `q`, one Newton step for a
+    /// declared invariant. For the `projection` method, at a state where
+    /// [`update`](Self::update) was just called.
     pub(crate) fn restore(&self, v: &mut [f64]) {
         let k = self.len();
         let mut deviation = [0.0; MAX_HELD];
@@ -206,7 +207,8 @@ impl Held {
     }
 
     /// Makes `direction` (in the range of `P_E P`) M-orthogonal to the
-    /// `g_j`, so that a step along it leaves every `L_j` as it is.
+    /// `g_j`, so that a step along it leaves every `I_j` as it is (to first
+    /// order).
     pub(crate) fn orthogonalize(&self, direction: &mut [f64]) {
         let (k, n) = (self.len(), self.n);
         let mut along = [0.0; MAX_HELD];
@@ -214,7 +216,7 @@ impl Held {
         self.remove_along(&mut along[..k], direction);
     }
 
-    /// `x −= Σ κ_j g_j` with `W κ = rates`: what moves the `L_j` at `rates`.
+    /// `x −= Σ κ_j g_j` with `W κ = rates`: what moves the `I_j` at `rates`.
     fn remove_along(&self, rates: &mut [f64], x: &mut [f64]) {
         let (k, n) = (self.len(), self.n);
         let mut w = [0.0; MAX_HELD * MAX_HELD];
@@ -227,12 +229,13 @@ impl Held {
         }
     }
 
-    /// `robust`'s energy law with the angular momenta held beside it: adds
+    /// `robust`'s energy law with the held invariants beside it: adds
     /// `−κ₀ (c P_E P M⁻¹Ψ_q, P_E P v) − Σ κ_j (0, g_j)` to `U`, which holds
-    /// the other terms already, with `κ` such that `Ψ` and every `L_j − L_j⁰`
-    /// decay at the rate `alpha` under the whole control. `energy` is
-    /// whether the energy's direction may be used (not at rest). `rows` are
-    /// two scratch vectors of `m`, `w` one of `n`.
+    /// the other terms already, with `κ` such that `Ψ` and every `I_j − I_j⁰`
+    /// decay at the rate `alpha` under the whole control. `energy(N, 2T)`
+    /// says whether the energy's direction, of rate `N`, may be used (not at
+    /// rest, and not where the energy term is left out). `rows` are two
+    /// scratch vectors of `m`, `w` one of `n`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn hold<E: Evaluation>(
         &mut self,
@@ -297,7 +300,7 @@ impl Held {
         let mut kappa = [0.0; MAX_HELD + 1];
         solve_independent(&mut a[..size * size], size, &mut rhs[..size], &mut kappa[..size]);
         // Bounded corrections, as the energy law caps its gain: the energy's
-        // gain at most α, and the rotations' velocity change at most α |v|_M.
+        // gain at most α, and the held invariants' velocity change at most α |v|_M.
         let mut limit: f64 = 1.0;
         if kappa[0].abs() > alpha {
             limit = limit.min(alpha / kappa[0].abs());

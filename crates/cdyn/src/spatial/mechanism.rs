@@ -71,6 +71,9 @@ impl SpatialBody {
     }
 }
 
+/// How many ground joints' points the builder proposes rotations about.
+const MAX_PIVOTS: usize = 4;
+
 /// The names of a body's coordinates: `name.x`, `name.y`, `name.z`, `name.e0` … `name.e3`.
 pub fn coordinate_names(name: &str) -> [String; 7] {
     ["x", "y", "z", "e0", "e1", "e2", "e3"].map(|c| format!("{name}.{c}"))
@@ -228,12 +231,26 @@ impl Mechanism {
                 (0..self.bodies.len()).map(|i| (SpatialBody::of(i).first + axis, 1.0)).collect();
             builder = builder.momentum_candidate(name, &direction);
         }
-        // The rigid rotations about the axes through the origin.
-        for (axis, name) in axes.iter().enumerate() {
-            let (unit, name) =
-                (std::array::from_fn(|i| f64::from(u8::from(i == axis))), name.replace("linear", "angular"));
-            if let Ok(g) = Generator::rotation(&name, &names, unit, [0.0; 3], false) {
-                builder = builder.rotation_candidate(g);
+        // The rigid rotations about the axes through the origin, and through
+        // the first few points where a joint holds the mechanism to the
+        // ground (a pendulum keeps its momentum about its pivot).
+        let mut points = vec![[0.0; 3]];
+        for j in self.joints.iter().filter(|j| j.b.is_none()) {
+            let point = if j.kind == JointKind::Distance { j.point_b.unwrap_or(j.point) } else { j.point };
+            if points.len() < MAX_PIVOTS + 1 && point.iter().all(|x| x.is_finite()) && !points.contains(&point) {
+                points.push(point);
+            }
+        }
+        for point in points {
+            for (axis, name) in axes.iter().enumerate() {
+                let unit = std::array::from_fn(|i| f64::from(u8::from(i == axis)));
+                let mut name = name.replace("linear", "angular");
+                if point != [0.0; 3] {
+                    name += &format!(" about {point:?}");
+                }
+                if let Ok(g) = Generator::rotation(&name, &names, unit, point, false) {
+                    builder = builder.rotation_candidate(g);
+                }
             }
         }
         for (i, body) in self.bodies.iter().enumerate() {
