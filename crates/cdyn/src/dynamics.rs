@@ -25,7 +25,9 @@ pub struct Dynamics {
     /// time of its latest factorization, so that an evaluation at the same
     /// ones (the next step's first, at the state the projection left)
     /// solves with it instead of factoring again; the results are the same
-    /// to the bit.
+    /// to the bit. Kept only when asked ([`Dynamics::reuse_factorization`]):
+    /// copying `q` costs 2–3 % of a chain's step where nothing repeats.
+    reuse: bool,
     factored_at: Option<f64>,
     /// The positions of that factorization (allocated once).
     factored_q: Vec<f64>,
@@ -259,9 +261,18 @@ impl Dynamics {
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
             solver,
+            reuse: false,
             factored_at: None,
             factored_q: vec![0.0; n],
         }
+    }
+
+    /// Whether an evaluation at the positions and time of the latest
+    /// factorization of `S` reuses it (constant `M` only): worth it where
+    /// states repeat, as after a projection.
+    pub fn reuse_factorization(&mut self, on: bool) {
+        self.reuse = on;
+        self.factored_at = None;
     }
 
     /// Sets what a dependent constraint row does in the next evaluations
@@ -319,13 +330,15 @@ impl Dynamics {
         }
         match &mut self.solver {
             Solver::Constant(schur) => {
-                if self.factored_at == Some(t) && self.factored_q == q {
+                if self.reuse && self.factored_at == Some(t) && self.factored_q == q {
                     schur.solve(&mut self.lambda);
                 } else {
                     self.factored_at = None;
                     schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
-                    self.factored_q.copy_from_slice(q);
-                    self.factored_at = Some(t);
+                    if self.reuse {
+                        self.factored_q.copy_from_slice(q);
+                        self.factored_at = Some(t);
+                    }
                 }
             }
             Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,

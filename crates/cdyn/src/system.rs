@@ -132,10 +132,12 @@ impl<'m> ControlledSystem<'m> {
 
     /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ`.
     pub fn with_solver(model: &'m Model, control: Control, e0: f64, solver: LinearSolver) -> Self {
+        let mut dynamics = Dynamics::with_solver(model, solver);
+        dynamics.reuse_factorization(control.projection.is_some());
         Self {
             model,
             control,
-            dynamics: Dynamics::with_solver(model, solver),
+            dynamics,
             e0,
             rows: std::array::from_fn(|_| vec![0.0; model.m()]),
             work: vec![0.0; model.n()],
@@ -292,6 +294,7 @@ impl System for ControlledSystem<'_> {
         })
     }
     fn set_control(&mut self, control: Control) {
+        self.dynamics.reuse_factorization(control.projection.is_some());
         self.control = control;
     }
     fn symmetries(&self) -> &Symmetries {
