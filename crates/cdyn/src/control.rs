@@ -5,6 +5,7 @@
 use crate::error::{Result, non_negative, positive};
 use crate::held::Held;
 use crate::integrate::Application;
+use crate::linalg::dot;
 use crate::mass::MassMatrix;
 use crate::momentum::Momenta;
 use crate::projection::Projection;
@@ -298,6 +299,18 @@ impl Control {
         Self::default()
     }
 
+    /// Whether its terms hold the angular momenta and declared invariants
+    /// beside the energy ([`crate::held`]): the projected energy law, or
+    /// none with the coupled geometric gain (robust with its energy term
+    /// left out).
+    pub(crate) fn holds_invariants(&self) -> bool {
+        match self.energy {
+            Energy::Projected { .. } => true,
+            Energy::None => matches!(self.geometric, Geometric::Newton(_)),
+            _ => false,
+        }
+    }
+
     /// Whether any control term can be non-zero.
     pub fn is_active(&self) -> bool {
         self.geometric != Geometric::None || self.velocity != Velocity::None || self.energy != Energy::None
@@ -412,7 +425,8 @@ impl Control {
                     && !held.is_empty()
                     && rate.value() > 0.0
                 {
-                    held.hold(d, v, 0.0, rate.value(), 0.0, |_, _| false, u_q, u_v, [scratch, r_v], work.w);
+                    let no_energy = None::<fn(f64, f64) -> bool>;
+                    held.hold(d, v, 0.0, rate.value(), 0.0, no_energy, u_q, u_v, [scratch, r_v], work.w);
                 }
             }
             Energy::Gradient(gain) if !momenta.is_empty() => {
@@ -482,7 +496,7 @@ impl Control {
                         let c = position_weight / (alpha_e * alpha_e);
                         let free =
                             |norm: f64, whole: f64| norm > REST && (momenta.is_empty() || norm > RELATIVE_REST * whole);
-                        held.hold(d, v, psi, alpha_e, c, free, u_q, u_v, [a, b], work.w);
+                        held.hold(d, v, psi, alpha_e, c, Some(free), u_q, u_v, [a, b], work.w);
                     }
                     None => self.coupled_terms(d, v, psi, alpha_e, position_weight, u_q, u_v, rows, work.w),
                 }
@@ -573,7 +587,6 @@ impl Control {
         let (along, kept) = momenta.split(v);
         if energy {
             let y_v: &[f64] = if separate_y_v { y_v } else { z_dot };
-            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
             let phi_q_v = |r: usize| phi_dot[r] - phi_t[r];
             let grad = d.grad_potential();
             // The rate at which the other terms change Ψ (moving q through V,

@@ -16,16 +16,13 @@
 
 use crate::control::Evaluation;
 use crate::dynamics::Dynamics;
+use crate::linalg::dot;
 use crate::mass::MassMatrix;
 use crate::model::Model;
 use crate::momentum::{Kind, Momenta};
 
 /// The most invariants a run holds beside the energy.
 pub const MAX_HELD: usize = 6;
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
-}
 
 /// The invariants a run holds beside the energy, with their gradients and
 /// directions at the latest evaluation: `∂I_j/∂v`, `∂I_j/∂q`, the field
@@ -234,7 +231,7 @@ impl Held {
     /// the other terms already, with `κ` such that `Ψ` and every `I_j − I_j⁰`
     /// decay at the rate `alpha` under the whole control. `energy(N, 2T)`
     /// says whether the energy's direction, of rate `N`, may be used (not at
-    /// rest, and not where the energy term is left out). `rows` are two
+    /// rest); `None` where the energy term is left out. `rows` are two
     /// scratch vectors of `m`, `w` one of `n`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn hold<E: Evaluation>(
@@ -244,7 +241,7 @@ impl Held {
         psi: f64,
         alpha: f64,
         c: f64,
-        energy: impl Fn(f64, f64) -> bool,
+        energy: Option<impl Fn(f64, f64) -> bool>,
         u_q: &mut [f64],
         u_v: &mut [f64],
         [y_v, y_w]: [&mut [f64]; 2],
@@ -253,18 +250,24 @@ impl Held {
         let (k, n) = (self.len(), self.n);
         let (mass, momenta) = (d.mass(), d.momenta());
         let grad = d.grad_potential();
-        // The energy's direction: P_E P v and c P_E P M⁻¹Ψ_q.
-        let (phi_dot, phi_t) = (d.phi_dot(), d.phi_t());
-        y_v.iter_mut().zip(phi_dot).zip(phi_t).for_each(|((y, pd), pt)| *y = pd - pt);
-        mass.solve(grad, w);
-        d.jac_mul(w, y_w);
-        d.solve_many(&mut [&mut *y_v, &mut *y_w]);
-        self.energy_v.copy_from_slice(v);
-        self.energy_q.copy_from_slice(w);
-        d.add_weighted_jt_pair([y_v, y_w], [&mut self.energy_v, &mut self.energy_q]);
-        momenta.project(&mut self.energy_v);
-        momenta.project(&mut self.energy_q);
-        self.energy_q.iter_mut().for_each(|x| *x *= c);
+        // The energy's direction: P_E P v and c P_E P M⁻¹Ψ_q (none where the
+        // energy term is left out).
+        if energy.is_some() {
+            let (phi_dot, phi_t) = (d.phi_dot(), d.phi_t());
+            y_v.iter_mut().zip(phi_dot).zip(phi_t).for_each(|((y, pd), pt)| *y = pd - pt);
+            mass.solve(grad, w);
+            d.jac_mul(w, y_w);
+            d.solve_many(&mut [&mut *y_v, &mut *y_w]);
+            self.energy_v.copy_from_slice(v);
+            self.energy_q.copy_from_slice(w);
+            d.add_weighted_jt_pair([y_v, y_w], [&mut self.energy_v, &mut self.energy_q]);
+            momenta.project(&mut self.energy_v);
+            momenta.project(&mut self.energy_q);
+            self.energy_q.iter_mut().for_each(|x| *x *= c);
+        } else {
+            self.energy_v.fill(0.0);
+            self.energy_q.fill(0.0);
+        }
         // Rates of (Ψ, L_1 … L_k) along a change (δq, δv).
         let rate = |i: usize, dq: &[f64], dv: &[f64]| match i {
             0 => dot(grad, dq) + dot(&self.mass_v, dv),
@@ -287,7 +290,7 @@ impl Held {
         }
         // At rest, or with all the motion along the linear momenta, the
         // energy has no direction of its own: its row and column are left out.
-        if !energy(a[0], whole) {
+        if !energy.is_some_and(|free| free(a[0], whole)) {
             for j in 0..size {
                 a[j] = 0.0;
                 a[j * size] = 0.0;

@@ -643,6 +643,16 @@ impl Schur {
 /// The most right-hand sides [`Schur::solve_many`] takes at once.
 pub(crate) const MAX_RIGHT_HAND_SIDES: usize = 4;
 
+/// `a · b`, for the small dense products of the momentum code.
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// `|x|`.
+pub(crate) fn norm(x: &[f64]) -> f64 {
+    dot(x, x).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -26,6 +26,7 @@
 use crate::angular::Generator;
 use crate::dynamics::Dynamics;
 use crate::held::MAX_HELD;
+use crate::linalg::{dot, norm};
 use crate::mass::MassMatrix;
 use crate::model::Model;
 
@@ -184,14 +185,6 @@ fn sample_states(model: &Model, q0: &[f64], v0: &[f64]) -> Vec<(Vec<f64>, Vec<f6
         states.push((q, v, t));
     }
     states
-}
-
-fn norm(x: &[f64]) -> f64 {
-    x.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
 /// What breaks the symmetry along `e` (dense) at sample `s`, if anything.

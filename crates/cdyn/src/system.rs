@@ -221,11 +221,7 @@ impl Rhs for ControlledSystem<'_> {
             if self.momenta.stale() {
                 self.momenta.update(&self.dynamics.mass(self.model));
             }
-            let holds = match self.control.energy {
-                crate::control::Energy::Projected { .. } => true,
-                crate::control::Energy::None => matches!(self.control.geometric, crate::control::Geometric::Newton(_)),
-                _ => false,
-            };
+            let holds = self.control.holds_invariants();
             let held = if holds && !self.held.is_empty() {
                 self.held.update(self.model, &self.dynamics, &self.momenta, q, v, true);
                 Some(&mut self.held)
