@@ -6,7 +6,7 @@
 # drawn at t = 0; a compare's page and a page without a drawing load without
 # error or request too. Installs Debian's chromium when missing; skips (exit 0,
 # one line) where that cannot work: not root, no apt-get or no package registry.
-# `.ci/browser-test.sh --screenshot docs/viewer.png` also remakes the README's picture.
+# `.ci/browser-test.sh --screenshot docs/viewer.png` also remakes the picture of the README.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

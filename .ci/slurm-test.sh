@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The README's cluster path on a real scheduler: start a one-node SLURM
+# The cluster path of docs/sweeps.md on a real scheduler: start a one-node SLURM
 # cluster on this machine (munged, slurmctld, slurmd, all private to this
 # script: own socket, ports, spool and state directories), run
 # `cdyn sweep --shard $SLURM_ARRAY_TASK_ID/N` as an `sbatch --array` job,

@@ -1,7 +1,7 @@
 """The paper's Figs. 3-5 (Example 1: the unit pendulum in Cartesian
 coordinates, AB-3, h = 0.01, t in [0, 20]) from Python, with Matplotlib.
 
-    pip install matplotlib            # besides the cdyn package (see README, "From Python")
+    pip install matplotlib            # besides the cdyn package (see docs/python.md)
     python examples/paper_figures.py out/py-figures
 
 Runs every case of `cdyn paper` through `cdyn.example1()` and draws, for

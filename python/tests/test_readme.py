@@ -1,23 +1,26 @@
-"""The README's "From Python" example runs as written (from the repository root)."""
+"""The Python examples of the README and the book run as written (from the repository root)."""
 
 import contextlib
 import io
 import os
 import re
 
+import pytest
+
 from conftest import ROOT
 
 
-def test_the_readme_example_runs_and_prints_what_it_says():
-    text = (ROOT / "README.md").read_text()
-    section = text[text.index("## From Python") :]
+@pytest.mark.parametrize("page", ["README.md", "docs/python.md"])
+def test_the_python_examples_run_and_print_what_they_say(page):
+    text = (ROOT / page).read_text()
+    section = text[text.index("From Python") :]
     code = re.findall(r"```python\n(.*?)```", section, re.S)[0]
     out = io.StringIO()
     here = os.getcwd()
     os.chdir(ROOT)
     try:
         with contextlib.redirect_stdout(out):
-            exec(compile(code, "README.md", "exec"), {})
+            exec(compile(code, page, "exec"), {})
     finally:
         os.chdir(here)
     printed = out.getvalue().splitlines()

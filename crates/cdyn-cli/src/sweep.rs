@@ -86,7 +86,7 @@ fn max_threads(available: usize) -> usize {
 }
 
 /// The `--threads` to run with: `None` for one per core; a request above
-/// [`max_threads`] is capped with a notice on standard error.
+/// `max_threads` (4 per core, at most 256) is capped with a notice on standard error.
 pub fn worker_threads(requested: Option<usize>) -> Result<Option<usize>> {
     let Some(n) = requested else { return Ok(None) };
     if n == 0 {

@@ -155,7 +155,7 @@ pub enum Energy {
     },
     /// Steepest descent on `Ψ²` (Eqs. 20, 22, 44).
     Gradient(EnergyGain),
-    /// Gradient feedback that respects the constraints (README, "Energy
+    /// Gradient feedback that respects the constraints (docs/methods.md, "Energy
     /// control that respects the constraints"): along `g_v = P v` and
     /// `g_q = c P M⁻¹ ∇V`, with `P = I − M⁻¹Φ_qᵀ(Φ_q M⁻¹ Φ_qᵀ)⁻¹Φ_q`, scaled
     /// so that `Ψ̇ = −α_e Ψ`. `Φ_q U_q = Φ_q U_v = 0` exactly, and the gain
@@ -188,7 +188,7 @@ pub enum Invariants {
 }
 
 /// The default `position_weight` of [`Energy::Projected`]: `c = 16/α_e²`,
-/// the suite's choice (README).
+/// the suite's choice (docs/methods.md).
 pub const POSITION_WEIGHT: f64 = 16.0;
 
 /// A complete stabilization method: one row of the table in `equations.md`,
@@ -516,7 +516,7 @@ impl Control {
     /// * `U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v`,
     ///
     /// with `z_x = S⁻¹x`, `y_v = S⁻¹Φ_q v`, `y_w = S⁻¹Φ_q w`: these are the
-    /// laws of the README, `P v = v − M⁻¹Φ_qᵀ y_v`, `|Pv|²_M = vᵀMv − (Φ_q v)·y_v`.
+    /// laws of docs/methods.md, `P v = v − M⁻¹Φ_qᵀ y_v`, `|Pv|²_M = vᵀMv − (Φ_q v)·y_v`.
     /// Without drives (`Φ_t = 0`) `Φ_q v = Φ̇`, so `y_v = z_Φ̇` and one
     /// right-hand side is saved.
     #[allow(clippy::too_many_arguments)]
@@ -610,7 +610,7 @@ impl Control {
             // gradient is too short to reach the target without the quadratic
             // terms dominating (N < |target|/α_e: a static equilibrium, or at
             // rest at an extremum of V on the constraint surface) the gain is
-            // capped so that |U| stays bounded (README).
+            // capped so that |U| stays bounded (docs/methods.md).
             let scale = target / norm.max(target.abs() / alpha_e);
             let relative = momenta.is_empty() || norm > RELATIVE_REST * whole;
             if norm > REST && relative && scale.is_finite() {

@@ -486,7 +486,7 @@ impl Dynamics {
     pub fn gamma(&self) -> &[f64] {
         &self.constraints.gamma
     }
-    /// Values of `Φ_q` in the model's [`Pattern`] order.
+    /// Values of `Φ_q` in the model's [`Pattern`](crate::sparse::Pattern) order.
     pub fn jac(&self) -> &[f64] {
         &self.constraints.jac
     }

@@ -47,12 +47,12 @@ pub const STIFF_DISSIPATION_H: f64 = 0.01;
 /// What the automatic gains are chosen from, at the initial state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Operators {
-    /// `μ_max` of the paper's CVSGF operator ([`coupling`]).
+    /// `μ_max` of the paper's CVSGF operator (`coupling` in this module).
     pub coupling: f64,
     /// The largest `|∇Φᵢ|²`, for a fixed `ζ`.
     pub max_row_norm2: f64,
     /// `λ_d`, the fastest damping of the non-conservative forces
-    /// ([`dissipation_rate`]).
+    /// (`dissipation_rate` in this module).
     pub dissipation: f64,
 }
 

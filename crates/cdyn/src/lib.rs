@@ -1,5 +1,5 @@
 #![doc = include_str!("../../../README.md")]
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 /// Runs `$body` with the const `$k` equal to the run-time `$n`, one of the
 /// listed values: code generic over a small size (an element's coordinates,
@@ -16,6 +16,11 @@ macro_rules! with_const {
     };
 }
 pub(crate) use with_const;
+
+/// The book's Rust examples (`docs/library.md`), compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/library.md")]
+pub struct BookLibrary;
 
 pub mod angular;
 pub mod assemble;

@@ -439,7 +439,7 @@ pub fn independent_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
 }
 
 /// The `robust` preset: the combination the method suite shows best
-/// (README, "Choosing a method"), every rate automatic, applied by a
+/// (docs/methods.md, "Choosing a method"), every rate automatic, applied by a
 /// forward Euler step: CVSGF with the coupled gain, velocity feedback on
 /// `Φ̇`, and energy control that respects the constraints.
 pub fn robust() -> Control {

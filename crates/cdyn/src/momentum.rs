@@ -14,7 +14,7 @@
 //! and every explicit scheme keeps it to round-off; so does `eᵀ M q − p t`
 //! (the centre of mass moves on a straight line). A control term `U`
 //! keeps them too exactly when `Eᵀ M U_q = 0` and `Eᵀ M U_v = 0`: it is
-//! M-orthogonal to the momentum directions. [`Momenta::project`] applies
+//! M-orthogonal to the momentum directions. `Momenta::project` applies
 //! the M-orthogonal projector `P_E = I − E (EᵀME)⁻¹ EᵀM` onto that
 //! complement. Since `Φ_q E = 0`, `Φ_q P_E U = Φ_q U`: projecting a
 //! correction changes nothing of what it does to the constraints.

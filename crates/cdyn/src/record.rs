@@ -263,7 +263,7 @@ impl Series {
 /// What a recorded run produced. With the `serde` feature it serializes
 /// under the names summaries have always used (the paper's error is in `X`:
 /// `max_abs_err_x`, `err_x_final`, `rhs_evals`), infinities and NaN as
-/// strings ([`crate::json_float`]); the series and the error are left to
+/// strings (`cdyn::json_float`, with the `serde` feature); the series and the error are left to
 /// the caller.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]

@@ -1054,7 +1054,7 @@ fn judged(built: &Built, x: &[f64], reference: &[f64]) -> [f64; 4] {
 
 /// Renormalization against cdyn's methods, on the heavy top, the
 /// precessing top, a free body and a chain of five rods, with AB-3 and
-/// RK-4 (the table is printed for the README). Every kind holds `|p| = 1`
+/// RK-4 (the table is printed for docs/library.md, "Spatial systems"). Every kind holds `|p| = 1`
 /// exactly, as `robust` and `projection` do, but leaves the joints and the
 /// energy as without control. On the spinning tops with AB-3, plain
 /// renormalization makes the motion worse than no control at all (heavy

@@ -34,7 +34,7 @@ pub enum FourBarBranch {
 /// reaching a toggle position: `|b − c| < d − a` and `d + a < b + c`
 /// (Grashof, crank shortest and adjacent to the ground).
 ///
-/// As for [`SliderCrankParams`], the driven linkage has no free motion of
+/// As for [`SliderCrankParams`](super::SliderCrankParams), the driven linkage has no free motion of
 /// its own; an optional `load` pendulum hanging from joint C adds one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]

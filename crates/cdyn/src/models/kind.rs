@@ -24,7 +24,7 @@ pub enum Kind {
     PendulumTheta,
     /// A planar mechanism described body by body and joint by joint
     /// ([`Mechanism`](crate::planar::Mechanism)): not built from parameters,
-    /// so [`Kind::example`] refuses it.
+    /// so `Kind::example` refuses it.
     Mechanism,
     /// A spatial mechanism described body by body and joint by joint
     /// ([`spatial::Mechanism`](crate::spatial::Mechanism)): not built from

@@ -24,7 +24,7 @@
 //! do. Gravity acts along −Y.
 //!
 //! Every built-in model has a [`Kind`], the name scenario files give it;
-//! [`Kind::example`] builds it from its parameters (with the `serde` feature).
+//! `Kind::example` builds it from its parameters (with the `serde` feature).
 //!
 //! Fine references: where no closed form exists, a 1-D equation of motion
 //! is integrated by [`crate::reference`]'s fine RK-4 (error about 1e-13).

@@ -1,0 +1,165 @@
+//! The README and the book stay true: every scenario they show runs, the
+//! README's commands do what it says, `cdyn paper` prints the README's
+//! table to the last digit, and every link between the pages resolves.
+
+#[allow(dead_code)] // each test file uses some of the helpers
+mod common;
+
+use common::{cdyn, path_str, scenario};
+use std::path::{Path, PathBuf};
+
+/// The repository's root.
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// README.md and every page of the book, with their paths from the root.
+fn pages() -> Vec<(String, String)> {
+    let mut pages = vec![("README.md".to_string(), std::fs::read_to_string(root().join("README.md")).unwrap())];
+    let mut book: Vec<_> = std::fs::read_dir(root().join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    book.sort();
+    for p in book {
+        let name = format!("docs/{}", p.file_name().unwrap().to_string_lossy());
+        pages.push((name, std::fs::read_to_string(&p).unwrap()));
+    }
+    pages
+}
+
+/// The fenced blocks of `lang` in `text`, in order.
+fn blocks<'a>(text: &'a str, lang: &str) -> Vec<&'a str> {
+    let open = format!("```{lang}\n");
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(start) = rest.find(&open) {
+        let body = &rest[start + open.len()..];
+        let end = body.find("```").expect("a closed block");
+        out.push(&body[..end]);
+        rest = &body[end + 3..];
+    }
+    out
+}
+
+#[test]
+fn every_scenario_in_the_readme_and_the_book_runs() {
+    let mut count = 0;
+    for (page, text) in pages() {
+        for (i, block) in blocks(&text, "toml").into_iter().enumerate() {
+            // A snippet that shows only the model's keys runs for ten steps.
+            let mut text = block.to_string();
+            if !text.contains("[integrator]") {
+                text.push_str("\n[integrator]\nscheme = \"rk4\"\nh = 0.01\nt_end = 0.1\n");
+            }
+            let (dir, file) = scenario("snippet.toml", &text);
+            let out = cdyn(&["run", path_str(&file), "--out", path_str(&dir.join("out"))]);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "{page}, TOML block {}: {stderr}", i + 1);
+            count += 1;
+        }
+    }
+    assert!(count >= 4, "only {count} scenario blocks found");
+}
+
+#[test]
+fn the_readme_first_scenario_runs_as_its_command_says() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let section = &readme[readme.find("## A first scenario").unwrap()..];
+    let toml = blocks(section, "toml")[0];
+    let command = blocks(section, "sh")[0].trim();
+    let args: Vec<&str> = command.split_whitespace().collect();
+    assert_eq!(args[..2], ["cdyn", "run"], "{command}");
+    let (dir, _) = scenario(args[2], toml);
+    let out =
+        std::process::Command::new(env!("CARGO_BIN_EXE_cdyn")).args(&args[1..]).current_dir(&dir).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out_dir = dir.join(args[args.iter().position(|&a| a == "--out").unwrap() + 1]);
+    let stem = Path::new(args[2]).file_stem().unwrap().to_string_lossy();
+    for file in [format!("{stem}.csv"), "summary.json".into(), "report.html".into(), "phi.png".into(), "psi.png".into()]
+    {
+        assert!(out_dir.join(&file).is_file(), "{file} not written");
+    }
+    // What the README says it printed.
+    let printed = String::from_utf8_lossy(&out.stdout);
+    let row = printed.lines().find(|l| l.starts_with(&*stem)).unwrap();
+    let values: Vec<f64> = row.split_whitespace().skip(1).take(2).map(|x| x.parse().unwrap()).collect();
+    assert!(values[0] < 1e-15 && values[1] < 1e-13, "{row}");
+}
+
+#[test]
+fn cdyn_paper_prints_the_readme_table_to_the_last_digit() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let table = blocks(&readme, "text")[0];
+    let dir = tempfile::tempdir().unwrap();
+    let out = cdyn(&["paper", "--out", path_str(dir.path())]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let printed = String::from_utf8_lossy(&out.stdout);
+    for line in table.lines() {
+        assert!(printed.lines().any(|p| p == line), "not printed by cdyn paper: {line}\n{printed}");
+    }
+}
+
+/// GitHub's anchor of a heading: lower case, punctuation dropped, spaces as `-`.
+fn anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The anchors of the headings of a Markdown page (outside code blocks).
+fn anchors(text: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && line.starts_with('#') {
+            out.push(anchor(line.trim_start_matches('#')));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_link_between_the_pages_resolves() {
+    let mut checked = 0;
+    for (page, text) in pages() {
+        let base = root().join(&page).parent().unwrap().to_path_buf();
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("](") {
+            let tail = &rest[at + 2..];
+            let end = tail.find(')').unwrap();
+            let target = &tail[..end];
+            rest = &tail[end..];
+            if target.starts_with("http") || target.contains(' ') {
+                continue;
+            }
+            let (file, fragment) = target.split_once('#').unwrap_or((target, ""));
+            let path = if file.is_empty() { root().join(&page) } else { base.join(file) };
+            assert!(path.exists(), "{page}: link to {target}: no such file");
+            if !fragment.is_empty() {
+                let linked = std::fs::read_to_string(&path).unwrap();
+                assert!(anchors(&linked).iter().any(|a| a == fragment), "{page}: link to {target}: no such heading");
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "only {checked} links found");
+}
+
+#[test]
+fn the_book_lists_every_page_and_the_readme_stays_short() {
+    let summary = std::fs::read_to_string(root().join("docs/SUMMARY.md")).unwrap();
+    for (page, _) in pages().iter().filter(|(p, _)| p.starts_with("docs/") && *p != "docs/SUMMARY.md") {
+        let name = page.trim_start_matches("docs/");
+        assert!(summary.contains(&format!("]({name})")), "docs/SUMMARY.md does not list {name}");
+    }
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    assert!(readme.lines().count() <= 250, "README.md has {} lines", readme.lines().count());
+}
