@@ -370,12 +370,10 @@ fn chain_example(n: usize) -> Result<Example> {
 
 /// The chain's control: CVSGF + energy with hα_g = hα_e = 0.4, by forward Euler.
 fn chain_control(h: f64) -> Control {
-    Control {
-        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-        application: Application::ForwardEuler,
-        ..Control::none()
-    }
+    Control::none()
+        .with_geometric(Geometric::Gradient(Gain::Rate(0.4 / h)))
+        .with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }))
+        .with_application(Application::ForwardEuler)
 }
 
 /// [`compare_methods`] on Example 1 and on the chain.

@@ -402,7 +402,7 @@ impl Scenario {
             ),
             other => integrator(other),
         })?;
-        let mut settings = Settings { dependent_rows: i.dependent_rows, ..Settings::new(i.scheme, h, control) };
+        let mut settings = Settings::new(i.scheme, h, control).with_dependent_rows(i.dependent_rows);
         let init = &self.initial;
         if let Some(tol) = init.tolerance {
             settings.consistency_tolerance =

@@ -18,7 +18,7 @@ use crate::terminal::print;
 use anyhow::{Context, Result, anyhow};
 use cdyn::json_float::JsonFloat;
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
-use cdyn::{Control, Scheme, Settings, Simulation};
+use cdyn::{Control, Scheme, Simulation};
 use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::json;
@@ -276,7 +276,7 @@ fn run_model(model: &Model) -> Result<Vec<Group>> {
 /// Positions of the model without control, RK-4 at `interval / 20`, at `t = k·interval`.
 fn reference(case: &Case, interval: f64, t_end: f64) -> cdyn::Result<Vec<Vec<f64>>> {
     let h = interval / REFERENCE_DIVISOR as f64;
-    let settings = Settings { scheme: Scheme::RungeKutta4, h, control: Control::none(), ..case.settings };
+    let settings = case.settings.with_scheme(Scheme::RungeKutta4).with_h(h).with_control(Control::none());
     let ex = &case.example;
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
     let mut samples = Vec::new();

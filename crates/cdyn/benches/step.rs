@@ -95,12 +95,10 @@ fn chains(c: &mut Criterion) {
         sizes.push(10_000);
     }
     let h = 1e-3;
-    let cvsgf_energy = Control {
-        geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-        application: Application::ForwardEuler,
-        ..Control::none()
-    };
+    let cvsgf_energy = Control::none()
+        .with_geometric(Geometric::Gradient(Gain::Rate(0.4 / h)))
+        .with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }))
+        .with_application(Application::ForwardEuler);
     let examples: Vec<_> = sizes
         .iter()
         .map(|&n| chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 }).unwrap())

@@ -192,9 +192,21 @@ pub enum Invariants {
 pub const POSITION_WEIGHT: f64 = 16.0;
 
 /// A complete stabilization method: one row of the table in `equations.md`,
-/// plus velocity-level feedback.
+/// plus velocity-level feedback. Built from [`Control::none`],
+/// [`Control::robust`] or [`Control::projection`] and the `with_*` setters:
+///
+/// ```
+/// use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+/// // The paper's CVSGF + energy control, Eq. 51.
+/// let paper = Control::none()
+///     .with_geometric(Geometric::Gradient(Gain::Rate(40.0)))
+///     .with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e: 40.0 }))
+///     .with_application(Application::ForwardEuler);
+/// assert!(paper.is_active() && paper.projection.is_none());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub struct Control {
     /// Control of the holonomic constraints.
     pub geometric: Geometric,
@@ -293,10 +305,35 @@ const REST: f64 = 1e-30;
 /// it is round-off (a rigid translation), and the law is skipped.
 const RELATIVE_REST: f64 = 1e-12;
 
+crate::setters!(Control {
+    /// With this control of the holonomic constraints.
+    with_geometric => geometric: Geometric,
+    /// With this velocity-level feedback.
+    with_velocity => velocity: Velocity,
+    /// With this control of the energy constraint.
+    with_energy => energy: Energy,
+    /// With the control term integrated here.
+    with_application => application: Application,
+    /// With (`Some`) or without an exact projection after every step.
+    with_projection => projection: Option<Projection>,
+    /// With the corrections keeping the momenta, or free of them.
+    with_invariants => invariants: Invariants,
+});
+
 impl Control {
     /// No control at all (Eq. 8).
     pub fn none() -> Self {
         Self::default()
+    }
+
+    /// The `robust` preset ([`crate::methods::robust`]).
+    pub fn robust() -> Self {
+        crate::methods::robust()
+    }
+
+    /// The `projection` method with its default settings ([`crate::methods::projection`]).
+    pub fn projection() -> Self {
+        crate::methods::projection()
     }
 
     /// Whether its terms hold the angular momenta and declared invariants

@@ -17,6 +17,25 @@ macro_rules! with_const {
 }
 pub(crate) use with_const;
 
+/// Builder-style setters, `with_<field>(value) -> Self`, for the fields of a
+/// configuration type that users build: with the type `#[non_exhaustive]`,
+/// a new field is then not a breaking change.
+macro_rules! setters {
+    ($ty:ty { $($(#[$doc:meta])* $name:ident => $field:ident: $t:ty),+ $(,)? }) => {
+        impl $ty {
+            $(
+                $(#[$doc])*
+                #[must_use]
+                pub fn $name(mut self, value: $t) -> Self {
+                    self.$field = value;
+                    self
+                }
+            )+
+        }
+    };
+}
+pub(crate) use setters;
+
 /// The book's Rust examples (`docs/library.md`), compiled and run as doctests.
 #[cfg(doctest)]
 #[doc = include_str!("../../../docs/library.md")]

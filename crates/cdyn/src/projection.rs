@@ -40,6 +40,7 @@ pub enum OnFailure {
 /// Settings of the exact projection (the `projection` method).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub struct Projection {
     /// `|Φ|` and `|Φ̇|` are brought below this, and `|Ψ|` below this times
     /// `max(1, T + |V|)` (`Ψ` is a difference of energies).
@@ -73,7 +74,25 @@ impl Default for Projection {
     }
 }
 
+crate::setters!(Projection {
+    /// With this tolerance on `|Φ|`, `|Φ̇|` and the relative `|Ψ|`.
+    with_tolerance => tolerance: f64,
+    /// With at most this many Newton iterations per step.
+    with_max_iterations => max_iterations: u32,
+    /// Stopping or continuing when the iterations do not converge.
+    with_on_failure => on_failure: OnFailure,
+    /// With `Ψ` projected too, or not.
+    with_energy => energy: bool,
+    /// With `Ψ`'s error shared between velocities and positions by this `c α_e²`.
+    with_position_weight => position_weight: f64,
+});
+
 impl Projection {
+    /// The default settings ([`Projection::default`]).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
     /// Checks the tolerance is positive and the iteration cap not zero.
     pub fn validate(&self) -> Result<()> {
         positive("tolerance", self.tolerance)?;

@@ -15,8 +15,9 @@ use crate::momentum::{self, Symmetries};
 use crate::projection::{Failure, OnFailure};
 use crate::system::{ControlledSystem, EvalError, System};
 
-/// How to simulate.
+/// How to simulate: [`Settings::new`] and the `with_*` setters.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Settings {
     /// The fixed-step scheme.
     pub scheme: Scheme,
@@ -34,6 +35,23 @@ pub struct Settings {
     /// is solved around (redundant constraints, singular positions).
     pub dependent_rows: DependentRows,
 }
+
+crate::setters!(Settings {
+    /// With this scheme.
+    with_scheme => scheme: Scheme,
+    /// With this step size.
+    with_h => h: f64,
+    /// With this stabilization method.
+    with_control => control: Control,
+    /// With the initial state checked to this `|Φ|, |Φ̇|`, or not checked (`None`).
+    with_consistency_tolerance => consistency_tolerance: Option<f64>,
+    /// Stopping when `max |Φ|` exceeds this.
+    with_violation_limit => violation_limit: f64,
+    /// With this factorization of `Φ_q M⁻¹ Φ_qᵀ`.
+    with_solver => solver: LinearSolver,
+    /// With dependent constraint rows an error or solved around.
+    with_dependent_rows => dependent_rows: DependentRows,
+});
 
 impl Settings {
     /// These choices, a consistency tolerance of 1e-9, no violation limit

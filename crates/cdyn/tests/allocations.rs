@@ -127,7 +127,7 @@ fn controls() -> Vec<Control> {
             [Energy::None, Energy::Gradient(EnergyGain::Rate { alpha_e: 40.0 }), Energy::Baumgarte { eta: 40.0 }]
         {
             for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-                out.push(Control { geometric, energy, application, ..Control::none() });
+                out.push(Control::none().with_geometric(geometric).with_energy(energy).with_application(application));
             }
         }
     }
@@ -151,7 +151,13 @@ fn robust_controls() -> Vec<Control> {
         (Geometric::Gradient(Gain::Auto), Velocity::Gradient(Rate::Auto), projected(Rate::Auto, POSITION_WEIGHT)),
     ] {
         for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-            out.push(Control { geometric, velocity, energy, application, ..Control::none() });
+            out.push(
+                Control::none()
+                    .with_geometric(geometric)
+                    .with_velocity(velocity)
+                    .with_energy(energy)
+                    .with_application(application),
+            );
         }
     }
     out.push(methods::robust());
@@ -162,8 +168,8 @@ fn robust_controls() -> Vec<Control> {
 /// converges and goes on (its failure path must not allocate either).
 fn projections() -> [Control; 2] {
     let failing =
-        Projection { tolerance: 1e-30, max_iterations: 2, on_failure: OnFailure::Continue, ..Projection::default() };
-    [methods::projection(), Control { projection: Some(failing), ..Control::none() }]
+        Projection::default().with_tolerance(1e-30).with_max_iterations(2).with_on_failure(OnFailure::Continue);
+    [methods::projection(), Control::none().with_projection(Some(failing))]
 }
 
 /// Allocations during `steps` steps (and samples) after `warm_up` steps.
@@ -219,11 +225,11 @@ fn steps_do_not_allocate() {
             assert_eq!(n, 0, "tractor and trailer, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
         // Rates with hα = 0.4, as in the paper.
-        let control = |h: f64| Control {
-            geometric: Geometric::Gradient(Gain::Rate(0.4 / h)),
-            energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }),
-            application: Application::ForwardEuler,
-            ..Control::none()
+        let control = |h: f64| {
+            Control::none()
+                .with_geometric(Geometric::Gradient(Gain::Rate(0.4 / h)))
+                .with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e: 0.4 / h }))
+                .with_application(Application::ForwardEuler)
         };
         let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, control(1e-5)), 5, 200);
         assert_eq!(n, 0, "andrews, {scheme:?}: {n} allocations in 200 steps");
@@ -261,11 +267,11 @@ fn steps_do_not_allocate() {
         }
         for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
             for control in [methods::robust()].into_iter().chain(projections()) {
-                let settings = Settings { solver, ..Settings::new(scheme, 1e-3, control) };
+                let settings = Settings::new(scheme, 1e-3, control).with_solver(solver);
                 let n = allocations_per_run(&chain, settings, 5, 200);
                 assert_eq!(n, 0, "chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
                 // A dependent row dropped at every step allocates nothing either.
-                let settings = Settings { dependent_rows: DependentRows::Tolerate, ..settings };
+                let settings = settings.with_dependent_rows(DependentRows::Tolerate);
                 let n = allocations_per_run(&redundant, settings, 5, 200);
                 assert_eq!(n, 0, "redundant chain, {scheme:?}, {solver:?}, {control:?}: {n} allocations in 200 steps");
             }

@@ -132,15 +132,13 @@ fn invariants(system: &mut ControlledSystem<'_>, model: &Model, x: &[f64], e0: f
 #[test]
 fn robust_restores_the_energy_and_each_angular_momentum_at_their_rate() {
     let alpha = 15.0;
-    let robust = Control {
-        geometric: Geometric::Newton(Rate::Given(20.0)),
-        velocity: Velocity::Gradient(Rate::Given(10.0)),
-        energy: Energy::Projected { alpha_e: Rate::Given(alpha), position_weight: 16.0 },
-        ..Control::none()
-    };
+    let robust = Control::none()
+        .with_geometric(Geometric::Newton(Rate::Given(20.0)))
+        .with_velocity(Velocity::Gradient(Rate::Given(10.0)))
+        .with_energy(Energy::Projected { alpha_e: Rate::Given(alpha), position_weight: 16.0 });
     // robust with its energy term left out (stiff dampers): the angular
     // momenta decay at the constraints' rate α_g, Ψ is left alone.
-    let left_out = Control { geometric: Geometric::Newton(Rate::Given(alpha)), energy: Energy::None, ..robust };
+    let left_out = robust.with_geometric(Geometric::Newton(Rate::Given(alpha))).with_energy(Energy::None);
     let cases = [
         ("free body", free_body(), robust),
         ("heavy top", top([0.0; 3], [0.0, 0.0, -9.81]), robust),

@@ -193,7 +193,7 @@ fn the_energy_controls_set_the_same_decay_of_psi_in_both_coordinates() {
             for ex in [double_pendulum_angles(p).unwrap(), double_pendulum(p).unwrap()] {
                 let model = &ex.model;
                 let e0 = model.kinetic(&ex.q0, &ex.v0) + model.potential(&ex.q0, None) + 0.05;
-                let mut system = ControlledSystem::new(model, Control { energy, ..Control::none() }, e0);
+                let mut system = ControlledSystem::new(model, Control::none().with_energy(energy), e0);
                 let x: Vec<f64> = ex.q0.iter().chain(&ex.v0).copied().chain([0.0]).collect();
                 let (mut f, mut u) = (vec![0.0; x.len()], vec![0.0; x.len()]);
                 system.eval(&x, 0.0, &mut f, Some(&mut u)).unwrap();

@@ -20,7 +20,7 @@ const G: f64 = 9.81;
 
 /// Settings that also insist on an initial state on the constraints to 1e-12.
 fn settings(scheme: Scheme, h: f64, control: Control) -> Settings {
-    Settings { consistency_tolerance: Some(1e-12), ..Settings::new(scheme, h, control) }
+    Settings::new(scheme, h, control).with_consistency_tolerance(Some(1e-12))
 }
 
 /// The end time a run of steps `h` towards `t` reaches: the first whole

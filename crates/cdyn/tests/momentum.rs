@@ -107,14 +107,12 @@ fn laws() -> Vec<(&'static str, Control)> {
     let mut laws: Vec<(&'static str, Control)> = methods::redundant_cases(&g).into_iter().skip(1).collect();
     laws.push((
         "newton + velocity + projected",
-        Control {
-            geometric: Geometric::Newton(Rate::Given(20.0)),
-            velocity: Velocity::Gradient(Rate::Given(10.0)),
-            energy: Energy::Projected { alpha_e: Rate::Given(15.0), position_weight: 16.0 },
-            ..Control::none()
-        },
+        Control::none()
+            .with_geometric(Geometric::Newton(Rate::Given(20.0)))
+            .with_velocity(Velocity::Gradient(Rate::Given(10.0)))
+            .with_energy(Energy::Projected { alpha_e: Rate::Given(15.0), position_weight: 16.0 }),
     ));
-    laws.push(("energy (baumgarte)", Control { energy: Energy::Baumgarte { eta: 12.0 }, ..Control::none() }));
+    laws.push(("energy (baumgarte)", Control::none().with_energy(Energy::Baumgarte { eta: 12.0 })));
     laws
 }
 
@@ -143,7 +141,7 @@ fn every_correction_is_m_orthogonal_to_the_momenta_at_random_states() {
     let e0 = model.kinetic(&q, &v) + model.potential(&q, None);
     for (name, control) in laws() {
         for free in [false, true] {
-            let control = Control { invariants: if free { Invariants::Free } else { Invariants::Keep }, ..control };
+            let control = control.with_invariants(if free { Invariants::Free } else { Invariants::Keep });
             let mut system = ControlledSystem::new(&model, control, e0);
             system.set_symmetries(symmetries.clone());
             let mut worst_free: f64 = 0.0;
@@ -186,7 +184,7 @@ fn the_energy_is_restored_at_its_rate_with_the_momenta_kept() {
         ("baumgarte", Energy::Baumgarte { eta: alpha_e }),
     ] {
         let e0 = model.kinetic(&q, &v) + model.potential(&q, None) - 0.05;
-        let mut system = ControlledSystem::new(&model, Control { energy, ..Control::none() }, e0);
+        let mut system = ControlledSystem::new(&model, Control::none().with_energy(energy), e0);
         system.set_symmetries(symmetries.clone());
         let mut x: Vec<f64> = q.iter().chain(&v).copied().collect();
         x.push(0.0);

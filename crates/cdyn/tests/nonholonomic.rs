@@ -239,11 +239,11 @@ fn run(
 }
 
 fn baumgarte() -> Control {
-    Control { geometric: Geometric::Baumgarte { alpha: 20.0, beta: 100.0 }, ..Control::none() }
+    Control::none().with_geometric(Geometric::Baumgarte { alpha: 20.0, beta: 100.0 })
 }
 
 fn velocity_feedback(application: Application) -> Control {
-    Control { velocity: Velocity::Gradient(Rate::Auto), application, ..Control::none() }
+    Control::none().with_velocity(Velocity::Gradient(Rate::Auto)).with_application(application)
 }
 
 #[test]
@@ -253,7 +253,7 @@ fn sled_on_an_incline_follows_its_closed_form_with_and_without_control() {
     let cases = [
         ("none", Control::none()),
         ("baumgarte", baumgarte()),
-        ("velocity (rhs)", Control { velocity: Velocity::Gradient(Rate::Given(50.0)), ..Control::none() }),
+        ("velocity (rhs)", Control::none().with_velocity(Velocity::Gradient(Rate::Given(50.0)))),
         ("velocity (post-step)", velocity_feedback(Application::PostStep)),
         ("robust", methods::robust()),
         ("projection", methods::projection()),

@@ -141,7 +141,9 @@ fn all_controls() -> Vec<Control> {
                 for a in
                     [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler, Application::PostStep]
                 {
-                    out.push(Control { geometric: g, velocity, energy: e, application: a, ..Control::none() });
+                    out.push(
+                        Control::none().with_geometric(g).with_velocity(velocity).with_energy(e).with_application(a),
+                    );
                 }
             }
         }
@@ -244,7 +246,7 @@ fn fitted_rate(samples: &[(f64, f64)]) -> f64 {
 #[test]
 fn cvsgf_decays_a_perturbation_at_the_target_rate() {
     for alpha_g in [5.0, 20.0] {
-        let c = Control { geometric: Geometric::Gradient(Gain::Rate(alpha_g)), ..Control::none() };
+        let c = Control::none().with_geometric(Geometric::Gradient(Gain::Rate(alpha_g)));
         let run = perturbed_run(c, 1.0 + 1e-4, 1.0, 0.5);
         let rate = fitted_rate(&run.iter().map(|&(t, phi, _)| (t, phi)).collect::<Vec<_>>());
         assert!((rate / alpha_g - 1.0).abs() < 0.01, "α_g = {alpha_g}: fitted {rate}");
@@ -258,12 +260,12 @@ fn gradient_energy_control_decays_psi_at_the_target_rate() {
     // scale v after the start through a perturbed initial velocity and an
     // energy reference of 2 — equivalently, Ψ₀ = 2(s² − 1) at Y = 0.
     for alpha_e in [5.0, 20.0] {
-        let c = Control { energy: Energy::Gradient(EnergyGain::Rate { alpha_e }), ..Control::none() };
+        let c = Control::none().with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e }));
         let run = energy_perturbed(c, 0.5);
         let rate = fitted_rate(&run);
         assert!((rate / alpha_e - 1.0).abs() < 0.01, "α_e = {alpha_e}: fitted {rate}");
     }
-    let c = Control { energy: Energy::Baumgarte { eta: 10.0 }, ..Control::none() };
+    let c = Control::none().with_energy(Energy::Baumgarte { eta: 10.0 });
     let rate = fitted_rate(&energy_perturbed(c, 0.5));
     assert!((rate / 10.0 - 1.0).abs() < 0.01, "η = 10: fitted {rate}");
 }
@@ -288,7 +290,7 @@ fn energy_perturbed(control: Control, t_end: f64) -> Vec<(f64, f64)> {
 #[test]
 fn baumgarte_follows_the_critically_damped_response() {
     let omega: f64 = 8.0;
-    let c = Control { geometric: Geometric::baumgarte_from(omega, 1.0).unwrap(), ..Control::none() };
+    let c = Control::none().with_geometric(Geometric::baumgarte_from(omega, 1.0).unwrap());
     let run = perturbed_run(c, 1.0 + 1e-4, 1.0, 1.0);
     let phi0 = run[0].1;
     for &(t, phi, _) in &run {
@@ -305,12 +307,10 @@ fn backward_euler_cvsgf_with_unit_gain_step_is_a_gauss_newton_projection() {
     let model = pendulum();
     let h = 0.01;
     for eps in [1e-3_f64, 1e-5] {
-        let c = Control {
-            geometric: Geometric::Gradient(Gain::Rate(1.0 / h)),
-            energy: Energy::None,
-            application: Application::BackwardEuler,
-            ..Control::none()
-        };
+        let c = Control::none()
+            .with_geometric(Geometric::Gradient(Gain::Rate(1.0 / h)))
+            .with_energy(Energy::None)
+            .with_application(Application::BackwardEuler);
         let mut sys = ControlledSystem::new(&model, c, 2.0);
         let mut integ = Integrator::new(Scheme::Euler, c.application, sys.state_len());
         let r = (1.0 + 2.0 * eps).sqrt();
@@ -346,7 +346,7 @@ fn right_hand_side_evaluations_per_step_are_as_designed() {
         (Scheme::RungeKutta4, Application::PostStep, 400 + 1),
     ];
     for (scheme, application, expected) in cases {
-        let c = Control { geometric: cvsgf, energy: Energy::None, application, ..Control::none() };
+        let c = Control::none().with_geometric(cvsgf).with_energy(Energy::None).with_application(application);
         let mut sim = Simulation::new(&ex.model, Settings::new(scheme, 0.01, c), &ex.q0, &ex.v0).unwrap();
         sim.run::<Error>(1.0, 1000, |_| Ok(())).unwrap();
         assert_eq!(sim.steps(), 100);
@@ -377,11 +377,8 @@ fn redundant_constraints_are_a_typed_error_with_step_and_time() {
 fn a_diverging_run_stops_with_step_and_time() {
     let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
     // hα_g = 2·10⁴: forward Euler control is far outside its stability region.
-    let mut settings = Settings::new(
-        Scheme::Euler,
-        0.01,
-        Control { geometric: Geometric::Gradient(Gain::Rate(2e6)), ..Control::none() },
-    );
+    let mut settings =
+        Settings::new(Scheme::Euler, 0.01, Control::none().with_geometric(Geometric::Gradient(Gain::Rate(2e6))));
     settings.consistency_tolerance = None;
     let mut sim = Simulation::new(&ex.model, settings, &[1.001, 0.0], &[0.0, 2.0]).unwrap();
     let mut observed = 0u64;
@@ -445,12 +442,10 @@ fn paper_gains_have_a_spurious_equilibrium_that_long_runs_reach() {
     }
     let y_eq = 0.5 * (lo + hi);
 
-    let control = Control {
-        geometric: Geometric::Gradient(Gain::Fixed(zeta)),
-        energy: Energy::Gradient(EnergyGain::Rate { alpha_e }),
-        application: Application::ForwardEuler,
-        ..Control::none()
-    };
+    let control = Control::none()
+        .with_geometric(Geometric::Gradient(Gain::Fixed(zeta)))
+        .with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e }))
+        .with_application(Application::ForwardEuler);
     let (system, q0, v0) = small_pendulum(PendulumParams::default()).unwrap();
     let mut sim = SmallSimulation::new(system, Settings::new(Scheme::AdamsBashforth3, 0.01, control), q0, v0).unwrap();
     let mut phi_at_100s = 0.0_f64;

@@ -38,7 +38,7 @@ fn parallelogram(theta0: f64, omega0: f64, redundant: bool) -> Mechanism {
 }
 
 fn tolerant(settings: Settings) -> Settings {
-    Settings { dependent_rows: DependentRows::Tolerate, ..settings }
+    settings.with_dependent_rows(DependentRows::Tolerate)
 }
 
 #[test]
@@ -50,11 +50,11 @@ fn a_parallelogram_with_a_redundant_crank_moves_as_the_plain_four_bar() {
         (parallelogram(theta0, 0.0, false).build().unwrap(), parallelogram(theta0, 0.0, true).build().unwrap());
     assert_eq!((plain.model.m(), redundant.model.m()), (8, 9));
     let (h, t_end) = (1e-3, 5.0);
-    for control in [Control::none(), Control { geometric: Geometric::Newton(Rate::Given(50.0)), ..Control::none() }] {
+    for control in [Control::none(), Control::none().with_geometric(Geometric::Newton(Rate::Given(50.0)))] {
         // Dense eliminates the redundant row last and drops it; the sparse
         // ordering may drop another row of the loop: the motion is the same.
         for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
-            let settings = Settings { solver, ..Settings::new(Scheme::RungeKutta4, h, control) };
+            let settings = Settings::new(Scheme::RungeKutta4, h, control).with_solver(solver);
             let mut a = Simulation::new(&plain.model, settings, &plain.q0, &plain.v0).unwrap();
             let mut b = Simulation::new(&redundant.model, tolerant(settings), &redundant.q0, &redundant.v0).unwrap();
             let mut worst = 0.0_f64;
@@ -217,12 +217,12 @@ fn the_published_a02_reference_is_the_one_degree_of_freedom_motion_for_n_40() {
 
 /// The projection method: `Φ`, `Φ̇` and the energy projected after every step.
 fn projection() -> Control {
-    Control { projection: Some(Projection::default()), ..Control::none() }
+    Control::none().with_projection(Some(Projection::default()))
 }
 
 /// Baumgarte's feedback, critically damped at 10 rad/s.
 fn baumgarte() -> Control {
-    Control { geometric: Geometric::baumgarte_from(10.0, 1.0).unwrap(), ..Control::none() }
+    Control::none().with_geometric(Geometric::baumgarte_from(10.0, 1.0).unwrap())
 }
 
 #[test]
@@ -263,8 +263,8 @@ fn every_method_is_well_defined_with_the_redundant_crank() {
     let (plain, redundant) =
         (parallelogram(theta0, 0.0, false).build().unwrap(), parallelogram(theta0, 0.0, true).build().unwrap());
     let mut cases = cdyn::methods::compare_cases(&cdyn::methods::MethodGains::paper(), true);
-    cases.push(("newton_auto", Control { geometric: Geometric::Newton(Rate::Auto), ..Control::none() }));
-    cases.push(("cvsgf_auto", Control { geometric: Geometric::Gradient(cdyn::Gain::Auto), ..Control::none() }));
+    cases.push(("newton_auto", Control::none().with_geometric(Geometric::Newton(Rate::Auto))));
+    cases.push(("cvsgf_auto", Control::none().with_geometric(Geometric::Gradient(cdyn::Gain::Auto))));
     let (h, steps) = (1e-3, 3000);
     for (name, control) in cases {
         let settings = Settings::new(Scheme::RungeKutta4, h, control);

@@ -37,7 +37,7 @@ fn pendulum() -> Example {
 
 /// Baumgarte-free CVSGF at rate `alpha_g`.
 fn cvsgf(alpha_g: f64) -> Control {
-    Control { geometric: Geometric::Gradient(Gain::Rate(alpha_g)), ..Control::none() }
+    Control::none().with_geometric(Geometric::Gradient(Gain::Rate(alpha_g)))
 }
 
 #[test]

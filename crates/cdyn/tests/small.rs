@@ -48,7 +48,7 @@ fn controls() -> Vec<Control> {
             Energy::Baumgarte { eta: 40.0 },
         ] {
             for application in [Application::InRhs, Application::ForwardEuler, Application::BackwardEuler] {
-                out.push(Control { geometric, energy, application, ..Control::none() });
+                out.push(Control::none().with_geometric(geometric).with_energy(energy).with_application(application));
             }
         }
     }
@@ -112,7 +112,7 @@ fn small_and_general_paths_give_the_same_trajectories() {
 #[test]
 fn the_double_pendulum_moves_and_its_drive_puts_energy_in() {
     // Guards the comparison above against two paths that agree by doing nothing.
-    let control = Control { geometric: Geometric::Gradient(Gain::Rate(40.0)), ..Control::default() };
+    let control = Control::default().with_geometric(Geometric::Gradient(Gain::Rate(40.0)));
     let mut sim =
         SmallSimulation::new(DrivenDouble, Settings::new(Scheme::RungeKutta4, 0.005, control), DOUBLE_Q0, DOUBLE_V0)
             .unwrap();
@@ -198,16 +198,12 @@ fn a_tolerated_doubled_row_is_the_circle_on_both_paths() {
     // The doubled constraint, tolerated: uniform motion on the unit circle
     // under every control law, the same on both paths, the row reported.
     let mut all = controls();
-    all.push(Control { geometric: Geometric::Newton(Rate::Given(40.0)), ..Control::none() });
-    all.push(Control { velocity: Velocity::Gradient(Rate::Given(40.0)), ..Control::none() });
-    all.push(Control {
-        energy: Energy::Projected { alpha_e: Rate::Given(40.0), position_weight: 16.0 },
-        ..Control::none()
-    });
+    all.push(Control::none().with_geometric(Geometric::Newton(Rate::Given(40.0))));
+    all.push(Control::none().with_velocity(Velocity::Gradient(Rate::Given(40.0))));
+    all.push(Control::none().with_energy(Energy::Projected { alpha_e: Rate::Given(40.0), position_weight: 16.0 }));
     all.push(cdyn::methods::robust());
     for control in all {
-        let settings =
-            Settings { dependent_rows: DependentRows::Tolerate, ..Settings::new(Scheme::RungeKutta4, 0.01, control) };
+        let settings = Settings::new(Scheme::RungeKutta4, 0.01, control).with_dependent_rows(DependentRows::Tolerate);
         let d = divergence(DoubledRod, settings, [1.0, 0.0], [0.0, 1.0], 300);
         assert!(d.is_some_and(|d| d < 1e-12), "{control:?}: {d:?}");
         let mut sim = SmallSimulation::new(DoubledRod, settings, [1.0, 0.0], [0.0, 1.0]).unwrap();

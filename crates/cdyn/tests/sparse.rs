@@ -72,12 +72,10 @@ fn sparse_solver_reports_a_dependent_row() {
 fn a_long_chain_stays_on_its_constraints_with_the_sparse_path() {
     let (model, q, _) = chain(300, false);
     let v = vec![0.0; q.len()];
-    let control = Control {
-        geometric: Geometric::Gradient(Gain::Rate(400.0)),
-        energy: Energy::Gradient(EnergyGain::Rate { alpha_e: 400.0 }),
-        application: cdyn::Application::ForwardEuler,
-        ..Control::none()
-    };
+    let control = Control::none()
+        .with_geometric(Geometric::Gradient(Gain::Rate(400.0)))
+        .with_energy(Energy::Gradient(EnergyGain::Rate { alpha_e: 400.0 }))
+        .with_application(cdyn::Application::ForwardEuler);
     let mut settings = Settings::new(Scheme::AdamsBashforth3, 1e-3, control);
     settings.solver = LinearSolver::Sparse;
     let mut sim = Simulation::new(&model, settings, &q, &v).unwrap();

@@ -293,7 +293,7 @@ fn heavy_top() -> Mechanism {
 }
 
 fn heavy_top_at(t_end: f64, h: f64, control: Control, solver: LinearSolver) -> (Vec<f64>, Vec<f64>) {
-    let settings = Settings { solver, ..Settings::new(Scheme::RungeKutta4, h, control) };
+    let settings = Settings::new(Scheme::RungeKutta4, h, control).with_solver(solver);
     end_state(&heavy_top().build().unwrap(), settings, t_end)
 }
 
@@ -369,7 +369,7 @@ fn block_diagonal_and_dense_mass_paths_agree() {
     let Built { model, q0, v0, .. } = cdyn::spatial::chain(4, 0.3, 9.81).build().unwrap();
     assert_eq!(model.mass_blocks().map(<[_]>::len), Some(4));
     let run = |solver| {
-        let settings = Settings { solver, ..Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust()) };
+        let settings = Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust()).with_solver(solver);
         let mut sim = Simulation::new(&model, settings, &q0, &v0).unwrap();
         sim.run::<Error>(1.0, u64::MAX, |_| Ok(())).unwrap();
         sim.q().to_vec()
@@ -974,10 +974,8 @@ fn the_stiff_flyball_governor_keeps_its_steady_state_momentum_and_energy_balance
     // held to E₀ minus the dampers' work as the scheme integrated it, which
     // carries more error than the state (none's |Ψ| above against its
     // state's energy error, about 4e-9 J): printed, not asserted.
-    let with_energy = Control {
-        energy: cdyn::Energy::Projected { alpha_e: cdyn::Rate::Given(1.0 / 1e-4), position_weight: 16.0 },
-        ..methods::robust()
-    };
+    let with_energy = methods::robust()
+        .with_energy(cdyn::Energy::Projected { alpha_e: cdyn::Rate::Given(1.0 / 1e-4), position_weight: 16.0 });
     let (q, m, p, f) = run(1e-4, with_energy);
     println!("robust with its energy term: {m:.1e}, |Ψ| {p:.1e}, |Φ| {f:.1e}, to h/2 {:.1e}", gap(&q));
 }
@@ -1125,7 +1123,7 @@ fn plain_renormalization_against_the_controls() {
 fn carried_rate(model: &Model, q: &[f64], v: &[f64], p: [usize; 4], dependent: DependentRows) -> f64 {
     let n = model.n();
     let alpha = 7.0;
-    let control = Control { geometric: cdyn::Geometric::Newton(cdyn::Rate::Given(alpha)), ..Control::none() };
+    let control = Control::none().with_geometric(cdyn::Geometric::Newton(cdyn::Rate::Given(alpha)));
     let e0 = model.kinetic(q, v) + model.potential(q, None);
     let mut system = cdyn::system::ControlledSystem::new(model, control, e0);
     system.set_dependent_rows(dependent);

@@ -226,10 +226,7 @@ proptest! {
             let norm = d.norm2_m(&d.project(&v_vec)) + c * d.norm2_m(&d.project(&w));
             prop_assume!(norm > 1e-8);
             let psi = fraction * norm;
-            let control = Control {
-                energy: Energy::Projected { alpha_e: Rate::Given(alpha), position_weight: weight },
-                ..Control::none()
-            };
+            let control = Control::none().with_energy(Energy::Projected { alpha_e: Rate::Given(alpha), position_weight: weight });
             let (u_q, u_v) = control_term(&model, control, &q, &v, 0.0, psi);
             // U_v = −s P v and U_q = −s c P M⁻¹∇V: the round-off of a
             // projection is relative to the vector projected.
@@ -277,7 +274,7 @@ proptest! {
             let d = Dense::at(&model, &q, v, t);
             let jac_norm = d.jac.norm();
 
-            let velocity = Control { velocity: Velocity::Gradient(Rate::Given(alpha)), ..Control::none() };
+            let velocity = Control::none().with_velocity(Velocity::Gradient(Rate::Given(alpha)));
             let (u_q, u_v) = control_term(&model, velocity, &q, v, t, 0.3);
             prop_assert!(u_q.iter().all(|u| *u == 0.0), "{name}: velocity feedback moves no position");
             let residual = (&d.jac * &u_v + alpha * &d.phi_dot).norm();
@@ -286,7 +283,7 @@ proptest! {
                 "{name}: |Φ_q U_v + α_v Φ̇| = {residual:e}, |α_v Φ̇| = {:e}", alpha * d.phi_dot.norm()
             );
 
-            let newton = Control { geometric: Geometric::Newton(Rate::Given(alpha)), ..Control::none() };
+            let newton = Control::none().with_geometric(Geometric::Newton(Rate::Given(alpha)));
             let (u_q, u_v) = control_term(&model, newton, &q, v, t, 0.3);
             prop_assert!(u_v.iter().all(|u| *u == 0.0), "{name}: Newton moves no velocity");
             let residual = (&d.jac * &u_q + alpha * &d.phi).norm();
@@ -335,12 +332,10 @@ fn psi_at_turning_points(controlled: &[(f64, f64)], free: &[(f64, f64)]) -> Vec<
 
 /// CVSGF with `α_g = 40` and this energy control, applied by forward Euler.
 fn cvsgf_with(energy: Energy) -> Control {
-    Control {
-        geometric: Geometric::Gradient(Gain::Rate(40.0)),
-        energy,
-        application: Application::ForwardEuler,
-        ..Control::none()
-    }
+    Control::none()
+        .with_geometric(Geometric::Gradient(Gain::Rate(40.0)))
+        .with_energy(energy)
+        .with_application(Application::ForwardEuler)
 }
 
 /// At a turning point the kinetic energy cannot absorb an energy error; the
@@ -430,7 +425,7 @@ fn example_1_for_5000_s(control: Control) -> LongRun {
 #[test]
 fn velocity_feedback_keeps_example_1_on_the_manifold_for_5000_s() {
     let paper = MethodGains::paper().cvsgf_energy();
-    let with = example_1_for_5000_s(Control { velocity: Velocity::Gradient(Rate::Given(40.0)), ..paper });
+    let with = example_1_for_5000_s(paper.with_velocity(Velocity::Gradient(Rate::Given(40.0))));
     assert!(with.phi <= 1e-6 && with.psi <= 1e-5, "{with:?}");
     assert!(with.last_1000.0 <= 1.01 * with.first_1000.0 && with.last_1000.1 <= 1.01 * with.first_1000.1, "{with:?}");
 
@@ -497,10 +492,11 @@ fn projection_holds_every_invariant_to_its_tolerance_after_every_step() {
 fn a_projection_that_cannot_converge_stops_by_name_or_is_counted() {
     for (name, ex, _) in projection_cases() {
         for (tolerance, max_iterations, h) in [(1e-30, 10, 0.01), (1e-10, 1, 0.1)] {
-            let projection =
-                Projection { tolerance, max_iterations, on_failure: OnFailure::Stop, ..Projection::default() };
-            let settings =
-                |p| Settings::new(Scheme::AdamsBashforth3, h, Control { projection: Some(p), ..Control::none() });
+            let projection = Projection::default()
+                .with_tolerance(tolerance)
+                .with_max_iterations(max_iterations)
+                .with_on_failure(OnFailure::Stop);
+            let settings = |p| Settings::new(Scheme::AdamsBashforth3, h, Control::none().with_projection(Some(p)));
             let mut sim = Simulation::new(&ex.model, settings(projection), &ex.q0, &ex.v0).unwrap();
             let error = (0..100).find_map(|_| sim.step().err());
             let case = format!("{name}, tolerance {tolerance:e}, max_iterations {max_iterations}, h = {h}");
@@ -516,7 +512,7 @@ fn a_projection_that_cannot_converge_stops_by_name_or_is_counted() {
                 other => panic!("{case}: {other:?}"),
             }
 
-            let projection = Projection { on_failure: OnFailure::Continue, ..projection };
+            let projection = projection.with_on_failure(OnFailure::Continue);
             let mut sim = Simulation::new(&ex.model, settings(projection), &ex.q0, &ex.v0).unwrap();
             for _ in 0..100 {
                 sim.step().unwrap();
@@ -564,7 +560,7 @@ fn automatic_cvsgf_gain_sees_the_coupling_of_the_rows() {
             (Scheme::RungeKutta4, Application::InRhs),
         ] {
             let h = 0.01;
-            let control = Control { geometric: Geometric::Gradient(Gain::Auto), application, ..Control::none() };
+            let control = Control::none().with_geometric(Geometric::Gradient(Gain::Auto)).with_application(application);
             let sim = Simulation::new(model, Settings::new(scheme, h, control), q0, v0).unwrap();
             let tuning = *sim.tuning();
             let case = format!("{name}, {scheme:?}, {application:?}: {tuning:?}");
@@ -644,10 +640,8 @@ fn robust_and_projection_are_no_worse_than_none_from_light_to_heavy_damping() {
             let ex = damped_pendulum(DampedPendulumParams { damping, theta0: 0.5, ..Default::default() }).unwrap();
             let (none, _) = error(&ex, scheme, Control::none());
             let (robust, tuning) = error(&ex, scheme, methods::robust());
-            let kept = Control {
-                energy: Energy::Projected { alpha_e: Rate::Given(1.0 / h), position_weight: POSITION_WEIGHT },
-                ..methods::robust()
-            };
+            let kept = methods::robust()
+                .with_energy(Energy::Projected { alpha_e: Rate::Given(1.0 / h), position_weight: POSITION_WEIGHT });
             let (with_energy, _) = error(&ex, scheme, kept);
             let (projection, _) = error(&ex, scheme, methods::projection());
             println!(
