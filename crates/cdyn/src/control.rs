@@ -15,6 +15,7 @@ use crate::unit_vector::{UnitVector, carry_rate};
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Gain {
     /// The gain itself (`ζ` for CVSGF).
     Fixed(f64),
@@ -31,6 +32,7 @@ pub enum Gain {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Rate {
     /// This rate (1/s).
     Given(f64),
@@ -53,6 +55,7 @@ impl Rate {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Geometric {
     /// No geometric control (Eq. 8).
     #[default]
@@ -80,6 +83,7 @@ pub enum Geometric {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Velocity {
     /// None.
     #[default]
@@ -125,6 +129,7 @@ pub(crate) fn baumgarte_gains(omega: f64, damping_ratio: f64) -> Result<(f64, f6
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum EnergyGain {
     /// `ρ_q`, `ρ_v` as given (Eq. 20).
     Fixed {
@@ -144,6 +149,7 @@ pub enum EnergyGain {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Energy {
     /// No energy control.
     #[default]
@@ -175,6 +181,7 @@ pub enum Energy {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Invariants {
     /// Every correction is made M-orthogonal to the momentum directions the
     /// run finds or is told of, so that what the uncontrolled scheme keeps

@@ -6,6 +6,7 @@ use thiserror::Error;
 
 /// Everything that can go wrong while building a model or simulating it.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A setting or parameter outside its domain.
     #[error("invalid {name} = {value}: {reason}")]
@@ -120,6 +121,7 @@ pub enum Error {
 /// A combination of method keys ([`MethodKeys`](crate::methods::MethodKeys))
 /// that does not describe one method.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum KeyProblem {
     /// Two keys that each set the same gain.
     #[error("give one of {0}, {1}, not both")]
@@ -152,6 +154,7 @@ pub enum KeyProblem {
 
 /// The part of a model an [`Error::InvalidModel`] is about.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Part {
     /// The model as a whole.
     #[default]
@@ -207,6 +210,7 @@ impl std::fmt::Display for Part {
 
 /// What is wrong with a part of a model.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum Problem {
     /// A number outside its domain.
     #[error("{name} = {value} {reason}")]

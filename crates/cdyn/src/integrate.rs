@@ -10,6 +10,7 @@
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(try_from = "String", into = "&'static str"))]
+#[non_exhaustive]
 pub enum Scheme {
     /// Forward Euler, order 1.
     Euler,
@@ -26,6 +27,7 @@ pub enum Scheme {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Application {
     /// `U` is part of the right-hand side the scheme integrates.
     #[default]
@@ -47,6 +49,7 @@ pub enum Application {
 
 /// How a scheme combines evaluations.
 #[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
 pub enum Formula {
     /// `x_{k+1} = x_k + h Σ_j w_j F_{k−j}`
     Multistep(&'static [f64]),

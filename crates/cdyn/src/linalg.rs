@@ -18,6 +18,7 @@ use crate::sparse::{Pattern, Structure};
 
 /// Why `S` could not be factored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Breakdown {
     /// This row is linearly dependent on the rows before it.
     Singular(usize),
@@ -31,6 +32,7 @@ pub enum Breakdown {
 
 /// How to factor `Φ_q M⁻¹ Φ_qᵀ`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum LinearSolver {
     /// Dense below [`SPARSE_FROM`] constraint rows, sparse from there on.
     #[default]
@@ -81,6 +83,7 @@ const DROP_TOLERANCE: f64 = 1e-8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum DependentRows {
     /// Stop with an error naming the row. The default: a dependent row is
     /// far more often a modelling mistake (a joint entered twice) than an

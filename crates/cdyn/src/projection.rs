@@ -26,6 +26,7 @@ use crate::unit_vector::carry_step;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum OnFailure {
     /// Stop the run with [`Error::ProjectionFailed`](crate::Error::ProjectionFailed).
     #[default]
@@ -110,6 +111,7 @@ impl Projection {
 
 /// Why a projection did not converge.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Failure {
     /// `Φ_q M⁻¹ Φ_qᵀ` could not be factored.
     Breakdown(Breakdown, u32),

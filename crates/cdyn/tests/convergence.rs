@@ -29,6 +29,7 @@ fn every_scheme_converges_at_its_order() {
                 Scheme::AdamsBashforth2 => 4e-3,
                 Scheme::AdamsBashforth3 => 1e-2,
                 Scheme::RungeKutta4 => 4e-2,
+                other => panic!("no step chosen for {other:?}: add one here"),
             };
             let errors: Vec<f64> =
                 (0..3).map(|k| max_error(&ex, scheme, h0 / 2f64.powi(k), Control::none(), 4.0)).collect();
