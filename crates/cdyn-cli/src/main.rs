@@ -7,7 +7,7 @@ use cdyn_cli::{
     alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal, view3d,
     viewer,
 };
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -18,22 +18,30 @@ static ALLOCATOR: alloc_count::Counting = alloc_count::Counting;
 #[command(
     name = "cdyn",
     version,
-    about = "Constrained dynamics in redundant coordinates, with constraint and energy violations pushed back (CVSGF)"
+    about = "Constrained dynamics in redundant coordinates, with constraint and energy violations pushed back (CVSGF)",
+    after_help = EXIT_CODES
 )]
 struct Cli {
     #[command(subcommand)]
     command: Command,
 }
 
+/// What `cdyn`'s exit status means, in `--help` and the man page.
+const EXIT_CODES: &str = "Exit status: 0 done; 1 an error (bad input, a failed run: one line on standard error \
+naming the file and key, or the step and time); 2 a command line clap cannot parse; 130 or 143 a run \
+stopped by SIGINT or SIGTERM (its output up to there is written).";
+
 #[derive(Subcommand)]
 enum Command {
     /// Reproduce the paper's Example 1 test: every case, CSVs, summary.json, Figs. 3–5.
+    #[command(after_help = "Example: cdyn paper --out out/paper")]
     Paper {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
     },
     /// Run one model under every stabilization method of `cdyn paper`.
+    #[command(after_help = "Example: cdyn compare examples/four_bar.toml --out out/four_bar --html")]
     Compare {
         /// The scenario (TOML); its [method] gains, if any, are used, else target rates 0.2/h.
         scenario: PathBuf,
@@ -47,6 +55,7 @@ enum Command {
         viewer: viewer::ViewerArgs,
     },
     /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
+    #[command(after_help = "Example: cdyn bench --out out/bench")]
     Bench {
         /// Output directory (created if missing).
         #[arg(long)]
@@ -56,6 +65,7 @@ enum Command {
         light: bool,
     },
     /// Run a grid over gains and step sizes (the scenario's [sweep] table) in parallel; writes sweep.json and heat maps.
+    #[command(after_help = "Example: cdyn sweep examples/sweep_gains.toml --out out/sweep --threads 2")]
     Sweep {
         /// The scenario (TOML) with a [sweep] table, e.g. alpha_g = [10, 20, 40].
         scenario: PathBuf,
@@ -72,6 +82,7 @@ enum Command {
         listing: ListingArgs,
     },
     /// Join the sweep.json files of the shards of one sweep into the complete result.
+    #[command(after_help = "Example: cdyn merge parts/* --out result")]
     Merge {
         /// Shard output directories (or their sweep.json files).
         #[arg(required = true)]
@@ -84,6 +95,7 @@ enum Command {
     },
     /// Judge every method of `cdyn compare` on many models (examples/suite and any given) at AB-3 and RK-4,
     /// h and h/2, against a fine reference; writes suite.json and suite.png. Misses of its checks are reported, not fatal.
+    #[command(after_help = "Example: cdyn suite --out out/suite --light")]
     Suite {
         /// More scenarios (TOML) to add to the shipped ones.
         scenarios: Vec<PathBuf>,
@@ -95,6 +107,7 @@ enum Command {
         light: bool,
     },
     /// Run a scenario file.
+    #[command(after_help = "Example: cdyn run examples/four_bar.toml --out out/four_bar --html")]
     Run {
         /// The scenario (TOML).
         scenario: PathBuf,
@@ -106,6 +119,19 @@ enum Command {
         force: bool,
         #[command(flatten)]
         viewer: viewer::ViewerArgs,
+    },
+    /// Print a shell completion script for cdyn.
+    #[command(after_help = "Example: cdyn completions bash > ~/.local/share/bash-completion/completions/cdyn")]
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Print cdyn's man page, or write one page per command into a directory.
+    #[command(after_help = "Example: cdyn man --out man/ && man -l man/cdyn-run.1")]
+    Man {
+        /// Write cdyn.1 and cdyn-<command>.1 here (created if missing) instead of printing cdyn.1.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -191,8 +217,41 @@ fn write_sweep(result: &sweep::Sweep, out: &Path, listing: sweep::Listing) -> Re
     Ok(())
 }
 
+/// The roff man page of `command`.
+fn man_page(command: clap::Command) -> Result<Vec<u8>> {
+    let mut page = Vec::new();
+    clap_mangen::Man::new(command).render(&mut page).context("cannot render the man page")?;
+    Ok(page)
+}
+
+/// `cdyn man`: cdyn.1 to standard output, or every command's page into `out`.
+fn man(out: Option<PathBuf>) -> Result<()> {
+    let cli = Cli::command();
+    let Some(dir) = out else {
+        return print(&String::from_utf8_lossy(&man_page(cli)?));
+    };
+    output_dir(&dir)?;
+    let name = cli.get_name().to_string();
+    let mut pages = vec![(format!("{name}.1"), man_page(cli.clone())?)];
+    for sub in cli.get_subcommands() {
+        let sub_name = format!("{name}-{}", sub.get_name());
+        pages.push((format!("{sub_name}.1"), man_page(sub.clone().name(sub_name).version(env!("CARGO_PKG_VERSION")))?));
+    }
+    for (file, page) in &pages {
+        output::write(&dir.join(file), page)?;
+    }
+    print(&format!("wrote {} man pages into {}\n", pages.len(), dir.display()))
+}
+
 fn run(cli: Cli) -> Result<Ended> {
     match cli.command {
+        Command::Completions { shell } => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "cdyn", &mut script);
+            print(&String::from_utf8_lossy(&script))?;
+            Ok(Ended::Done)
+        }
+        Command::Man { out } => man(out).map(|()| Ended::Done),
         Command::Paper { out } => {
             output_dir(&out)?;
             let cases = paper::cases()?;
