@@ -1,4 +1,16 @@
 #![doc = include_str!("../../../README.md")]
+//!
+//! # Map of the modules
+//!
+//! | layer | modules |
+//! |---|---|
+//! | what a system is | [`model`] (coordinates, mass, elements), [`constraint`], [`nonholonomic`], [`force`], [`kinetic`], [`scalar`] (the number type physics is written in), [`timefn`] |
+//! | building systems | [`planar`] and [`spatial`] mechanisms, [`models`] (built-ins), [`small`] (sizes known at compile time), [`assemble`] (consistent initial states) |
+//! | what it does, uncontrolled | [`dynamics`] (`Φ`, `λ`, `A`), [`mass`], [`energy`] (`Ψ`), [`system`] (the state equation with its control term) |
+//! | pushing violations back | [`control`] (the laws), [`methods`] (by name, presets), [`gains`] (automatic rates), [`projection`], [`unit_vector`] |
+//! | what it keeps | [`momentum`] (symmetries found, corrections kept orthogonal), [`angular`], [`invariant`] (declared), [`held`] |
+//! | stepping and output | [`integrate`] (schemes), [`simulate`] (the loop), [`record`], [`diagnostics`], `json_float` (with `serde`) |
+//! | checking | [`reference`](mod@reference) (closed-form motions), [`error`] |
 #![deny(missing_docs)]
 
 /// Runs `$body` with the const `$k` equal to the run-time `$n`, one of the

@@ -9,7 +9,7 @@
 //!
 //! With the `serde` feature, [`Body`] and [`Element<String>`] are the
 //! scenario file's `[[bodies]]` and `[[joints]]`/`[[drives]]`/`[[forces]]`
-//! entries ([`format`](mod@format) reads the three lists), and
+//! entries (`format` reads the three lists), and
 //! [`Mechanism::add_named`] resolves the body names.
 
 mod body;
