@@ -4,8 +4,8 @@
 use anyhow::{Context, Result, bail};
 use cdyn_cli::terminal::print;
 use cdyn_cli::{
-    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, sweep, terminal, view3d,
-    viewer,
+    alloc_count, bench, compare, interrupt, output, paper, report, runner, scenario, suite, suite_plot, sweep,
+    terminal, view3d, viewer,
 };
 use clap::{CommandFactory, Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -350,6 +350,7 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Suite { scenarios, out, light } => {
             let result = suite::run(&scenarios, light)?;
             output_dir(&out)?;
+            suite_plot::write(&result, &out)?;
             suite::write(&result, &out)?;
             print(&suite::table(&result))?;
             print(&suite::summary(&result))?;

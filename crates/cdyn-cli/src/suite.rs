@@ -482,9 +482,9 @@ impl Suite {
     }
 }
 
-/// Writes `dir/suite.json` and the figure; each file appears whole or not at all.
+/// Writes `dir/suite.json`, whole or not at all (the figure is
+/// [`crate::suite_plot::write`]'s, which reads this module's types).
 pub fn write(suite: &Suite, dir: &Path) -> Result<()> {
-    crate::suite_plot::write(suite, dir)?;
     let text = serde_json::to_string_pretty(&suite.json())? + "\n";
     crate::output::write(&dir.join("suite.json"), text.as_bytes())
 }

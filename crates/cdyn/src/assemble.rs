@@ -9,8 +9,8 @@
 
 use crate::dynamics::{Breakdown, DependentRows, Dynamics};
 use crate::error::{Part, Problem, Result};
+use crate::manifold::{Failure, Work, positions, velocities};
 use crate::model::Model;
-use crate::projection::{Failure, Work, positions, velocities};
 
 /// What the assembly changed.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -3,13 +3,13 @@
 //! they add to the uncontrolled state equations.
 
 use crate::error::{Result, non_negative, positive};
+use crate::evaluation::Evaluation;
 use crate::held::Held;
 use crate::integrate::Application;
 use crate::linalg::dot;
 use crate::mass::MassMatrix;
-use crate::momentum::Momenta;
 use crate::projection::Projection;
-use crate::unit_vector::{UnitVector, carry_rate};
+use crate::unit_vector::carry_rate;
 
 /// A gain either fixed, or set at every evaluation from a target decay rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -194,9 +194,7 @@ pub enum Invariants {
     Free,
 }
 
-/// The default `position_weight` of [`Energy::Projected`]: `c = 16/α_e²`,
-/// the suite's choice (docs/methods.md).
-pub const POSITION_WEIGHT: f64 = 16.0;
+pub use crate::energy::POSITION_WEIGHT;
 
 /// A complete stabilization method: one row of the table in `equations.md`,
 /// plus velocity-level feedback. Built from [`Control::none`],
@@ -229,68 +227,6 @@ pub struct Control {
     /// Whether the corrections keep the system's momenta.
     pub invariants: Invariants,
 }
-
-/// What the control laws read of one evaluation of the dynamics.
-pub(crate) trait Evaluation {
-    /// The kind of mass matrix.
-    type Mass: MassMatrix;
-    /// The mass matrix `M`.
-    fn mass(&self) -> &Self::Mass;
-    fn phi(&self) -> &[f64];
-    fn phi_dot(&self) -> &[f64];
-    /// `Ψ_q = ∇V + ∂T/∂q`: `∇V` when `M` is constant; with `M(q)` the
-    /// energy's position gradient takes `∂T/∂q` too (the laws below read
-    /// `Ψ_q` through this, never `∇V` alone).
-    fn grad_potential(&self) -> &[f64];
-    /// The uncontrolled acceleration `A`.
-    fn acc(&self) -> &[f64];
-    /// Row `r` of `Φ_q`: its entries and their coordinates.
-    fn row(&self, r: usize) -> (&[f64], &[u32]);
-    /// For a change `b` of the constraint right-hand side, adds the change
-    /// of acceleration `−M⁻¹ Φ_qᵀ S⁻¹ b` to `out`; `b` is overwritten.
-    fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
-        self.solve_many(&mut [b]);
-        self.add_weighted_jt(b, -1.0, out);
-    }
-
-    /// Solves `S x = b` in place for every `b`, in one pass over the
-    /// factorization of the last evaluation (`S = Φ_q M⁻¹ Φ_qᵀ`).
-    fn solve_many(&self, b: &mut [&mut [f64]]);
-
-    /// `out += scale · M⁻¹ Φ_qᵀ y`.
-    fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]);
-
-    /// `out[k] −= M⁻¹ Φ_qᵀ y[k]` for two pairs, in one pass where the
-    /// storage allows.
-    fn add_weighted_jt_pair(&self, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
-        self.add_weighted_jt(y0, -1.0, out0);
-        self.add_weighted_jt(y1, -1.0, out1);
-    }
-
-    /// `Φ_t`.
-    fn phi_t(&self) -> &[f64];
-
-    /// The model's unit vectors (see [`crate::unit_vector`]).
-    fn unit_vectors(&self) -> &[UnitVector] {
-        &[]
-    }
-
-    /// The momenta the run keeps, with `M E` at this state (see
-    /// [`crate::momentum`]): every correction is made M-orthogonal to them.
-    fn momenta(&self) -> &Momenta {
-        &NO_MOMENTA
-    }
-
-    /// `out = Φ_q x`.
-    fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
-        for (r, o) in out.iter_mut().enumerate() {
-            let (jac, cols) = self.row(r);
-            *o = jac.iter().zip(cols).map(|(j, &c)| j * x[c as usize]).sum();
-        }
-    }
-}
-
-static NO_MOMENTA: Momenta = Momenta::NONE;
 
 /// Buffers the control laws work in.
 pub(crate) struct Workspace<'a> {
@@ -333,14 +269,26 @@ impl Control {
         Self::default()
     }
 
-    /// The `robust` preset ([`crate::methods::robust`]).
+    /// The `robust` preset: the combination the method suite shows best
+    /// (docs/methods.md, "Choosing a method"), every rate automatic, applied
+    /// after the step ([`Application::PostStep`]): CVSGF with the coupled
+    /// gain, velocity feedback on `Φ̇`, and energy control that respects the
+    /// constraints.
     pub fn robust() -> Self {
-        crate::methods::robust()
+        Self {
+            geometric: Geometric::Newton(Rate::Auto),
+            velocity: Velocity::Gradient(Rate::Auto),
+            energy: Energy::Projected { alpha_e: Rate::Auto, position_weight: POSITION_WEIGHT },
+            application: Application::PostStep,
+            projection: None,
+            invariants: Invariants::Keep,
+        }
     }
 
-    /// The `projection` method with its default settings ([`crate::methods::projection`]).
+    /// The `projection` method with its default settings: no control
+    /// terms, an exact projection onto the invariants after every step.
     pub fn projection() -> Self {
-        crate::methods::projection()
+        Self { projection: Some(Projection::default()), ..Self::none() }
     }
 
     /// Whether its terms hold the angular momenta and declared invariants

@@ -23,3 +23,7 @@ pub fn psi(mass: &impl MassMatrix, v: &[f64], potential: f64, e: f64, e0: f64) -
 pub fn power(force_power: f64, lambda: &[f64], phi_t: &[f64]) -> f64 {
     force_power + lambda.iter().zip(phi_t).map(|(l, p)| l * p).sum::<f64>()
 }
+
+/// The default `position_weight` of [`Energy::Projected`](crate::control::Energy::Projected): `c = 16/α_e²`,
+/// the suite's choice (docs/methods.md).
+pub const POSITION_WEIGHT: f64 = 16.0;

@@ -33,7 +33,8 @@
 //!   method was 37× worse than none on the flyball governor, and 2× on
 //!   the damped pendulum at AB-3 with `h λ_d` = 0.018).
 
-use crate::control::{Control, Energy, EnergyGain, Evaluation, Gain, Geometric, Rate, Velocity};
+use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
+use crate::evaluation::Evaluation;
 use crate::integrate::{Application, Formula, Scheme};
 use crate::mass::MassMatrix;
 

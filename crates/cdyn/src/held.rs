@@ -14,15 +14,14 @@
 //! body spinning about a principal axis, whose energy and angular momentum
 //! change together — the dependent rows are left out (`docs/momenta.md`).
 
-use crate::control::Evaluation;
 use crate::dynamics::Dynamics;
+use crate::evaluation::Evaluation;
 use crate::linalg::dot;
 use crate::mass::MassMatrix;
 use crate::model::Model;
 use crate::momentum::{Kind, Momenta};
 
-/// The most invariants a run holds beside the energy.
-pub const MAX_HELD: usize = 6;
+pub use crate::momentum::MAX_HELD;
 
 /// The invariants a run holds beside the energy, with their gradients and
 /// directions at the latest evaluation: `∂I_j/∂v`, `∂I_j/∂q`, the field

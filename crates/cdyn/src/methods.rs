@@ -438,24 +438,14 @@ pub fn independent_cases(g: &MethodGains) -> Vec<(&'static str, Control)> {
     ]
 }
 
-/// The `robust` preset: the combination the method suite shows best
-/// (docs/methods.md, "Choosing a method"), every rate automatic, applied by a
-/// forward Euler step: CVSGF with the coupled gain, velocity feedback on
-/// `Φ̇`, and energy control that respects the constraints.
+/// The `robust` preset ([`Control::robust`]).
 pub fn robust() -> Control {
-    Control {
-        geometric: Geometric::Newton(Rate::Auto),
-        velocity: Velocity::Gradient(Rate::Auto),
-        energy: Energy::Projected { alpha_e: Rate::Auto, position_weight: POSITION_WEIGHT },
-        application: Application::PostStep,
-        projection: None,
-        invariants: Invariants::Keep,
-    }
+    Control::robust()
 }
 
-/// The `projection` method with its default settings.
+/// The `projection` method with its default settings ([`Control::projection`]).
 pub fn projection() -> Control {
-    Control { projection: Some(Projection::default()), ..Control::none() }
+    Control::projection()
 }
 
 /// The cases of `cdyn compare` and `cdyn suite`: the paper's comparison

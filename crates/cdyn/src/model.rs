@@ -9,7 +9,6 @@ use crate::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, Pot
 use crate::invariant::{Declared, Invariant};
 use crate::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::mass::{BlockMass, DenseMass, DiagonalMass, MAX_BLOCK, MassMatrix};
-use crate::momentum::Direction;
 use crate::nonholonomic::{Nonholonomic, NonholonomicGroup};
 use crate::unit_vector::{UnitNorm, UnitVector};
 
@@ -347,6 +346,18 @@ fn block_layout(mass: &[f64], kinetic: &[Box<dyn KineticBlock>], pattern: &Patte
         }
     }
     Some(blocks)
+}
+
+/// A direction along which a model may keep its momentum: added by a
+/// mechanism builder (rigid translations) or declared by the user.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Direction {
+    /// What its momentum is called ("linear momentum x").
+    pub name: String,
+    /// Its non-zero entries: coordinate and weight.
+    pub entries: Vec<(u32, f64)>,
+    /// Declared by the user: reported when the model does not keep it.
+    pub declared: bool,
 }
 
 /// A momentum direction on `n` coordinates, checked: coordinates that

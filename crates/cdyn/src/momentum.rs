@@ -25,7 +25,6 @@
 
 use crate::angular::Generator;
 use crate::dynamics::Dynamics;
-use crate::held::MAX_HELD;
 use crate::linalg::{dot, norm};
 use crate::mass::MassMatrix;
 use crate::model::Model;
@@ -42,17 +41,10 @@ pub const TOLERANCE: f64 = 1e-9;
 /// and still count as kept to round-off: `10³ ε`.
 pub const ROUND_OFF: f64 = 1e3 * f64::EPSILON;
 
-/// A direction along which a model may keep its momentum: added by a
-/// mechanism builder (rigid translations) or declared by the user.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Direction {
-    /// What its momentum is called ("linear momentum x").
-    pub name: String,
-    /// Its non-zero entries: coordinate and weight.
-    pub entries: Vec<(u32, f64)>,
-    /// Declared by the user: reported when the model does not keep it.
-    pub declared: bool,
-}
+pub use crate::model::Direction;
+
+/// The most invariants a run holds beside the energy.
+pub const MAX_HELD: usize = 6;
 
 /// A momentum the system keeps, found when a run starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -171,17 +163,17 @@ struct Sample {
 fn sample_states(model: &Model, q0: &[f64], v0: &[f64]) -> Vec<(Vec<f64>, Vec<f64>, f64)> {
     let mut states = vec![(q0.to_vec(), v0.to_vec(), 0.0)];
     let mut d = Dynamics::new(model);
-    let mut work = crate::projection::Work::new(model);
+    let mut work = crate::manifold::Work::new(model);
     let mut rng = Lcg(0x5eed_cafe);
     let q_scale = 0.05 * (1.0 + q0.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
     let v_scale = 0.5 * (1.0 + v0.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
     for t in SAMPLE_TIMES {
         let mut q: Vec<f64> = q0.iter().map(|x| x + q_scale * rng.next()).collect();
         let mut v: Vec<f64> = v0.iter().map(|x| x + v_scale * rng.next()).collect();
-        if crate::projection::positions(model, &mut d, &mut q, &mut v, t, 1e-12, 30, &mut work).is_err() {
+        if crate::manifold::positions(model, &mut d, &mut q, &mut v, t, 1e-12, 30, &mut work).is_err() {
             continue;
         }
-        crate::projection::velocities(model, &d, &mut v, &mut work);
+        crate::manifold::velocities(model, &d, &mut v, &mut work);
         states.push((q, v, t));
     }
     states

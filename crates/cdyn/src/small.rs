@@ -12,10 +12,11 @@
 //! model, and the tests hold both to the same trajectories.
 
 use crate::constraint::{Constraint, local};
-use crate::control::{Control, Evaluation, Workspace};
+use crate::control::{Control, Workspace};
 use crate::diagnostics::Measures;
 use crate::energy;
 use crate::error::{Error, Result};
+use crate::evaluation::Evaluation;
 use crate::force::{Force, Potential, energy_and_gradient};
 use crate::gains::Operators;
 use crate::integrate::{Buffer, Rhs};

@@ -1,10 +1,11 @@
 //! The controlled state equation `ẋ = f(x, t) + U(x, t)` of a model, with
 //! the state laid out as `x = (q, v, e)`, `e = ∫Ė dτ`.
 
-use crate::control::{Control, Evaluation, Workspace};
+use crate::control::{Control, Workspace};
 use crate::diagnostics::{Measures, Probe};
 use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::energy;
+use crate::evaluation::Evaluation;
 use crate::gains::Operators;
 use crate::held::Held;
 use crate::integrate::{Buffer, Rhs};
@@ -107,7 +108,7 @@ pub struct ControlledSystem<'m> {
     rows: [Vec<f64>; 5],
     work: Vec<f64>,
     probe: Probe,
-    projection: projection::Work,
+    projection: crate::manifold::Work,
     /// Right-hand-side evaluations so far.
     evaluations: u64,
     /// Most rows dropped as dependent by an evaluation since the last
@@ -142,7 +143,7 @@ impl<'m> ControlledSystem<'m> {
             rows: std::array::from_fn(|_| vec![0.0; model.m()]),
             work: vec![0.0; model.n()],
             probe: Probe::new(model),
-            projection: projection::Work::new(model),
+            projection: crate::manifold::Work::new(model),
             evaluations: 0,
             dependent: 0,
             symmetries: Symmetries::default(),
