@@ -40,19 +40,12 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Run one model under every stabilization method of `cdyn paper`.
+    /// Run one model under every stabilization method of `cdyn paper`, robust and projection, with the
+    /// scenario's [method] gains where given, else target rates 0.2/h.
     #[command(after_help = "Example: cdyn compare examples/four_bar.toml --out out/four_bar --html")]
     Compare {
-        /// The scenario (TOML); its [method] gains, if any, are used, else target rates 0.2/h.
-        scenario: PathBuf,
-        /// Output directory (created if missing).
-        #[arg(long)]
-        out: PathBuf,
-        /// Run even if the CSV output would exceed 2 GB.
-        #[arg(long)]
-        force: bool,
         #[command(flatten)]
-        viewer: viewer::ViewerArgs,
+        case: CaseArgs,
     },
     /// Measure the cost of a step (Example 1 against hand-written code, the N-link chain), write bench.json.
     #[command(after_help = "Example: cdyn bench --out out/bench")]
@@ -109,16 +102,8 @@ enum Command {
     /// Run a scenario file.
     #[command(after_help = "Example: cdyn run examples/four_bar.toml --out out/four_bar --html")]
     Run {
-        /// The scenario (TOML).
-        scenario: PathBuf,
-        /// Output directory (created if missing).
-        #[arg(long)]
-        out: PathBuf,
-        /// Run even if the CSV output would exceed 2 GB.
-        #[arg(long)]
-        force: bool,
         #[command(flatten)]
-        viewer: viewer::ViewerArgs,
+        case: CaseArgs,
     },
     /// Print a shell completion script for cdyn.
     #[command(after_help = "Example: cdyn completions bash > ~/.local/share/bash-completion/completions/cdyn")]
@@ -133,6 +118,21 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+}
+
+/// What `run` and `compare` take: a scenario, where to write, and what else to write.
+#[derive(clap::Args)]
+struct CaseArgs {
+    /// The scenario (TOML).
+    scenario: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Run even if the CSV output would exceed 2 GB.
+    #[arg(long)]
+    force: bool,
+    #[command(flatten)]
+    viewer: viewer::ViewerArgs,
 }
 
 /// How much of a sweep's table `sweep` and `merge` print.
@@ -262,7 +262,7 @@ fn run(cli: Cli) -> Result<Ended> {
             print(&format!("wrote {}\n", out.display()))?;
             ended(&results, &out)
         }
-        Command::Run { scenario, out, force, viewer } => {
+        Command::Run { case: CaseArgs { scenario, out, force, viewer } } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "run")?;
             let mut case = parsed.case(&scenario)?;
@@ -330,7 +330,7 @@ fn run(cli: Cli) -> Result<Ended> {
                 .collect::<Result<Vec<_>>>()?;
             write_sweep(&sweep::merge(parts)?, &out, listing.listing()).map(|()| Ended::Done)
         }
-        Command::Compare { scenario, out, force, viewer } => {
+        Command::Compare { case: CaseArgs { scenario, out, force, viewer } } => {
             let parsed = scenario::load(&scenario)?;
             parsed.refuse_sweep(&scenario, "compare")?;
             let mut cases = compare::cases(&parsed, &scenario)?;
