@@ -37,6 +37,7 @@ use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
 
+/// Example 1 (`cvsgf_energy`, AB-3): cdyn as a `SmallSimulation` and as a general model against hand-written code.
 #[derive(Debug, Serialize)]
 pub struct Example1 {
     /// Every run starts afresh and lasts this many steps (100 s of motion:
@@ -44,39 +45,53 @@ pub struct Example1 {
     /// into a spurious equilibrium, which would no longer be a benchmark
     /// of the motion).
     pub steps_per_run: u64,
+    /// Runs per trial.
     pub runs_per_trial: u64,
+    /// Interleaved trials; each figure is the best over them.
     pub trials: usize,
     /// cdyn's [`SmallSimulation`]: the system's size known at compile time.
     pub cdyn_ns_per_step: f64,
     /// cdyn's general [`Simulation`] of a [`cdyn::Model`] (run-time sizes, element blocks).
     pub general_ns_per_step: f64,
+    /// The same step written out by hand ([`cdyn::baseline`]).
     pub handwritten_ns_per_step: f64,
     /// cdyn / hand-written.
     pub overhead_ratio: f64,
     /// general / hand-written.
     pub general_overhead_ratio: f64,
+    /// The most allocations per step of any run (0 expected).
     pub allocations_per_step: f64,
 }
 
+/// One size of the planar chain (`cvsgf_energy`, AB-3, h = 1e-3).
 #[derive(Debug, Serialize)]
 pub struct ChainRun {
+    /// Bodies.
     pub n: usize,
+    /// Steps timed.
     pub steps: u64,
+    /// Time per step.
     pub us_per_step: f64,
+    /// Largest `|Φ|` over the run.
     pub max_abs_phi: f64,
+    /// Allocations per step (0 expected).
     pub allocations_per_step: f64,
+    /// The factorization of `S` used: `dense` or `sparse`.
     pub solver: &'static str,
 }
 
 /// The spatial chain's step in cdyn against the same chain written out by hand.
 #[derive(Debug, Serialize)]
 pub struct SpatialBaseline {
+    /// Bodies.
     pub n: usize,
     /// Every run starts afresh (set-up untimed) and lasts this many steps.
     pub steps_per_run: u64,
+    /// Interleaved trials.
     pub trials: usize,
     /// Best over the interleaved trials.
     pub cdyn_us_per_step: f64,
+    /// The hand-written step, best over the trials.
     pub handwritten_us_per_step: f64,
     /// cdyn / hand-written.
     pub overhead_ratio: f64,
@@ -110,16 +125,22 @@ pub struct MethodComparison {
     pub h: f64,
     /// Every run starts afresh (set-up untimed) and lasts this many steps.
     pub steps_per_run: u64,
+    /// Runs per trial.
     pub runs_per_trial: u64,
+    /// Interleaved trials.
     pub trials: usize,
     /// In the order of [`METHODS`].
     pub methods: Vec<MethodCost>,
 }
 
+/// What `bench.json` holds.
 #[derive(Debug, Serialize)]
 pub struct Report {
+    /// A `--light` run: few steps, figures that mean little.
     pub light: bool,
+    /// Example 1 against hand-written code.
     pub example1: Example1,
+    /// The planar chain at each size.
     pub chain: Vec<ChainRun>,
     /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
     pub chain_cost_exponent: Option<f64>,

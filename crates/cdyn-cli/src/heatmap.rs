@@ -10,11 +10,17 @@ use std::path::Path;
 
 /// A table of values over two axes; `z[iy][ix]`, `None` where the run failed.
 pub struct HeatMap<'a> {
+    /// Title above the map.
     pub title: &'a str,
+    /// Label of the x axis.
     pub x_label: &'a str,
+    /// The x axis values, one per column.
     pub x_values: &'a [f64],
+    /// Label of the y axis.
     pub y_label: &'a str,
+    /// The y axis values, one per row.
     pub y_values: &'a [f64],
+    /// The values, `z[iy][ix]`.
     pub z: &'a [Vec<Option<f64>>],
 }
 

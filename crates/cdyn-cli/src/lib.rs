@@ -3,6 +3,8 @@
 //! Python package (crates/cdyn-py), so both read scenarios, run cases and
 //! word errors the same way.
 
+#![deny(missing_docs)]
+
 pub mod alloc_count;
 pub mod bench;
 pub mod compare;

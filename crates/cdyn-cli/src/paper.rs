@@ -10,7 +10,9 @@ use cdyn::{Scheme, Settings};
 use serde_json::json;
 use std::path::Path;
 
+/// The paper's step size.
 pub const H: f64 = 0.01;
+/// The paper's end time.
 pub const T_END: f64 = 20.0;
 
 /// Every case of the paper's test, by name: the Cartesian pendulum under

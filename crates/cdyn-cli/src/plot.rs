@@ -20,23 +20,32 @@ use plotters::style::{FontStyle, register_font};
 
 /// One labelled line of a figure.
 pub struct Series {
+    /// Its name in the legend.
     pub label: String,
+    /// Its points `(x, y)`.
     pub points: Vec<(f64, f64)>,
 }
 
 /// How the y axis maps values.
 pub enum Scale {
+    /// y as it is.
     #[allow(dead_code)] // the figures cdyn writes are all logarithmic today
     Linear,
     /// log10 of |y|; points with y == 0 or non-finite are skipped
     LogAbs,
 }
 
+/// A line figure: its labels, y scale and series.
 pub struct Figure<'a> {
+    /// Title above the plot.
     pub title: &'a str,
+    /// Label of the x axis.
     pub x_label: &'a str,
+    /// Label of the y axis.
     pub y_label: &'a str,
+    /// How y is mapped.
     pub scale: Scale,
+    /// The lines drawn.
     pub series: &'a [Series],
 }
 

@@ -51,8 +51,11 @@ pub fn write_summary(dir: &Path, cases: &[CaseResult], extra: serde_json::Value)
 /// Which time history a figure shows.
 #[derive(Clone, Copy)]
 pub enum Quantity {
+    /// The constraint violation `Φ`.
     Phi,
+    /// The energy violation `Ψ`.
     Psi,
+    /// The error against the reference.
     Err,
 }
 

@@ -19,9 +19,13 @@ use std::path::Path;
 
 /// One case to run.
 pub struct Case {
+    /// Its name: the CSV file's stem.
     pub name: String,
+    /// The model and its initial state.
     pub example: Example,
+    /// Scheme, step and method.
     pub settings: Settings,
+    /// End time, a whole number of steps.
     pub t_end: f64,
     /// Write a sample every this many steps.
     pub every: u64,
@@ -108,12 +112,16 @@ pub fn every_to_fit(every: u64, bytes: u64) -> u64 {
 /// library's record of the run.
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
+    /// The case's name.
     pub name: String,
     /// The observable whose error against the reference is reported.
     pub error_observable: String,
+    /// The scheme's name.
     pub scheme: &'static str,
+    /// The step size.
     #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub h: f64,
+    /// The library's record of the run.
     #[serde(flatten)]
     pub record: Record,
     /// The method as it ran: its automatic gains chosen (`None` if it could not start).

@@ -15,23 +15,32 @@ use cdyn::{Scheme, Settings};
 use serde::Deserialize;
 use std::path::Path;
 
+/// A scenario file, as read: every table and list it may have.
 #[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
+    /// `[model]`.
     pub model: ModelSpec,
+    /// `[initial]`.
     #[serde(default)]
     pub initial: InitialSpec,
     /// `[method]`; without it, the `robust` preset.
     pub method: Option<MethodKeys>,
+    /// `[integrator]`.
     pub integrator: IntegratorSpec,
+    /// `[output]`.
     #[serde(default)]
     pub output: OutputSpec,
+    /// `[[bodies]]` of a planar mechanism.
     #[serde(default)]
     pub bodies: Vec<Body>,
+    /// `[[joints]]` of a planar mechanism.
     #[serde(default, deserialize_with = "cdyn::planar::format::joints")]
     pub joints: Vec<Element<String>>,
+    /// `[[drives]]` of a planar mechanism.
     #[serde(default, deserialize_with = "cdyn::planar::format::drives")]
     pub drives: Vec<Element<String>>,
+    /// `[[forces]]` of a planar mechanism.
     #[serde(default, deserialize_with = "cdyn::planar::format::forces")]
     pub forces: Vec<Element<String>>,
     /// Axes of a parameter sweep (`cdyn sweep`): key → values.
@@ -54,9 +63,29 @@ pub struct Scenario {
 #[derive(Debug, Deserialize, Clone)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum InvariantSpec {
-    Momentum { axis: Vec<f64>, name: Option<String> },
-    AngularMomentum { axis: Option<Vec<f64>>, point: Option<Vec<f64>>, name: Option<String> },
-    Coordinate { coordinate: String, name: Option<String> },
+    /// Every body translated along `axis`.
+    Momentum {
+        /// The direction, in the mechanism's dimension.
+        axis: Vec<f64>,
+        /// Its name in the output.
+        name: Option<String>,
+    },
+    /// The rigid rotation about `axis` through `point`.
+    AngularMomentum {
+        /// The axis (spatial; default z).
+        axis: Option<Vec<f64>>,
+        /// A point on the axis (default the origin).
+        point: Option<Vec<f64>>,
+        /// Its name in the output.
+        name: Option<String>,
+    },
+    /// The generalized momentum of one coordinate.
+    Coordinate {
+        /// The coordinate's name (`sled.angle`).
+        coordinate: String,
+        /// Its name in the output.
+        name: Option<String>,
+    },
 }
 
 impl InvariantSpec {
@@ -113,10 +142,13 @@ impl InvariantSpec {
 /// A spatial mechanism's entries, bodies named by the joints.
 #[derive(Debug, Deserialize, Clone, Default)]
 pub struct SpatialEntries {
+    /// `[[bodies]]`.
     #[serde(default)]
     pub bodies: Vec<cdyn::spatial::Body>,
+    /// `[[joints]]`.
     #[serde(default)]
     pub joints: Vec<cdyn::spatial::Joint<String>>,
+    /// `[[forces]]`.
     #[serde(default)]
     pub forces: Vec<cdyn::spatial::Load<String>>,
 }
@@ -125,8 +157,11 @@ pub struct SpatialEntries {
 /// (three components for spatial ones).
 #[derive(Debug, Clone, Copy)]
 pub enum GravitySpec {
+    /// `g` for the pendulums.
     Magnitude(f64),
+    /// `[gx, gy]` for planar mechanisms.
     Vector([f64; 2]),
+    /// `[gx, gy, gz]` for spatial mechanisms.
     Vector3([f64; 3]),
 }
 
@@ -157,7 +192,9 @@ impl<'de> Deserialize<'de> for GravitySpec {
 /// one place; unknown ones are refused there.
 #[derive(Debug, Deserialize, Clone)]
 pub struct ModelSpec {
+    /// `kind`: which model.
     pub kind: Kind,
+    /// `gravity`, where the kind takes one.
     pub gravity: Option<GravitySpec>,
     /// Parameters of the other built-in models.
     pub parameters: Option<toml::Table>,
@@ -167,24 +204,32 @@ pub struct ModelSpec {
     pub pendulum_keys: toml::Table,
 }
 
+/// `[initial]`: overrides and checks of the initial state.
 #[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
+    /// The initial positions, overriding the model's.
     pub q: Option<Vec<f64>>,
+    /// The initial velocities, overriding the model's.
     pub v: Option<Vec<f64>>,
     /// Start even if the initial state violates the constraints.
     #[serde(default)]
     pub off_constraint: bool,
     /// Project the initial state onto the constraints first (default: on for mechanisms).
     pub assemble: Option<bool>,
+    /// How far off the constraints the initial state may be (default 1e-9).
     pub tolerance: Option<f64>,
 }
 
+/// `[integrator]`.
 #[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
+    /// The fixed-step scheme.
     pub scheme: Scheme,
+    /// The step size.
     pub h: f64,
+    /// The end time, a whole number of steps.
     pub t_end: f64,
     /// A constraint row that depends on the others: `"error"` (default) or
     /// `"tolerate"` (solved without it; redundant constraints).
@@ -192,6 +237,7 @@ pub struct IntegratorSpec {
     pub dependent_rows: DependentRows,
 }
 
+/// `[output]`.
 #[derive(Debug, Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {

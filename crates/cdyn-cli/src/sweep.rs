@@ -16,32 +16,45 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// One axis of the grid: a key and its values.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Axis {
+    /// The `[method]` key or `h`.
     pub name: String,
+    /// Its values, in the order given.
     #[serde(with = "cdyn::json_float")]
     pub values: Vec<f64>,
 }
 
+/// One grid point and how its run went.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Point {
+    /// Its index in the grid, by which points are stored and sharded.
     pub index: usize,
     /// One value per axis.
     #[serde(with = "cdyn::json_float")]
     pub values: Vec<f64>,
+    /// Largest `|Φ|`.
     #[serde(with = "cdyn::json_float")]
     pub max_abs_phi: f64,
+    /// Largest `|Ψ|`.
     #[serde(with = "cdyn::json_float")]
     pub max_abs_psi: f64,
+    /// Largest error against the reference, where the model has one.
     #[serde(with = "cdyn::json_float")]
     pub max_abs_err: Option<f64>,
+    /// Steps taken.
     pub steps: u64,
+    /// Why the run stopped early, if it did.
     pub error: Option<String>,
 }
 
+/// Which part of a sharded sweep: points with `index % count == index`.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Shard {
+    /// This shard's index.
     pub index: usize,
+    /// The number of shards.
     pub count: usize,
 }
 
@@ -54,13 +67,16 @@ pub struct Sweep {
     /// grid included, so `merge` refuses shards of an edited file and
     /// accepts the same file given by any path.
     pub scenario_hash: String,
+    /// The grid's axes.
     pub axes: Vec<Axis>,
     /// `None` for a complete sweep.
     pub shard: Option<Shard>,
+    /// The points run, by index.
     pub points: Vec<Point>,
 }
 
 impl Sweep {
+    /// The number of points of the whole grid.
     pub fn total(&self) -> usize {
         self.axes.iter().map(|a| a.values.len()).product()
     }
