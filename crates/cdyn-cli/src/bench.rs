@@ -29,7 +29,7 @@
 use crate::alloc_count::allocations;
 use anyhow::Result;
 use cdyn::baseline::{HandWritten, HandWrittenChain};
-use cdyn::methods::{self, MethodGains};
+use cdyn::control::methods::{self, MethodGains};
 use cdyn::models::{ChainParams, Example, PendulumParams, cartesian_pendulum, chain, small_pendulum};
 use cdyn::small::SmallSimulation;
 use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme, Settings, Simulation};

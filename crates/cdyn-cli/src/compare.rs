@@ -6,7 +6,7 @@ use crate::report;
 use crate::runner::{Case, CaseResult};
 use crate::scenario::Scenario;
 use anyhow::Result;
-use cdyn::methods::compare_cases;
+use cdyn::control::methods::compare_cases;
 use serde_json::json;
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 use crate::report;
 use crate::runner::{Case, CaseResult};
 use anyhow::Result;
-use cdyn::methods::{MethodGains, independent_cases, redundant_cases};
+use cdyn::control::methods::{MethodGains, independent_cases, redundant_cases};
 use cdyn::models::{Example, PendulumParams, cartesian_pendulum, theta_pendulum};
 use cdyn::{Scheme, Settings};
 use serde_json::json;

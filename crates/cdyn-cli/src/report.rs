@@ -128,7 +128,7 @@ pub fn table(cases: &[CaseResult]) -> String {
                 c.name,
                 if projected { "the projection of Ψ" } else { "energy term" },
                 t.dissipation_h,
-                cdyn::gains::STIFF_DISSIPATION_H
+                cdyn::control::gains::STIFF_DISSIPATION_H
             );
         }
     }
@@ -154,13 +154,13 @@ fn momenta_lines(cases: &[CaseResult]) -> String {
                     m.reason.as_deref().unwrap_or("something"),
                     m.max_drift
                 );
-            } else if m.linear && m.max_drift > cdyn::momentum::ROUND_OFF * m.scale {
+            } else if m.linear && m.max_drift > cdyn::dynamics::momentum::ROUND_OFF * m.scale {
                 out += &format!(
                     "note: {}: {} drifted by {:.3e}, above round-off ({:.1e} of its scale {:.3e})\n",
                     c.name,
                     m.name,
                     m.max_drift,
-                    cdyn::momentum::ROUND_OFF,
+                    cdyn::dynamics::momentum::ROUND_OFF,
                     m.scale
                 );
             }
@@ -170,7 +170,7 @@ fn momenta_lines(cases: &[CaseResult]) -> String {
 }
 
 /// The assembly report as JSON (infinities and NaN as strings, as everywhere).
-pub fn assembly_json(a: &cdyn::assemble::Assembly) -> serde_json::Value {
+pub fn assembly_json(a: &cdyn::dynamics::assemble::Assembly) -> serde_json::Value {
     json!({
         "newton_iterations": a.newton_iterations,
         "max_abs_phi_before": JsonFloat(a.phi_before),
@@ -183,7 +183,7 @@ pub fn assembly_json(a: &cdyn::assemble::Assembly) -> serde_json::Value {
 }
 
 /// One line saying what the assembly did.
-pub fn assembly_line(a: &cdyn::assemble::Assembly) -> String {
+pub fn assembly_line(a: &cdyn::dynamics::assemble::Assembly) -> String {
     format!(
         "assembly: {} Newton iterations, max |Φ| {:.2e} → {:.2e}, max |Φ̇| {:.2e} → {:.2e}, max |Δq| = {:.2e}, max |Δv| = {:.2e}",
         a.newton_iterations, a.phi_before, a.phi_after, a.phi_dot_before, a.phi_dot_after, a.max_dq, a.max_dv

@@ -9,8 +9,8 @@ use crate::progress;
 use anyhow::{Context, Result};
 use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sample, Series, Sink};
+use cdyn::simulate::system::System;
 use cdyn::simulate::{RankLoss, Stepper, steps_to};
-use cdyn::system::System;
 use cdyn::{Settings, Simulation};
 use indicatif::ProgressBar;
 use serde::Serialize;
@@ -30,7 +30,7 @@ pub struct Case {
     /// Write a sample every this many steps.
     pub every: u64,
     /// What projecting the initial state onto the constraints changed, if it was done.
-    pub assembly: Option<cdyn::assemble::Assembly>,
+    pub assembly: Option<cdyn::dynamics::assemble::Assembly>,
     /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
     /// where the model comes from entries; errors name it instead of the row.
     pub row_entries: Vec<String>,
@@ -127,7 +127,7 @@ pub struct CaseResult {
     /// The method as it ran: its automatic gains chosen (`None` if it could not start).
     pub control: Option<cdyn::Control>,
     /// What the automatic gains were chosen from, and the largest rate × h.
-    pub tuning: Option<cdyn::gains::Tuning>,
+    pub tuning: Option<cdyn::control::gains::Tuning>,
     /// Mean Newton iterations per step of the `projection` method.
     pub projection_iterations_per_step: Option<f64>,
     /// Steps in which constraint rows were dropped as dependent
@@ -148,7 +148,7 @@ pub struct CaseResult {
 struct Method {
     interrupted: bool,
     control: Option<cdyn::Control>,
-    tuning: Option<cdyn::gains::Tuning>,
+    tuning: Option<cdyn::control::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
     frames: Frames,
     rank_loss: Option<RankLoss>,

@@ -4,10 +4,10 @@
 
 use crate::runner::Case;
 use anyhow::{Result, anyhow, bail};
-use cdyn::assemble::assemble_with;
+use cdyn::control::methods::{MethodKeys, Preset};
 use cdyn::dynamics::DependentRows;
+use cdyn::dynamics::assemble::assemble_with;
 use cdyn::error::{Part, positive};
-use cdyn::methods::{MethodKeys, Preset};
 use cdyn::models::{Example, Kind};
 use cdyn::planar::{Body, Element, Group, Mechanism};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
@@ -125,7 +125,7 @@ impl InvariantSpec {
                 };
                 let label =
                     name.clone().unwrap_or_else(|| format!("angular momentum about {axis:?} through {point:?}"));
-                let g = cdyn::angular::Generator::rotation(&label, names, axis, point, true)?;
+                let g = cdyn::model::angular::Generator::rotation(&label, names, axis, point, true)?;
                 return example.model.declare_angular_momentum(g).map_err(|e| e.to_string());
             }
             InvariantSpec::Coordinate { coordinate, name } => {
@@ -488,7 +488,7 @@ impl Scenario {
             None
         };
         if let Some(tolerance) = settings.consistency_tolerance {
-            let mut probe = cdyn::diagnostics::Probe::new(&example.model);
+            let mut probe = cdyn::dynamics::diagnostics::Probe::new(&example.model);
             let m = probe.measure(&example.model, &example.q0, &example.v0, 0.0, 0.0, 0.0);
             if m.phi.abs() > tolerance || m.phi_dot > tolerance {
                 bail!(

@@ -100,7 +100,7 @@ pub struct Run {
     #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub rate_h: Option<f64>,
     /// Whether its automatic energy term was left out, the damping being
-    /// stiff against the step (`cdyn::gains::STIFF_DISSIPATION_H`).
+    /// stiff against the step (`cdyn::control::gains::STIFF_DISSIPATION_H`).
     pub energy_left_out: bool,
     /// Mean Newton iterations per step of its projection, if it projects.
     #[serde(serialize_with = "cdyn::json_float::serialize")]
@@ -395,12 +395,12 @@ fn verdicts(runs: &[Run], none: usize, robust: usize, projection: usize, free_mo
             let worst = worst.max_by(|a, b| a.0.total_cmp(&b.0));
             let numbers = worst.map_or(String::new(), |(d, r)| format!("largest {d:.3e} of its scale ({})", r.method));
             let applies = none.linear_momentum_drift.is_some();
-            verdict(applies, worst.is_none_or(|(d, _)| d <= cdyn::momentum::ROUND_OFF), numbers)
+            verdict(applies, worst.is_none_or(|(d, _)| d <= cdyn::dynamics::momentum::ROUND_OFF), numbers)
         },
         match (robust.momentum_drift, none.momentum_drift) {
             (Some(r), Some(n)) => verdict(
                 true,
-                r <= n.max(cdyn::momentum::ROUND_OFF),
+                r <= n.max(cdyn::dynamics::momentum::ROUND_OFF),
                 format!("robust {r:.3e}, none {n:.3e} of the scale"),
             ),
             _ => verdict(false, true, String::new()),

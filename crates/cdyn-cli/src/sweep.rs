@@ -168,7 +168,7 @@ fn at_point(scenario: &Scenario, axes: &[Axis], values: &[f64]) -> Result<Scenar
 }
 
 /// Sets one axis: `h`, or a key of the library's method table (whatever
-/// [`cdyn::methods::MethodKeys`] accepts, so a new gain needs no change here).
+/// [`cdyn::control::methods::MethodKeys`] accepts, so a new gain needs no change here).
 fn set(scenario: &mut Scenario, name: &str, value: f64) -> Result<()> {
     if name == "h" {
         scenario.integrator.h = value;

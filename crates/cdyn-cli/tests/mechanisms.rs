@@ -42,7 +42,7 @@ fn compare_runs_every_method_and_reports_final_states() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let s = summary(dir.path());
     let names: Vec<&str> = s["cases"].as_array().unwrap().iter().map(|c| c["name"].as_str().unwrap()).collect();
-    let expected = cdyn::methods::compare_cases(&cdyn::methods::MethodGains::paper(), true);
+    let expected = cdyn::control::methods::compare_cases(&cdyn::control::methods::MethodGains::paper(), true);
     assert_eq!(names, expected.iter().map(|(n, _)| *n).collect::<Vec<_>>());
     assert_eq!(names.last(), Some(&"projection"), "the paper's cases, then robust and projection");
     for c in s["cases"].as_array().unwrap() {

@@ -16,7 +16,10 @@ fn cdyn(args: &[&str], out: &Path) -> Output {
 const MODELS: [&str; 4] = ["example1", "mixed_masses", "pendulum_rest", "slider_crank"];
 /// The methods of `cdyn compare` on a model with constraints, as the library names them.
 fn methods() -> Vec<&'static str> {
-    cdyn::methods::compare_cases(&cdyn::methods::MethodGains::paper(), true).into_iter().map(|(n, _)| n).collect()
+    cdyn::control::methods::compare_cases(&cdyn::control::methods::MethodGains::paper(), true)
+        .into_iter()
+        .map(|(n, _)| n)
+        .collect()
 }
 
 /// Checks that miss in the light suite: (model, scheme, h, check, measured and why).
@@ -88,7 +91,7 @@ fn the_light_suite_has_every_case_and_its_checks_hold_but_the_known_misses() {
 
     let models: BTreeSet<&str> = cases.iter().map(|c| c["model"].as_str().unwrap()).collect();
     assert_eq!(models, MODELS.into_iter().collect());
-    let tolerance = cdyn::projection::Projection::default().tolerance;
+    let tolerance = cdyn::control::projection::Projection::default().tolerance;
     let mut misses = Vec::new();
     let mut seen = Vec::new();
     for model in MODELS {

@@ -10,7 +10,7 @@
 //! as JSON.
 
 use cdyn::baseline::HandWritten;
-use cdyn::methods::{self, MethodGains};
+use cdyn::control::methods::{self, MethodGains};
 use cdyn::models::{
     ChainParams, DoublePendulumParams, Example, FourBarParams, LoadPendulum, PendulumParams, cartesian_pendulum, chain,
     double_pendulum, double_pendulum_angles, four_bar, four_bar_angles, small_pendulum,

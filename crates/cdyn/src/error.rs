@@ -118,7 +118,7 @@ pub enum Error {
     Separatrix,
 }
 
-/// A combination of method keys ([`MethodKeys`](crate::methods::MethodKeys))
+/// A combination of method keys ([`MethodKeys`](crate::control::methods::MethodKeys))
 /// that does not describe one method.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]

@@ -53,55 +53,45 @@ pub(crate) use setters;
 #[doc = include_str!("../../../docs/library.md")]
 pub struct BookLibrary;
 
-pub mod angular;
-pub mod assemble;
+pub mod ad;
 #[doc(hidden)] // for benchmarks only; see its module head
 pub mod baseline;
-pub mod constraint;
 pub mod control;
-pub mod diagnostics;
 pub mod dynamics;
-pub mod energy;
 pub mod error;
-mod evaluation;
-pub mod force;
-pub mod gains;
-pub mod held;
 pub mod integrate;
-pub mod invariant;
-mod jet;
 #[cfg(feature = "serde")]
 pub mod json_float;
-pub mod kinetic;
-mod linalg;
-mod manifold;
-pub mod mass;
-pub mod methods;
+pub mod linalg;
 pub mod model;
 pub mod models;
-pub mod momentum;
-pub mod nonholonomic;
 pub mod planar;
-pub mod projection;
 pub mod record;
 pub mod reference;
-pub mod scalar;
 pub mod simulate;
 pub mod small;
-mod sparse;
 pub mod spatial;
-pub mod system;
-pub mod timefn;
-pub mod unit_vector;
 
-pub use constraint::Constraint;
+/// The flat paths of 0.1 (`cdyn::mass`, `cdyn::gains`, …), kept so that
+/// programs written against them still build; see `CHANGELOG.md`.
+#[doc(hidden)]
+pub use crate::{
+    ad::scalar,
+    control::{gains, held, methods, projection},
+    dynamics::{assemble, diagnostics, energy, momentum},
+    linalg::mass,
+    model::{angular, constraint, force, invariant, kinetic, nonholonomic, timefn, unit_vector},
+    simulate::system,
+};
+
+pub use ad::scalar::Scalar;
 pub use control::{Control, Energy, EnergyGain, Gain, Geometric, Invariants, Rate, Velocity};
 pub use error::{Error, Result};
-pub use force::{Force, Potential};
 pub use integrate::{Application, Scheme};
-pub use invariant::Invariant;
-pub use kinetic::Kinetic;
 pub use model::Model;
-pub use nonholonomic::Nonholonomic;
-pub use scalar::Scalar;
+pub use model::constraint::Constraint;
+pub use model::force::{Force, Potential};
+pub use model::invariant::Invariant;
+pub use model::kinetic::Kinetic;
+pub use model::nonholonomic::Nonholonomic;
 pub use simulate::{Settings, Simulation};

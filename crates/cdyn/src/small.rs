@@ -11,22 +11,22 @@
 //! the storage differs. [`to_model`] turns the same system into a general
 //! model, and the tests hold both to the same trajectories.
 
-use crate::constraint::{Constraint, local};
+use crate::ad::scalar::Scalar;
+use crate::control::evaluation::Evaluation;
+use crate::control::gains::Operators;
+use crate::control::projection::{Failure, Projection};
 use crate::control::{Control, Workspace};
-use crate::diagnostics::Measures;
-use crate::energy;
+use crate::dynamics::diagnostics::Measures;
+use crate::dynamics::energy;
 use crate::error::{Error, Result};
-use crate::evaluation::Evaluation;
-use crate::force::{Force, Potential, energy_and_gradient};
-use crate::gains::Operators;
 use crate::integrate::{Buffer, Rhs};
+use crate::linalg::mass::{DiagonalMass, MassMatrix};
 use crate::linalg::{Breakdown, DependentRows, inverse_pivot};
-use crate::mass::{DiagonalMass, MassMatrix};
+use crate::model::constraint::{Constraint, local};
+use crate::model::force::{Force, Potential, energy_and_gradient};
 use crate::model::{Model, check_rows};
-use crate::projection::{Failure, Projection};
-use crate::scalar::Scalar;
+use crate::simulate::system::{EvalError, System};
 use crate::simulate::{Settings, Stepper, check_initial_state};
-use crate::system::{EvalError, System};
 use num_dual::Dual64;
 use std::sync::Arc;
 
@@ -430,9 +430,9 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
             out.iter_mut().zip(f).for_each(|(o, f)| *o = -f.eps);
         };
         Ok(Operators {
-            coupling: crate::gains::coupling(&self.d, N),
+            coupling: crate::control::gains::coupling(&self.d, N),
             max_row_norm2: rows.fold(0.0, f64::max),
-            dissipation: crate::gains::dissipation_rate(&self.d, N, damping),
+            dissipation: crate::control::gains::dissipation_rate(&self.d, N, damping),
         })
     }
     fn set_control(&mut self, control: Control) {

@@ -7,20 +7,20 @@
 //! (nonholonomic rows); and the models whose `M(q)` comes from a kinetic
 //! energy (the double pendulum and the loaded four-bar in angles).
 
+use cdyn::control::methods;
+use cdyn::control::projection::{OnFailure, Projection};
 use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, POSITION_WEIGHT, Rate, Velocity};
 use cdyn::dynamics::{DependentRows, LinearSolver};
 use cdyn::integrate::Application;
-use cdyn::methods;
+use cdyn::model::timefn::TimeFn;
 use cdyn::models::{
     DoublePendulumParams, Example, FourBarParams, LoadPendulum, PendulumParams, andrews, cartesian_pendulum,
     double_pendulum_angles, four_bar_angles, small_pendulum,
 };
 use cdyn::planar::{BodyId, Coordinate, Element, Mechanism};
-use cdyn::projection::{OnFailure, Projection};
 use cdyn::simulate::Stepper;
+use cdyn::simulate::system::System as Controlled;
 use cdyn::small::SmallSimulation;
-use cdyn::system::System as Controlled;
-use cdyn::timefn::TimeFn;
 use cdyn::{Scheme, Settings, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -1,4 +1,4 @@
-//! Angular momenta (`cdyn::angular`), in layers: the rotations found
+//! Angular momenta (`cdyn::model::angular`), in layers: the rotations found
 //! against hand-built cases (a free body keeps all three, a top on a fixed
 //! point the vertical one, a top whose point is off the axis or a push a
 //! millionth of gravity none), the rotation field and its momentum against
@@ -6,11 +6,11 @@
 //! at their rate at a state off both, and a free asymmetric body's angular
 //! momentum over 1 000 s.
 
+use cdyn::dynamics::momentum::{self, Kind, ROUND_OFF};
 use cdyn::integrate::Rhs;
-use cdyn::momentum::{self, Kind, ROUND_OFF};
+use cdyn::simulate::system::{ControlledSystem, System};
 use cdyn::spatial::rotation::{about, body_rate, compose, e_matrix, rotate};
 use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
-use cdyn::system::{ControlledSystem, System};
 use cdyn::{
     Control, Energy, Geometric, Invariant, Model, Rate, Scalar, Scheme, Settings, Simulation, Velocity, methods,
 };

@@ -71,7 +71,7 @@ fn cartesian_and_angle_models_agree_for_other_parameters() {
 fn the_hand_written_baseline_follows_cdyn_step_for_step() {
     // The benchmark compares cdyn with this baseline: it must compute the same thing.
     use cdyn::baseline::HandWritten;
-    use cdyn::methods::{MethodGains, redundant_cases};
+    use cdyn::control::methods::{MethodGains, redundant_cases};
     let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
     let control = redundant_cases(&MethodGains::paper()).into_iter().find(|(n, _)| *n == "cvsgf_energy").unwrap().1;
     let mut sim =

@@ -2,7 +2,7 @@
 //! over random states, for a time-dependent multi-row constraint element.
 
 use cdyn::dynamics::Dynamics;
-use cdyn::mass::MassMatrix;
+use cdyn::linalg::mass::MassMatrix;
 use cdyn::{Constraint, Model, Potential, Scalar};
 use proptest::prelude::*;
 

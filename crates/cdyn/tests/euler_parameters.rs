@@ -7,7 +7,7 @@
 //! and the spatial angular momentum exact. This is the formulation the
 //! spatial issue has to weigh; the numbers here are its first measurement.
 
-use cdyn::kinetic::Kinetic;
+use cdyn::model::kinetic::Kinetic;
 use cdyn::reference::torque_free_rate;
 use cdyn::spatial::rotation::{body_rate, e_matrix, g_matrix};
 use cdyn::{Constraint, Control, Error, Model, Scalar, Scheme, Settings, Simulation, methods};

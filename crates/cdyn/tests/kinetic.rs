@@ -6,13 +6,13 @@
 
 use cdyn::control::{Control, Energy, POSITION_WEIGHT, Rate};
 use cdyn::integrate::Rhs;
-use cdyn::kinetic::local;
-use cdyn::mass::DenseMass;
+use cdyn::linalg::mass::DenseMass;
+use cdyn::model::kinetic::local;
 use cdyn::models::{
     DoublePendulumKinetic, DoublePendulumParams, Example, FourBarParams, LoadPendulum, double_pendulum,
     double_pendulum_angles, four_bar, four_bar_angles,
 };
-use cdyn::system::ControlledSystem;
+use cdyn::simulate::system::ControlledSystem;
 use cdyn::{Error, Model, Scheme, Settings, Simulation};
 use proptest::prelude::*;
 

@@ -6,14 +6,14 @@
 
 use std::f64::consts::PI;
 
+use cdyn::control::methods::{MethodGains, redundant_cases};
 use cdyn::dynamics::Dynamics;
-use cdyn::methods::{MethodGains, redundant_cases};
+use cdyn::model::timefn::TimeFn;
 use cdyn::models::{
     ChainParams, DampedPendulumParams, DoublePendulumParams, Example, FourBarBranch, FourBarParams, LoadPendulum,
     MovingSupportParams, SliderCrankParams, chain, damped_pendulum, double_pendulum, four_bar, moving_support_pendulum,
     slider_crank,
 };
-use cdyn::timefn::TimeFn;
 use cdyn::{Control, Error, Gain, Scheme, Settings, Simulation};
 
 const G: f64 = 9.81;

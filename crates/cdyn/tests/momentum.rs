@@ -1,4 +1,4 @@
-//! Momenta the system keeps (`cdyn::momentum`), in layers: the symmetries
+//! Momenta the system keeps (`cdyn::dynamics::momentum`), in layers: the symmetries
 //! found against hand-built cases (found where they hold; not found where
 //! one force, one joint to the ground or a small push breaks them), every
 //! control law's correction M-orthogonal to them at random states, the
@@ -6,13 +6,13 @@
 //! heading against its closed form, the floating chain's centre of mass on
 //! its straight line.
 
-use cdyn::assemble::assemble;
+use cdyn::control::methods::{self, MethodGains};
+use cdyn::dynamics::assemble::assemble;
+use cdyn::dynamics::momentum::{self, ROUND_OFF};
 use cdyn::integrate::Rhs;
-use cdyn::methods::{self, MethodGains};
-use cdyn::momentum::{self, ROUND_OFF};
+use cdyn::model::timefn::TimeFn;
 use cdyn::planar::{BodyId, Element, Mechanism};
-use cdyn::system::ControlledSystem;
-use cdyn::timefn::TimeFn;
+use cdyn::simulate::system::ControlledSystem;
 use cdyn::{Control, Energy, Gain, Geometric, Invariants, Model, Rate, Scheme, Settings, Simulation, Velocity};
 
 /// A chain of `masses.len()` rods (1 m) joined end to end by revolute

@@ -4,10 +4,10 @@
 //! bicycle with fixed steering against their closed forms, with and
 //! without stabilization, and bad knife edges named.
 
+use cdyn::control::methods;
 use cdyn::control::{Control, Geometric, Rate, Velocity};
 use cdyn::dynamics::Dynamics;
 use cdyn::integrate::Application;
-use cdyn::methods;
 use cdyn::planar::{BodyId, Element, Mechanism};
 use cdyn::{Model, Nonholonomic, Potential, Scalar, Scheme, Settings, Simulation};
 
@@ -291,7 +291,7 @@ fn sled_errors_converge_at_each_schemes_order() {
 ///
 /// Every one of them also lowers the coordinates' error. The sled's heading
 /// rate is a first integral (no torque about the edge) which the scheme
-/// keeps exactly; the run finds it (`cdyn::momentum`), and the energy
+/// keeps exactly; the run finds it (`cdyn::dynamics::momentum`), and the energy
 /// correction of `robust` and `projection` moves `v` along `P_E P v`, which
 /// leaves it alone. (Along `P v`, before, it rescaled the heading rate with
 /// the rest of `v`: error 0.63 for robust, 0.67 for projection, against

@@ -6,7 +6,7 @@ use cdyn::control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity
 use cdyn::dynamics::Dynamics;
 use cdyn::integrate::{Application, Integrator, Rhs, Scheme};
 use cdyn::models::{PendulumParams, cartesian_pendulum};
-use cdyn::system::ControlledSystem;
+use cdyn::simulate::system::ControlledSystem;
 use cdyn::{Error, Model, Settings, Simulation};
 
 const G: f64 = 1.0;

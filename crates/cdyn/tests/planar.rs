@@ -80,7 +80,7 @@ fn bad_descriptions_name_the_element() {
 
 #[test]
 fn assembly_projects_positions_and_velocities_onto_the_constraints() {
-    use cdyn::assemble::assemble;
+    use cdyn::dynamics::assemble::assemble;
     use cdyn::models::andrews::{constants, mechanism};
     // Andrews' mechanism with every angle off by up to 0.02 rad and random velocities.
     let mut q0 = constants::Q0;
@@ -106,8 +106,8 @@ fn assembly_projects_positions_and_velocities_onto_the_constraints() {
 #[test]
 fn assembly_respects_a_moving_drive() {
     // A bar driven at φ = 2t about a pin: after assembly Φ_q v = −Φ_t, i.e. ω = 2.
-    use cdyn::assemble::assemble;
-    use cdyn::timefn::TimeFn;
+    use cdyn::dynamics::assemble::assemble;
+    use cdyn::model::timefn::TimeFn;
     let mut m = Mechanism::new([0.0, -G]);
     let bar = m.rigid("bar", 1.0, 0.1, [0.52, 0.03], 0.05);
     m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bar, pb: [-0.5, 0.0] });

@@ -4,9 +4,9 @@
 //! position where N rows become dependent) against its published
 //! reference and against the exact one-degree-of-freedom motion.
 
+use cdyn::control::projection::Projection;
 use cdyn::dynamics::{DependentRows, LinearSolver};
 use cdyn::planar::{BodyId, Element, Mechanism};
-use cdyn::projection::Projection;
 use cdyn::{Control, Error, Geometric, Rate, Scheme, Settings, Simulation};
 
 const G: f64 = 9.81;
@@ -262,7 +262,7 @@ fn every_method_is_well_defined_with_the_redundant_crank() {
     let theta0 = -0.6;
     let (plain, redundant) =
         (parallelogram(theta0, 0.0, false).build().unwrap(), parallelogram(theta0, 0.0, true).build().unwrap());
-    let mut cases = cdyn::methods::compare_cases(&cdyn::methods::MethodGains::paper(), true);
+    let mut cases = cdyn::control::methods::compare_cases(&cdyn::control::methods::MethodGains::paper(), true);
     cases.push(("newton_auto", Control::none().with_geometric(Geometric::Newton(Rate::Auto))));
     cases.push(("cvsgf_auto", Control::none().with_geometric(Geometric::Gradient(cdyn::Gain::Auto))));
     let (h, steps) = (1e-3, 3000);

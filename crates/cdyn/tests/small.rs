@@ -201,7 +201,7 @@ fn a_tolerated_doubled_row_is_the_circle_on_both_paths() {
     all.push(Control::none().with_geometric(Geometric::Newton(Rate::Given(40.0))));
     all.push(Control::none().with_velocity(Velocity::Gradient(Rate::Given(40.0))));
     all.push(Control::none().with_energy(Energy::Projected { alpha_e: Rate::Given(40.0), position_weight: 16.0 }));
-    all.push(cdyn::methods::robust());
+    all.push(cdyn::control::methods::robust());
     for control in all {
         let settings = Settings::new(Scheme::RungeKutta4, 0.01, control).with_dependent_rows(DependentRows::Tolerate);
         let d = divergence(DoubledRod, settings, [1.0, 0.0], [0.0, 1.0], 300);

@@ -4,10 +4,10 @@
 //! torque-free motion, the heavy top benchmark).
 
 use cdyn::dynamics::{DependentRows, Dynamics, LinearSolver};
+use cdyn::model::timefn::TimeFn;
 use cdyn::reference::torque_free_rate;
 use cdyn::spatial::rotation::{about, body_rate, compose, rate_from_body, rotate, space_rate};
 use cdyn::spatial::{Body, Built, Joint, JointKind, Mechanism, SpatialBody};
-use cdyn::timefn::TimeFn;
 use cdyn::{Control, Error, Model, Scheme, Settings, Simulation, methods};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
@@ -467,7 +467,9 @@ fn every_method_holds_the_heavy_tops_normalization_and_robust_is_no_worse() {
     };
     for (scheme, h) in [(Scheme::AdamsBashforth3, 1e-4), (Scheme::RungeKutta4, 5e-4)] {
         let none = run(scheme, h, Control::none());
-        for (name, control) in cdyn::methods::compare_cases(&cdyn::methods::MethodGains::paper(), true) {
+        for (name, control) in
+            cdyn::control::methods::compare_cases(&cdyn::control::methods::MethodGains::paper(), true)
+        {
             let (drift, error) = run(scheme, h, control);
             println!("{scheme:?} h = {h}: {name:>22}  max||p| − 1| {drift:.2e}  |p − p_ref| at 0.2 s {error:.2e}");
             if name == "robust" || name == "projection" {
@@ -757,7 +759,7 @@ proptest! {
     ) {
         let inertia = [[j[0] + j[1], off, 0.1], [off, j[1] + j[2], -0.2], [0.1, -0.2, j[0] + j[2]]];
         let body = cdyn::spatial::Rotation::new(inertia);
-        let (a, b) = (cdyn::kinetic::local(&body, p, pd), cdyn::kinetic::local_map(&body, p, pd));
+        let (a, b) = (cdyn::model::kinetic::local(&body, p, pd), cdyn::model::kinetic::local_map(&body, p, pd));
         let scale = 1.0 + a.energy.abs();
         prop_assert!((a.energy - b.energy).abs() < 1e-13 * scale);
         for r in 0..4 {
@@ -1003,7 +1005,7 @@ fn renormalized(built: &Built, scheme: Scheme, h: f64, t_end: f64, how: Renormal
     let Built { model, q0, v0, .. } = built;
     let n = model.n();
     let e0 = model.kinetic(q0, v0) + model.potential(q0, None);
-    let mut system = cdyn::system::ControlledSystem::new(model, Control::none(), e0);
+    let mut system = cdyn::simulate::system::ControlledSystem::new(model, Control::none(), e0);
     let mut integrator = cdyn::integrate::Integrator::new(scheme, Control::none().application, 2 * n + 1);
     let mut x = [q0.as_slice(), v0.as_slice(), &[0.0]].concat();
     let steps = cdyn::simulate::steps_to(t_end, h).unwrap();
@@ -1125,7 +1127,7 @@ fn carried_rate(model: &Model, q: &[f64], v: &[f64], p: [usize; 4], dependent: D
     let alpha = 7.0;
     let control = Control::none().with_geometric(cdyn::Geometric::Newton(cdyn::Rate::Given(alpha)));
     let e0 = model.kinetic(q, v) + model.potential(q, None);
-    let mut system = cdyn::system::ControlledSystem::new(model, control, e0);
+    let mut system = cdyn::simulate::system::ControlledSystem::new(model, control, e0);
     system.set_dependent_rows(dependent);
     let x = [q, v, &[0.0]].concat();
     let (mut f, mut u) = (vec![0.0; 2 * n + 1], vec![0.0; 2 * n + 1]);
@@ -1174,7 +1176,7 @@ fn projecting_the_euler_parameters_keeps_the_angular_velocity() {
     let (mut q, mut v) = (q0.clone(), v0.clone());
     // The same rotation and angular velocity, represented by 1.03 p.
     b.euler_parameters().iter().for_each(|&i| (q[i], v[i]) = (1.03 * q0[i], 1.03 * v0[i]));
-    let assembly = cdyn::assemble::assemble(&model, &mut q, &mut v, 0.0, 1e-14).unwrap();
+    let assembly = cdyn::dynamics::assemble::assemble(&model, &mut q, &mut v, 0.0, 1e-14).unwrap();
     assert!(assembly.newton_iterations > 1, "{assembly:?}");
     let (p, pd) = (b.orientation(&q), b.orientation(&v));
     let w_after = body_rate(p, pd);

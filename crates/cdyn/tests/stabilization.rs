@@ -6,20 +6,20 @@
 //! the projection method holds every invariant to its tolerance and fails
 //! by name; automatic gains see the coupling of the constraints.
 
-use cdyn::assemble::assemble;
 use cdyn::control::POSITION_WEIGHT;
+use cdyn::control::gains;
+use cdyn::control::methods::{self, MethodGains};
+use cdyn::control::projection::{OnFailure, Projection};
 use cdyn::dynamics::Dynamics;
-use cdyn::gains;
+use cdyn::dynamics::assemble::assemble;
 use cdyn::integrate::Rhs;
-use cdyn::methods::{self, MethodGains};
 use cdyn::models::{
     DampedPendulumParams, FourBarParams, LoadPendulum, PendulumParams, SliderCrankParams, cartesian_pendulum,
     damped_pendulum, four_bar, slider_crank, small_pendulum,
 };
 use cdyn::planar::{BodyId, Element, Mechanism};
-use cdyn::projection::{OnFailure, Projection};
+use cdyn::simulate::system::ControlledSystem;
 use cdyn::small::SmallSimulation;
-use cdyn::system::ControlledSystem;
 use cdyn::{Application, Control, Energy, Error, Gain, Geometric, Model, Rate, Scheme, Settings, Simulation, Velocity};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
@@ -440,7 +440,7 @@ fn velocity_feedback_keeps_example_1_on_the_manifold_for_5000_s() {
 /// measured max |Φ| = 2.5e-14, max |Ψ| = 4.5e-13 over the 5000 s.
 #[test]
 fn robust_keeps_example_1_within_1e_6_for_5000_s() {
-    let run = example_1_for_5000_s(cdyn::methods::robust());
+    let run = example_1_for_5000_s(cdyn::control::methods::robust());
     assert!(run.phi <= 1e-6 && run.psi <= 1e-6, "{run:?}");
 }
 

@@ -4,7 +4,7 @@
 //! elbow's damping as `−c θ̇`), and bad files refused with the element named.
 #![cfg(feature = "urdf")]
 
-use cdyn::kinetic::Kinetic;
+use cdyn::model::kinetic::Kinetic;
 use cdyn::spatial::{SpatialBody, from_urdf};
 use cdyn::{Control, Error, Force, Model, Potential, Scalar, Scheme, Settings, Simulation, methods};
 

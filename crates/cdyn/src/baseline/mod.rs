@@ -6,6 +6,8 @@
 //! For benchmarks and comparisons only: public because the benches and
 //! the command line's `bench` use it, and hidden from the documentation
 //! because it is not a capability of the library.
+//!
+//! May import: `integrate`, `control`, `simulate`, `spatial`.
 
 mod pendulum;
 mod spatial_chain;

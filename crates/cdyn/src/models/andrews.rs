@@ -27,8 +27,8 @@
 
 use super::Example;
 use crate::error::Result;
+use crate::model::timefn::TimeFn;
 use crate::planar::{BodyId, Element, Mechanism};
-use crate::timefn::TimeFn;
 
 /// The test set's constants (SI units), from `andrews.f`, with every published digit.
 // The names are the test set's own (see its problem description); a doc

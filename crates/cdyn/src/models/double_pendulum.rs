@@ -8,7 +8,7 @@ use std::f64::consts::FRAC_PI_2;
 use super::Example;
 use super::parts::{add, dir, example, hanging, point_body};
 use crate::error::{Result, finite, non_negative, positive};
-use crate::kinetic::Kinetic;
+use crate::model::kinetic::Kinetic;
 use crate::planar::{BodyId, Element, Mechanism};
 use crate::{Model, Potential, Scalar};
 

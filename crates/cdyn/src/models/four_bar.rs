@@ -8,9 +8,9 @@ use std::f64::consts::PI;
 use super::parts::{LoadPendulum, add, dir, example, load_state, max_acc, perp, rigid_body, validate_drive};
 use super::{Example, Reference};
 use crate::error::{Problem, Result, positive};
-use crate::kinetic::Kinetic;
+use crate::model::kinetic::Kinetic;
+use crate::model::timefn::TimeFn;
 use crate::planar::{BodyId, Element, Mechanism};
-use crate::timefn::TimeFn;
 use crate::{Constraint, Model, Potential, Scalar};
 
 /// Which of the two assemblies of a four-bar linkage: joint C lies to the

@@ -28,6 +28,8 @@
 //!
 //! Fine references: where no closed form exists, a 1-D equation of motion
 //! is integrated by [`crate::reference`]'s fine RK-4 (error about 1e-13).
+//!
+//! May import: `error`, `ad`, `model`, `planar`, `spatial`, `small`, `reference`.
 
 pub mod andrews;
 mod chain;

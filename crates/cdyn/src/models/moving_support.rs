@@ -5,10 +5,10 @@ use std::f64::consts::FRAC_PI_2;
 use super::parts::{add, dir, example, max_acc, perp, point_body};
 use super::{Example, Reference};
 use crate::error::{Part, Problem, Result, finite, non_negative, positive};
+use crate::model::timefn::TimeFn;
 use crate::planar::{Coordinate, Element, Mechanism};
 use crate::reference::PendulumExact;
 use crate::reference::fine_ode::FineOde;
-use crate::timefn::TimeFn;
 
 /// A point mass on a rod from a support point whose `x` and `y` are
 /// prescribed functions of time ([`Element::DriveCoordinate`]): the drives

@@ -5,8 +5,8 @@ use std::f64::consts::PI;
 use super::parts::{LoadPendulum, example, load_state, max_acc, rigid_body, validate_drive};
 use super::{Example, Reference};
 use crate::error::{Error, Result, positive};
+use crate::model::timefn::TimeFn;
 use crate::planar::{BodyId, Element, Mechanism};
-use crate::timefn::TimeFn;
 
 /// A slider-crank: the crank (pinned at the origin) is driven at constant
 /// angular speed by a [`Element::DriveAngle`] relative to the ground; the

@@ -8,10 +8,10 @@ use super::element::{Coordinate, Element};
 use super::ends::{End, idx_array, with_k};
 use super::loads::{Damper, Gravity, PointLoad, RotaryDamper, Spring, Torque, Torsion};
 use super::mechanism::Mechanism;
-use crate::angular::Generator;
 use crate::error::{Error, Part, Problem, Result, finite, non_negative, positive};
+use crate::model::angular::Generator;
+use crate::model::timefn::TimeFn;
 use crate::model::{Model, ModelBuilder};
-use crate::timefn::TimeFn;
 
 /// A mechanism turned into a model, with its initial state.
 pub struct Built {

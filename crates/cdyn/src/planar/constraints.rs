@@ -3,9 +3,9 @@
 
 use super::ends::{End, angle_of};
 use crate::Constraint;
-use crate::nonholonomic::Nonholonomic;
-use crate::scalar::Scalar;
-use crate::timefn::TimeFn;
+use crate::ad::scalar::Scalar;
+use crate::model::nonholonomic::Nonholonomic;
+use crate::model::timefn::TimeFn;
 
 /// Two points coincide: `p_a − p_b = 0`.
 pub(super) struct Revolute<const K: usize> {

@@ -134,7 +134,7 @@ fn ends(e: &Element) -> (Vec<BodyPoint>, Option<[f64; 2]>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::timefn::TimeFn;
+    use crate::model::timefn::TimeFn;
 
     /// A crank (rigid) pinned to the ground, driven, with a point mass on a spring.
     #[test]

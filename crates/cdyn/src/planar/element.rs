@@ -2,7 +2,7 @@
 //! code with [`BodyId`]s, or in a scenario file with body names.
 
 use super::body::BodyId;
-use crate::timefn::TimeFn;
+use crate::model::timefn::TimeFn;
 
 /// Which coordinate of a body a drive prescribes (`"x"`, `"y"`, `"angle"` in files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

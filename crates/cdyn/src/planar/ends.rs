@@ -3,7 +3,7 @@
 //! force elements are written on these ends, generic over the scalar and
 //! over how many coordinates they read.
 
-use crate::scalar::Scalar;
+use crate::ad::scalar::Scalar;
 
 /// Runs `$body` with the const `$k` equal to `$idx.len()` (1 to 6: an
 /// element reads at most two bodies): the elements are generic over how

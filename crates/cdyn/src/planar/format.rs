@@ -73,8 +73,8 @@ impl<'de> DeserializeSeed<'de> for Entry {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::timefn::TimeFn;
     use crate::planar::{BodyId, Coordinate, Mechanism};
-    use crate::timefn::TimeFn;
 
     const CRANK: BodyId = BodyId::Body(0);
     const BOB: BodyId = BodyId::Body(1);

@@ -2,8 +2,8 @@
 //! dampers and applied loads.
 
 use super::ends::{End, angle_of};
-use crate::scalar::Scalar;
-use crate::timefn::TimeFn;
+use crate::ad::scalar::Scalar;
+use crate::model::timefn::TimeFn;
 use crate::{Force, Potential};
 
 /// `V = −m g · p` on a body's centre of mass; `w = −m g`.

@@ -11,6 +11,8 @@
 //! scenario file's `[[bodies]]` and `[[joints]]`/`[[drives]]`/`[[forces]]`
 //! entries (`format` reads the three lists), and
 //! [`Mechanism::add_named`] resolves the body names.
+//!
+//! May import: `error`, `ad`, `model`.
 
 mod body;
 mod build;

@@ -2,9 +2,9 @@
 //! kinetic energy as a kinetic element of its Euler parameters.
 
 use super::rotation::body_rate;
+use crate::ad::scalar::Scalar;
 use crate::error::{Problem, Result, positive};
-use crate::kinetic::{Kinetic, VelocityMap};
-use crate::scalar::Scalar;
+use crate::model::kinetic::{Kinetic, VelocityMap};
 
 /// A rigid body as the user describes it, at the initial instant; in a
 /// scenario file a `[[bodies]]` entry with these keys (`orientation`,

@@ -20,10 +20,10 @@
 //! body at the initial pose (so every joint starts assembled).
 
 use super::rotation::rotate_fixed;
-use crate::constraint::Constraint;
-use crate::jet::{Eps, JetN};
-use crate::scalar::Scalar;
-use crate::timefn::TimeFn;
+use crate::ad::jet::{Eps, JetN};
+use crate::ad::scalar::Scalar;
+use crate::model::constraint::Constraint;
+use crate::model::timefn::TimeFn;
 
 /// What a joint allows (its `kind` in scenario files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -425,7 +425,7 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constraint::jacobian_of;
+    use crate::model::constraint::jacobian_of;
 
     /// A reproducible stream of numbers in (−1, 1).
     fn numbers(seed: u64) -> impl FnMut() -> f64 {

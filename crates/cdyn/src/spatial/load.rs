@@ -7,8 +7,8 @@
 //! torques are forces.
 
 use super::rotation::{cross, rotate_fixed, space_rate as rate, torque_on_parameters as on_parameters};
-use crate::force::{Force, Potential};
-use crate::scalar::Scalar;
+use crate::ad::scalar::Scalar;
+use crate::model::force::{Force, Potential};
 
 /// A load as the user describes it, at the initial pose; in a scenario
 /// file a `[[forces]]` entry, tagged by `kind`, its bodies named (`B =

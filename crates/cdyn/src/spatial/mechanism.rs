@@ -5,11 +5,11 @@ use super::body::{Body, Rotation};
 use super::joint::{BodyToBody, BodyToGround, Frame, Joint, JointKind, JointRows};
 use super::load::{BodyRotaryDamper, BodyTorque, GroundRotaryDamper, LineDamper, Load, PointForce, SpringEnergy};
 use super::rotation::{cross, rate_from_body, unrotate};
-use crate::angular::Generator;
+use crate::ad::scalar::Scalar;
 use crate::error::{Error, Part, Problem, Result};
-use crate::force::Potential;
+use crate::model::angular::Generator;
+use crate::model::force::Potential;
 use crate::model::{Model, ModelBuilder};
-use crate::scalar::Scalar;
 use std::collections::HashMap;
 
 /// Bodies, joints and uniform gravity.
@@ -26,7 +26,7 @@ pub struct Mechanism {
 }
 
 /// A mechanism's model, its initial state (as given, not yet projected
-/// onto the constraints: see [`crate::assemble`]) and, for every
+/// onto the constraints: see [`crate::dynamics::assemble`]) and, for every
 /// constraint row, the part it comes from: [`Part::Body`] for a body's
 /// normalization, [`Part::Element`] for a joint.
 pub struct Built {
@@ -385,8 +385,8 @@ impl Mechanism {
 }
 
 /// `−f(t)`: a drive seen from the other body.
-fn negated(f: crate::timefn::TimeFn) -> crate::timefn::TimeFn {
-    crate::timefn::TimeFn {
+fn negated(f: crate::model::timefn::TimeFn) -> crate::model::timefn::TimeFn {
+    crate::model::timefn::TimeFn {
         polynomial: f.polynomial.iter().map(|c| -c).collect(),
         sines: f.sines.iter().map(|&[a, w, phase]| [-a, w, phase]).collect(),
     }

@@ -15,10 +15,10 @@
 //! `q̇ = v`, on which every integrator, control law, the projection and the
 //! energy balance of the library are written, and its mass is
 //! block-diagonal, which the sparse solver factors block by block
-//! ([`BlockMass`](crate::mass::BlockMass)) at a cost linear in the number
+//! ([`BlockMass`](crate::linalg::mass::BlockMass)) at a cost linear in the number
 //! of bodies. The price is the AD of the 4 × 4 block at every evaluation,
 //! kept small by giving the energy as a velocity map
-//! ([`VelocityMap`](crate::kinetic::VelocityMap)).
+//! ([`VelocityMap`](crate::model::kinetic::VelocityMap)).
 //!
 //! Joints ([`Joint`]: spherical, revolute, universal, cylindrical,
 //! prismatic, fixed, distance; revolute, prismatic and cylindrical ones
@@ -27,6 +27,8 @@
 //! pose, and carried into each body's frame there, so that a mechanism is
 //! always assembled where it is defined. `from_urdf` (feature `urdf`)
 //! reads a robot; [`Sketch`] is what figures draw.
+//!
+//! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `planar`.
 
 mod body;
 mod chain;

@@ -3,7 +3,7 @@
 //! body angular velocity is `ω′ = 2 G(p) ṗ` and the spatial one
 //! `ω = 2 E(p) ṗ`. Written generic over the scalar, for dual numbers.
 
-use crate::scalar::Scalar;
+use crate::ad::scalar::Scalar;
 
 /// `G(p)`, with `ω′ = 2 G ṗ`.
 pub fn g_matrix<D: Scalar>([e0, e1, e2, e3]: [D; 4]) -> [[D; 4]; 3] {

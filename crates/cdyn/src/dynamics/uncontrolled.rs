@@ -1,0 +1,554 @@
+//! What the system does, uncontrolled: `Φ`, `Φ_q`, `γ`, the multipliers
+//! `λ` and the accelerations `A` (Eqs. 4–8), at one state.
+
+use crate::dynamics::energy;
+use crate::linalg::mass::{BlockMass, DenseMass, DiagonalMass, MassAt, MassMatrix, WidthFn};
+pub use crate::linalg::{Breakdown, DependentRows, LinearSolver, SPARSE_FROM};
+use crate::linalg::{DenseLdl, Schur};
+use crate::model::Model;
+use crate::model::constraint::ConstraintBuffers;
+
+/// Workspace holding one evaluation of the dynamics. Allocated once per
+/// model; `evaluate` never allocates. The results are read through the
+/// accessors below, so only [`evaluate`](Self::evaluate) writes them.
+pub struct Dynamics {
+    /// Φ, Φ̇, Φ_t, γ and Φ_q of the last pass.
+    constraints: ConstraintBuffers,
+    force: Vec<f64>,
+    grad_potential: Vec<f64>,
+    potential: f64,
+    force_power: f64,
+    lambda: Vec<f64>,
+    acc: Vec<f64>,
+    solver: Solver,
+    /// With a constant `M`, `S` depends on `(q, t)` alone: the positions and
+    /// time of its latest factorization, so that an evaluation at the same
+    /// ones (the next step's first, at the state the projection left)
+    /// solves with it instead of factoring again; the results are the same
+    /// to the bit. Kept only when asked ([`Dynamics::reuse_factorization`]):
+    /// copying `q` costs 2–3 % of a chain's step where nothing repeats.
+    reuse: bool,
+    factored_at: Option<f64>,
+    /// The positions of that factorization (allocated once).
+    factored_q: Vec<f64>,
+}
+
+/// How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied: decided by the model's mass.
+// The constant path's structure stays inline (no indirection in the hot
+// loops); there is one workspace per model, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
+enum Solver {
+    /// Constant diagonal `M`: `S` assembled on the Jacobian's pattern.
+    Constant(Schur),
+    /// `M(q)`: evaluated, factored and used densely.
+    General(Box<General>),
+    /// A block-diagonal `M(q)`: factored block by block, `S` sparse.
+    Blocks(Box<Blocks>),
+}
+
+/// Coordinates from which [`LinearSolver::Auto`] factors a block-diagonal
+/// `M(q)` by blocks: below, the dense path is as cheap (a double pendulum
+/// in angles, n = 2, took 9 % more instructions per step by blocks).
+pub const BLOCKS_FROM: usize = 16;
+
+/// The workspace of a block-diagonal `M(q)` ([`BlockMass`]), allocated once.
+///
+/// With `M_b = L_b L_bᵀ` on each block, `S = Φ_q M⁻¹ Φ_qᵀ = J̃ W J̃ᵀ`, where
+/// `J̃` is `Φ_q` with each row's entries on a block multiplied by `L_b⁻ᵀ`
+/// and `W` is `M⁻¹` outside the blocks and 1 on them. Since a row that
+/// reads a block reads all of it (the model checks), `J̃` and `M⁻¹ Φ_qᵀ`
+/// keep the pattern of `Φ_q`, and `S` is assembled and factored by the
+/// same sparse [`Schur`] as for a constant `M`.
+struct Blocks {
+    mass: BlockMass,
+    /// `Ψ_q = ∇V + ∂T/∂q` (`∂T/∂q` first, while it is summed).
+    psi_q: Vec<f64>,
+    /// `Ṁ q̇`
+    mdot_v: Vec<f64>,
+    /// `J̃`, in the pattern's order.
+    scaled: Vec<f64>,
+    /// `M⁻¹ Φ_qᵀ`, entry by entry in the pattern's order.
+    weighted: Vec<f64>,
+    /// The Jacobian entries outside every block, with their coordinate.
+    plain: Vec<(u32, u32)>,
+    /// Each row's run of entries on one block: the block, and where its
+    /// entries (in the block's coordinate order) start in `entries`.
+    segments: Vec<(u32, u32)>,
+    entries: Vec<u32>,
+    schur: Schur,
+}
+
+impl Blocks {
+    fn new(model: &Model, blocks: &[Vec<u32>], solver: LinearSolver) -> Self {
+        let (n, pattern) = (model.n(), model.pattern());
+        let mut owner = vec![(u32::MAX, 0u32); n];
+        for (b, coords) in blocks.iter().enumerate() {
+            for (i, &c) in coords.iter().enumerate() {
+                owner[c as usize] = (b as u32, i as u32);
+            }
+        }
+        let diagonal = model.diagonal_mass();
+        let (mut plain, mut segments, mut entries) = (Vec::new(), Vec::new(), Vec::new());
+        for r in 0..model.m() {
+            let first_segment = segments.len();
+            for j in pattern.row(r) {
+                let c = pattern.cols[j];
+                let (b, i) = owner[c as usize];
+                if b == u32::MAX {
+                    plain.push((j as u32, c));
+                    continue;
+                }
+                let at = match segments[first_segment..].iter().find(|&&(sb, _)| sb == b) {
+                    Some(&(_, at)) => at,
+                    None => {
+                        let at = entries.len() as u32;
+                        segments.push((b, at));
+                        entries.resize(entries.len() + blocks[b as usize].len(), 0);
+                        at
+                    }
+                };
+                entries[(at + i) as usize] = j as u32;
+            }
+        }
+        // `S`'s weights: `M⁻¹` outside the blocks, 1 on them (in `J̃`).
+        let weights: Vec<f64> =
+            owner.iter().zip(diagonal).map(|(&(b, _), &m)| if b == u32::MAX { m } else { 1.0 }).collect();
+        let weights = DiagonalMass::new(weights).expect("positive masses outside the blocks (checked by the model)");
+        let nnz = pattern.nnz();
+        Self {
+            mass: BlockMass::new(diagonal, blocks),
+            psi_q: vec![0.0; n],
+            mdot_v: vec![0.0; n],
+            scaled: vec![0.0; nnz],
+            weighted: vec![0.0; nnz],
+            plain,
+            segments,
+            entries,
+            schur: Schur::new(pattern, &weights, solver),
+        }
+    }
+
+    /// `J̃` and `M⁻¹ Φ_qᵀ` from `Φ_q`, then `S` factored and `b` solved in place.
+    fn factor_and_solve(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        let inverse = self.mass.inverse();
+        for &(j, c) in &self.plain {
+            let (j, c) = (j as usize, c as usize);
+            self.scaled[j] = jac[j];
+            self.weighted[j] = jac[j] * inverse[c];
+        }
+        // One row's entries on one block: `J̃` is `L⁻¹` times them, `M⁻¹ Φ_qᵀ` `L⁻ᵀ L⁻¹`.
+        struct Segment<'a> {
+            entries: &'a [u32],
+            jac: &'a [f64],
+            scaled: &'a mut [f64],
+            weighted: &'a mut [f64],
+        }
+        impl WidthFn for Segment<'_> {
+            #[inline(always)]
+            fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
+                let idx: &[u32; K] = self.entries[..K].try_into().expect("a block's K entries");
+                let x = mass.forward(b, idx.map(|j| self.jac[j as usize]));
+                idx.iter().zip(x).for_each(|(&j, x)| self.scaled[j as usize] = x);
+                let y = mass.backward(b, x);
+                idx.iter().zip(y).for_each(|(&j, y)| self.weighted[j as usize] = y);
+            }
+        }
+        for &(block, at) in &self.segments {
+            let segment = Segment {
+                entries: &self.entries[at as usize..],
+                jac,
+                scaled: &mut self.scaled,
+                weighted: &mut self.weighted,
+            };
+            self.mass.at_width(block as usize, segment);
+        }
+        self.schur.factor_and_solve(&self.scaled, b)
+    }
+}
+
+/// The workspace of a configuration-dependent `M(q)`, allocated once.
+struct General {
+    mass: DenseMass,
+    /// `Ψ_q = ∇V + ∂T/∂q` (`∂T/∂q` first, while it is summed).
+    psi_q: Vec<f64>,
+    /// `Ṁ q̇`
+    mdot_v: Vec<f64>,
+    /// Row `r` of `Φ_q`, dense (`n` entries per row).
+    jac: Vec<f64>,
+    /// Row `r` of `(M⁻¹ Φ_qᵀ)ᵀ`: `M⁻¹` times row `r` of `Φ_q`.
+    weighted: Vec<f64>,
+    schur: DenseLdl,
+}
+
+impl General {
+    /// `S = Φ_q (M⁻¹ Φ_qᵀ)` from the pattern and values of `Φ_q`, factored, and `b` solved in place.
+    fn factor_and_solve(&mut self, model: &Model, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        let (n, m, pattern) = (model.n(), model.m(), model.pattern());
+        self.jac.fill(0.0);
+        for r in 0..m {
+            for j in pattern.row(r) {
+                self.jac[r * n + pattern.cols[j] as usize] = jac[j];
+            }
+            let (row, out) = (&self.jac[r * n..(r + 1) * n], &mut self.weighted[r * n..(r + 1) * n]);
+            self.mass.solve(row, out);
+        }
+        let s = self.schur.matrix_mut();
+        for a in 0..m {
+            for c in 0..=a {
+                s[a * m + c] =
+                    self.jac[a * n..(a + 1) * n].iter().zip(&self.weighted[c * n..]).map(|(x, y)| x * y).sum();
+            }
+        }
+        self.schur.factor(jac)?;
+        self.schur.solve(b);
+        Ok(())
+    }
+
+    /// `out += scale · M⁻¹ Φ_qᵀ y`
+    fn add_weighted_jt(&self, n: usize, y: &[f64], scale: f64, out: &mut [f64]) {
+        for (r, &yr) in y.iter().enumerate() {
+            let s = scale * yr;
+            for (o, w) in out.iter_mut().zip(&self.weighted[r * n..(r + 1) * n]) {
+                *o += s * w;
+            }
+        }
+    }
+}
+
+/// Lagrange's velocity terms join `G`: `M q̈ = G + ∂T/∂q − Ṁ q̇` (see
+/// `kinetic.rs`); `∂T/∂q` becomes `Ψ_q = ∇V + ∂T/∂q`.
+fn lagrange_terms(force: &mut [f64], psi_q: &mut [f64], mdot_v: &[f64], grad_potential: &[f64]) {
+    for (((f, dt), mv), gv) in force.iter_mut().zip(psi_q).zip(mdot_v).zip(grad_potential) {
+        *f += *dt - mv;
+        *dt += gv;
+    }
+}
+
+impl Dynamics {
+    /// A workspace for `model`, factoring `Φ_q M⁻¹ Φ_qᵀ` dense or sparse by its size.
+    pub fn new(model: &Model) -> Self {
+        Self::with_solver(model, LinearSolver::Auto)
+    }
+
+    /// With a chosen factorization of `Φ_q M⁻¹ Φ_qᵀ`. A block-diagonal
+    /// `M(q)` (see [`Model::mass_blocks`]) is factored by blocks with
+    /// [`LinearSolver::Sparse`], and with [`LinearSolver::Auto`] from
+    /// [`BLOCKS_FROM`] coordinates; any other `M(q)` is dense.
+    pub fn with_solver(model: &Model, solver: LinearSolver) -> Self {
+        let (n, m) = (model.n(), model.m());
+        let solver = match (model.mass(), model.mass_blocks()) {
+            (Some(mass), _) => Solver::Constant(Schur::new(model.pattern(), mass, solver)),
+            (None, Some(blocks))
+                if solver == LinearSolver::Sparse || solver == LinearSolver::Auto && n >= BLOCKS_FROM =>
+            {
+                Solver::Blocks(Box::new(Blocks::new(model, blocks, solver)))
+            }
+            (None, _) => Solver::General(Box::new(General {
+                mass: DenseMass::new(n),
+                psi_q: vec![0.0; n],
+                mdot_v: vec![0.0; n],
+                jac: vec![0.0; m * n],
+                weighted: vec![0.0; m * n],
+                schur: DenseLdl::new(m),
+            })),
+        };
+        Self {
+            constraints: ConstraintBuffers::new(m, model.pattern().nnz()),
+            force: vec![0.0; n],
+            grad_potential: vec![0.0; n],
+            potential: 0.0,
+            force_power: 0.0,
+            lambda: vec![0.0; m],
+            acc: vec![0.0; n],
+            solver,
+            reuse: false,
+            factored_at: None,
+            factored_q: vec![0.0; n],
+        }
+    }
+
+    /// Whether an evaluation at the positions and time of the latest
+    /// factorization of `S` reuses it (constant `M` only): worth it where
+    /// states repeat, as after a projection.
+    pub fn reuse_factorization(&mut self, on: bool) {
+        self.reuse = on;
+        self.factored_at = None;
+    }
+
+    /// Sets what a dependent constraint row does in the next evaluations
+    /// (default: [`DependentRows::Error`]).
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.factored_at = None;
+        match &mut self.solver {
+            Solver::Constant(schur) => schur.set_dependent_rows(dependent),
+            Solver::General(g) => g.schur.set_dependent_rows(dependent),
+            Solver::Blocks(b) => b.schur.set_dependent_rows(dependent),
+        }
+    }
+
+    /// Constraint rows the last evaluation dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        match &self.solver {
+            Solver::Constant(schur) => schur.dependent_rows(),
+            Solver::General(g) => g.schur.dependent_rows(),
+            Solver::Blocks(b) => b.schur.dependent_rows(),
+        }
+    }
+
+    /// Evaluates everything at `(q, v, t)`: constraints, forces, the
+    /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
+    pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
+        self.grad_potential.fill(0.0);
+        self.potential = model.potential(q, Some(&mut self.grad_potential));
+        for (f, g) in self.force.iter_mut().zip(&self.grad_potential) {
+            *f = -g;
+        }
+        self.force_power = model.add_forces(q, v, t, &mut self.force);
+        // The unconstrained acceleration M⁻¹ G, which the constraint pass needs for `Φ_q M⁻¹ G − γ`.
+        match (&mut self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => mass.solve(&self.force, &mut self.acc),
+            (Solver::General(g), _) => {
+                g.psi_q.fill(0.0);
+                g.mdot_v.fill(0.0);
+                model.mass_at(q, v, &mut g.mass, &mut g.psi_q, &mut g.mdot_v).map_err(Breakdown::Mass)?;
+                lagrange_terms(&mut self.force, &mut g.psi_q, &g.mdot_v, &self.grad_potential);
+                g.mass.solve(&self.force, &mut self.acc);
+            }
+            (Solver::Blocks(b), _) => {
+                b.psi_q.fill(0.0);
+                b.mdot_v.fill(0.0);
+                model.block_mass_at(q, v, &mut b.mass, &mut b.psi_q, &mut b.mdot_v).map_err(Breakdown::Mass)?;
+                lagrange_terms(&mut self.force, &mut b.psi_q, &b.mdot_v, &self.grad_potential);
+                b.mass.solve(&self.force, &mut self.acc);
+            }
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        }
+        // λ starts as the right-hand side of (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
+        model.constraints(q, v, t, self.constraints.pass(&self.acc, &mut self.lambda));
+        if model.m() == 0 {
+            return Ok(());
+        }
+        match &mut self.solver {
+            Solver::Constant(schur) => {
+                if self.reuse && self.factored_at == Some(t) && self.factored_q == q {
+                    schur.solve(&mut self.lambda);
+                } else {
+                    self.factored_at = None;
+                    schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
+                    if self.reuse {
+                        self.factored_q.copy_from_slice(q);
+                        self.factored_at = Some(t);
+                    }
+                }
+            }
+            Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
+            Solver::Blocks(b) => b.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
+        }
+        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
+        let mut acc = std::mem::take(&mut self.acc);
+        self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
+        self.acc = acc;
+        Ok(())
+    }
+
+    /// For a change `b` of the constraint right-hand side (`Φ_q q̈ = γ − b`),
+    /// adds the resulting change of acceleration, `−M⁻¹ Φ_qᵀ S⁻¹ b`, to
+    /// `out`. `b` is overwritten with the multiplier change `S⁻¹ b`.
+    /// Uses the factorization of the last [`evaluate`](Self::evaluate).
+    pub fn add_constraint_response(&self, model: &Model, b: &mut [f64], out: &mut [f64]) {
+        match &self.solver {
+            Solver::Constant(schur) => schur.solve(b),
+            Solver::General(g) => g.schur.solve(b),
+            Solver::Blocks(blocks) => blocks.schur.solve(b),
+        }
+        self.add_weighted_jt(model, b, -1.0, out);
+    }
+
+    /// The mass matrix at the state of the last [`evaluate`](Self::evaluate).
+    #[inline(always)]
+    pub fn mass<'a>(&'a self, model: &'a Model) -> MassAt<'a> {
+        match (&self.solver, model.mass()) {
+            (Solver::General(g), _) => MassAt::Dense(&g.mass),
+            (Solver::Blocks(b), _) => MassAt::Blocks(&b.mass),
+            (Solver::Constant(_), Some(mass)) => MassAt::Diagonal(mass),
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        }
+    }
+
+    /// `Ψ_q = ∇V + ∂T/∂q` of the last evaluation (`∇V` when `M` is constant).
+    pub fn psi_q(&self) -> &[f64] {
+        match &self.solver {
+            Solver::Constant(_) => &self.grad_potential,
+            Solver::General(g) => &g.psi_q,
+            Solver::Blocks(b) => &b.psi_q,
+        }
+    }
+
+    /// `out += scale · M⁻¹ Φ_qᵀ y` with the Jacobian of the last
+    /// [`evaluate`](Self::evaluate), without bounds checks: the control laws
+    /// take up to three such products per evaluation, and the checks were
+    /// half their cost on a chain of 1 000 bodies.
+    pub fn add_weighted_jt(&self, model: &Model, y: &[f64], scale: f64, out: &mut [f64]) {
+        let jac = &self.constraints.jac;
+        match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => {
+                let weight = mass.inverse();
+                assert!(weight.len() == model.n(), "a mass of another model");
+                // SAFETY: `scatter` passes entries `j` < nnz = `jac.len()` and coordinates `c` < n.
+                scatter(model, jac, scale, [y], [out], |s, j, c| unsafe {
+                    s * weight.get_unchecked(c) * jac.get_unchecked(j)
+                })
+            }
+            (Solver::Blocks(b), _) => {
+                let weighted = &b.weighted;
+                // SAFETY: as above; `weighted` has an entry per Jacobian entry.
+                scatter(model, weighted, scale, [y], [out], |s, j, _| unsafe { s * weighted.get_unchecked(j) })
+            }
+            (Solver::General(g), _) => g.add_weighted_jt(model.n(), y, scale, out),
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        }
+    }
+
+    /// `out[k] −= M⁻¹ Φ_qᵀ y[k]` for two pairs in one pass over the Jacobian
+    /// (the coupled control terms' two products), each with the arithmetic of
+    /// [`add_weighted_jt`](Self::add_weighted_jt) at scale −1.
+    pub fn add_weighted_jt_pair(&self, model: &Model, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
+        let jac = &self.constraints.jac;
+        match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => {
+                let weight = mass.inverse();
+                assert!(weight.len() == model.n(), "a mass of another model");
+                // SAFETY: as in `add_weighted_jt`.
+                scatter(model, jac, -1.0, [y0, y1], [out0, out1], |s, j, c| unsafe {
+                    s * weight.get_unchecked(c) * jac.get_unchecked(j)
+                })
+            }
+            (Solver::Blocks(b), _) => {
+                let weighted = &b.weighted;
+                // SAFETY: as in `add_weighted_jt`.
+                scatter(model, weighted, -1.0, [y0, y1], [out0, out1], |s, j, _| unsafe {
+                    s * weighted.get_unchecked(j)
+                })
+            }
+            (Solver::General(g), _) => {
+                g.add_weighted_jt(model.n(), y0, -1.0, out0);
+                g.add_weighted_jt(model.n(), y1, -1.0, out1)
+            }
+            (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
+        }
+    }
+
+    /// `out = Φ_q x` with the Jacobian of the last [`evaluate`](Self::evaluate),
+    /// without bounds checks (see [`add_weighted_jt`](Self::add_weighted_jt)).
+    pub fn jac_mul(&self, model: &Model, x: &[f64], out: &mut [f64]) {
+        let (pattern, jac) = (model.pattern(), &self.constraints.jac);
+        assert!(x.len() == model.n() && out.len() == model.m(), "vectors of the wrong length");
+        assert!(jac.len() == pattern.cols.len(), "a Jacobian of another model");
+        // SAFETY: as in `add_weighted_jt`.
+        unsafe {
+            for (r, o) in out.iter_mut().enumerate() {
+                let (a, b) = (*pattern.start.get_unchecked(r) as usize, *pattern.start.get_unchecked(r + 1) as usize);
+                *o = (a..b)
+                    .map(|j| jac.get_unchecked(j) * x.get_unchecked(*pattern.cols.get_unchecked(j) as usize))
+                    .sum();
+            }
+        }
+    }
+
+    /// Solves `(Φ_q M⁻¹ Φ_qᵀ) x = b` in place for up to four vectors at
+    /// once, with the factorization of the last [`evaluate`](Self::evaluate).
+    pub fn solve_many(&self, bs: &mut [&mut [f64]]) {
+        match &self.solver {
+            Solver::Constant(schur) => schur.solve_many(bs),
+            Solver::General(g) => bs.iter_mut().for_each(|b| g.schur.solve(b)),
+            Solver::Blocks(b) => b.schur.solve_many(bs),
+        }
+    }
+
+    /// The energy input `Ė = F·v + λᵀ Φ_t` of the last evaluation (see [`crate::dynamics::energy`]).
+    pub fn energy_input(&self) -> f64 {
+        energy::power(self.force_power, &self.lambda, &self.constraints.phi_t)
+    }
+
+    /// `Φ(q, t)`
+    pub fn phi(&self) -> &[f64] {
+        &self.constraints.phi
+    }
+    /// `Φ̇ = Φ_q v + Φ_t`
+    pub fn phi_dot(&self) -> &[f64] {
+        &self.constraints.phi_dot
+    }
+    /// `Φ_t`, as `Φ̇ − Φ_q v` (zero up to round-off without drives).
+    pub fn phi_t(&self) -> &[f64] {
+        &self.constraints.phi_t
+    }
+    /// `γ` of Eq. 5
+    pub fn gamma(&self) -> &[f64] {
+        &self.constraints.gamma
+    }
+    /// Values of `Φ_q` in the model's [`Pattern`](crate::linalg::sparse::Pattern) order.
+    pub fn jac(&self) -> &[f64] {
+        &self.constraints.jac
+    }
+    /// Generalized applied force `G = −∇V + F`, with Lagrange's velocity
+    /// terms `∂T/∂q − Ṁ q̇` when `M` depends on `q`.
+    pub fn force(&self) -> &[f64] {
+        &self.force
+    }
+    /// `∇V` (which is `Ψ_q` when `M` is constant; see [`psi_q`](Self::psi_q)).
+    pub fn grad_potential(&self) -> &[f64] {
+        &self.grad_potential
+    }
+    /// `V(q)`
+    pub fn potential(&self) -> f64 {
+        self.potential
+    }
+    /// Power of the non-conservative forces, `F·v`.
+    pub fn force_power(&self) -> f64 {
+        self.force_power
+    }
+    /// `λ` of Eq. 7.
+    pub fn lambda(&self) -> &[f64] {
+        &self.lambda
+    }
+    /// `A = M⁻¹ (G − Φ_qᵀ λ)` of Eq. 8.
+    pub fn acc(&self) -> &[f64] {
+        &self.acc
+    }
+}
+
+/// `out[k]_c += term(s, j, c)` over every Jacobian entry `j` (coordinate
+/// `c`) of every row `r`, with `s = scale · y[k]_r`: the loop of
+/// `add_weighted_jt` (one vector) and of its pair (scale −1), without
+/// bounds checks. `values`, the per-entry array `term` reads, is checked
+/// for its length here.
+#[inline(always)]
+fn scatter<const K: usize>(
+    model: &Model,
+    values: &[f64],
+    scale: f64,
+    y: [&[f64]; K],
+    out: [&mut [f64]; K],
+    term: impl Fn(f64, usize, usize) -> f64,
+) {
+    let pattern = model.pattern();
+    let (m, n) = (model.m(), model.n());
+    assert!(y.iter().all(|y| y.len() == m) && out.iter().all(|o| o.len() == n), "vectors of the wrong length");
+    assert!(values.len() == pattern.cols.len(), "a Jacobian of another model");
+    // SAFETY: a model's pattern is built by `ModelBuilder::build` from
+    // checked coordinates (< n) with `start` rising from 0 to
+    // `cols.len()`, and it cannot be changed afterwards; `y` and `start`
+    // have m (+ 1) entries, `out` n.
+    unsafe {
+        for r in 0..m {
+            let s: [f64; K] = std::array::from_fn(|k| scale * *y[k].get_unchecked(r));
+            let (a, b) = (*pattern.start.get_unchecked(r) as usize, *pattern.start.get_unchecked(r + 1) as usize);
+            for j in a..b {
+                let c = *pattern.cols.get_unchecked(j) as usize;
+                for k in 0..K {
+                    *out[k].get_unchecked_mut(c) += term(s[k], j, c);
+                }
+            }
+        }
+    }
+}

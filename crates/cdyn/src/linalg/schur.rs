@@ -1,0 +1,883 @@
+//! The `m × m` system `S = Φ_q M⁻¹ Φ_qᵀ`: its assembly from the sparse
+//! Jacobian and its `L D Lᵀ` factorization.
+//!
+//! Everything structural is done once: the list of products `J_a J_b / m_c`
+//! that make `S` (one per pair of rows sharing a coordinate, so forming `S`
+//! costs the same as reading the Jacobian for chains and trees), the
+//! ordering, and the pattern of `L`. A step then only refills values,
+//! eliminates along the known pattern and solves — in buffers allocated
+//! here, never per step.
+//!
+//! Dense and sparse share the kernel and differ in the pattern of `L`:
+//! dense takes the full lower triangle in the natural order; sparse takes
+//! the pattern faer's symbolic Cholesky finds (`sparse.rs`), with an AMD
+//! ordering when it fills less than the natural one.
+
+use crate::linalg::mass::DiagonalMass;
+use crate::linalg::sparse::{Pattern, Structure};
+
+/// Why `S` could not be factored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Breakdown {
+    /// This row is linearly dependent on the rows before it.
+    Singular(usize),
+    /// `S` has non-finite entries: the state has blown up.
+    NonFinite,
+    /// The configuration-dependent mass matrix `M(q)` is not positive
+    /// definite at this state (its pivot of this coordinate): the kinetic
+    /// energy elements leave a coordinate without inertia there.
+    Mass(usize),
+}
+
+/// How to factor `Φ_q M⁻¹ Φ_qᵀ`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum LinearSolver {
+    /// Dense below [`SPARSE_FROM`] constraint rows, sparse from there on.
+    #[default]
+    Auto,
+    /// The full triangle of `S`: for few constraint rows.
+    Dense,
+    /// The pattern of `S`, ordered for little fill: for many rows.
+    Sparse,
+}
+
+/// Constraint rows from which `Auto` factors sparse: below it the dense
+/// pattern costs about the same and needs no symbolic analysis.
+pub const SPARSE_FROM: usize = 48;
+
+/// Pivots below this fraction of the assembled diagonal mean the row
+/// depends on the rows before it: an error (the strict default).
+///
+/// `d_j / S_jj` is the squared sine of the angle (in the metric `M⁻¹`)
+/// between row `j` of `Φ_q` and the span of the rows eliminated before it,
+/// so the test does not depend on the units or scale of a row. An exactly
+/// dependent row leaves round-off, `d_j / S_jj` of order `ε ≈ 1e-16` times
+/// a small growth factor; 1e-12 flags it with a margin of 10⁴.
+const PIVOT_TOLERANCE: f64 = 1e-12;
+
+/// Pivots below this fraction of the assembled diagonal are dropped with
+/// [`DependentRows::Tolerate`]: rows within 1e-4 rad of the span of the
+/// others.
+///
+/// Larger than [`PIVOT_TOLERANCE`] because redundant constraints are
+/// dependent only *on* the constraint manifold: at a drift `|Φ| ~ δ` their
+/// rows differ by `O(δ)`, so `d_j / S_jj ~ δ²`, and a row kept with such a
+/// pivot enforces a second, slightly different constraint — its multiplier
+/// grows like the right-hand side's `O(δ)` inconsistency over `δ²`. Measured
+/// on the parallelogram with a redundant crank under energy-only control:
+/// at 1e-12 the row came back once `|Φ|` drifted past 1e-7 and the run
+/// diverged within 0.5 s; at 1e-8 drifts to about 1e-5 are absorbed. A
+/// legitimately near-singular row (a mechanism within 1e-4 rad of a flat
+/// position) is dropped instead of solved with a pivot 1e-8 of its scale,
+/// where its equation is nearly implied by the others.
+const DROP_TOLERANCE: f64 = 1e-8;
+
+/// What to do with a constraint row that depends on the rows eliminated
+/// before it (a pivot of `Φ_q M⁻¹ Φ_qᵀ` small relative to its diagonal
+/// entry): redundant constraints, or a mechanism passing through a
+/// singular position.
+///
+/// In scenario files: `[integrator] dependent_rows = "error"` or `"tolerate"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
+pub enum DependentRows {
+    /// Stop with an error naming the row. The default: a dependent row is
+    /// far more often a modelling mistake (a joint entered twice) than an
+    /// intended redundancy, and redundant constraints are opted into.
+    #[default]
+    Error,
+    /// Solve without the row: its multiplier is 0 and the rows before it
+    /// carry the whole reaction (a *basic* solution of the singular
+    /// system, not the minimum-norm one). The accelerations are the unique
+    /// ones whenever the constraint equations are consistent. Rows are
+    /// dropped below 1e-8 of their diagonal entry (not 1e-12: redundant
+    /// rows are dependent only on the constraint manifold, and a drift
+    /// makes them independent by its square).
+    Tolerate,
+}
+
+impl DependentRows {
+    /// The fraction of its diagonal entry a pivot must exceed for its row
+    /// to count as independent.
+    #[inline(always)]
+    pub(crate) fn tolerance(self) -> f64 {
+        match self {
+            DependentRows::Error => PIVOT_TOLERANCE,
+            DependentRows::Tolerate => DROP_TOLERANCE,
+        }
+    }
+}
+
+/// The pivot test of every `L D Lᵀ` of `S` (this module's and the small
+/// systems' one in `small.rs`): pivot `d` of the row `row()` whose assembled
+/// diagonal entry is `s_jj`, for the Jacobian values `jac`. Returns `1/d`
+/// for a pivot above `tolerance · s_jj` (`dependent.tolerance()`, chosen
+/// once per factorization). One below means a dependent row — unless the
+/// state has blown up, which is told apart so that it is not reported as
+/// singular: the [`Breakdown`], or 0 and one more `dropped` row when
+/// `dependent` tolerates it — which removes the row from the solve: its
+/// column of `L` becomes `S_ij · 0 = 0` and its entry of `D⁻¹` is 0. A
+/// passing pivot costs what the strict test alone did.
+#[inline(always)]
+pub(crate) fn inverse_pivot(
+    d: f64,
+    s_jj: f64,
+    tolerance: f64,
+    jac: &[f64],
+    dependent: DependentRows,
+    dropped: &mut usize,
+    row: impl FnOnce() -> usize,
+) -> Result<f64, Breakdown> {
+    if d.is_nan() || d <= tolerance * s_jj {
+        return dependent_pivot(d, jac, dependent, dropped, row);
+    }
+    Ok(1.0 / d)
+}
+
+/// The failing branch of [`inverse_pivot`], out of the factorization's loop.
+#[cold]
+#[inline(never)]
+fn dependent_pivot(
+    d: f64,
+    jac: &[f64],
+    dependent: DependentRows,
+    dropped: &mut usize,
+    row: impl FnOnce() -> usize,
+) -> Result<f64, Breakdown> {
+    if !d.is_finite() || jac.iter().any(|x| !x.is_finite()) {
+        return Err(Breakdown::NonFinite);
+    }
+    match dependent {
+        DependentRows::Error => Err(Breakdown::Singular(row())),
+        DependentRows::Tolerate => {
+            *dropped += 1;
+            Ok(0.0)
+        }
+    }
+}
+
+/// `S = Φ_q M⁻¹ Φ_qᵀ` held dense and factored as `L D Lᵀ`, for a mass
+/// matrix that changes with the state (`M(q)`): `S` is then formed anew at
+/// every evaluation, densely, which is what small systems in angles need.
+/// Same pivot test ([`inverse_pivot`]) and handling of dependent rows as
+/// the sparse kernel.
+pub(crate) struct DenseLdl {
+    m: usize,
+    /// `S` on entry to [`factor`](Self::factor) (lower triangle read), then
+    /// `L` below the diagonal, row-major.
+    lower: Vec<f64>,
+    /// `D` and `D⁻¹`.
+    d: Vec<f64>,
+    inv_d: Vec<f64>,
+    /// Whether a dependent row is an error or dropped.
+    dependent: DependentRows,
+    /// Rows dropped by the last factorization.
+    dropped: usize,
+}
+
+impl DenseLdl {
+    /// Storage for `m` rows.
+    pub fn new(m: usize) -> Self {
+        Self {
+            m,
+            lower: vec![0.0; m * m],
+            d: vec![0.0; m],
+            inv_d: vec![0.0; m],
+            dependent: DependentRows::Error,
+            dropped: 0,
+        }
+    }
+
+    /// Sets what a dependent row does in the next factorizations.
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        self.dependent = dependent;
+    }
+
+    /// Rows the last factorization dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        self.dropped
+    }
+
+    /// `S`, row-major, to be filled (lower triangle) before [`factor`](Self::factor).
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
+        &mut self.lower
+    }
+
+    /// Factors the `S` written through [`matrix_mut`](Self::matrix_mut);
+    /// `jac` is the Jacobian it came from (for the pivot test).
+    pub fn factor(&mut self, jac: &[f64]) -> Result<(), Breakdown> {
+        let (m, a, dependent) = (self.m, &mut self.lower, self.dependent);
+        let tolerance = dependent.tolerance();
+        self.dropped = 0;
+        let mut count = 0;
+        for j in 0..m {
+            let s_jj = a[j * m + j];
+            let mut d = s_jj;
+            for k in 0..j {
+                d -= a[j * m + k] * a[j * m + k] * self.d[k];
+            }
+            // A dropped row has `D⁻¹ = 0`, so its column of `L` below is 0.
+            self.inv_d[j] = inverse_pivot(d, s_jj, tolerance, jac, dependent, &mut count, || j)?;
+            self.d[j] = d;
+            for i in j + 1..m {
+                let mut s = a[i * m + j];
+                for k in 0..j {
+                    s -= a[i * m + k] * a[j * m + k] * self.d[k];
+                }
+                a[i * m + j] = s * self.inv_d[j];
+            }
+        }
+        self.dropped = count;
+        Ok(())
+    }
+
+    /// Solves `S x = b` in place with the current factor.
+    pub fn solve(&self, b: &mut [f64]) {
+        let (m, l) = (self.m, &self.lower);
+        for i in 0..m {
+            b[i] -= (0..i).map(|k| l[i * m + k] * b[k]).sum::<f64>();
+        }
+        for (b, w) in b.iter_mut().zip(&self.inv_d) {
+            *b *= w;
+        }
+        for i in (0..m).rev() {
+            b[i] -= (i + 1..m).map(|k| l[k * m + i] * b[k]).sum::<f64>();
+        }
+    }
+}
+
+/// For every pair of rows `(a ≥ b)` sharing a coordinate, the products
+/// that make `S_ab`, as `(a, b, ja, jb, col)`; `col` selects the weight
+/// `(M⁻¹)_col,col` of the product.
+pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize, usize, usize)> {
+    let m = pattern.start.len() - 1;
+    // For every coordinate, the Jacobian entries that touch it (that can be non-zero).
+    let mut by_col: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
+    for r in 0..m {
+        for j in pattern.row(r).filter(|&j| pattern.read[j]) {
+            by_col[pattern.cols[j] as usize].push((r, j));
+        }
+    }
+    let mut out = Vec::new();
+    for (col, entries) in by_col.iter().enumerate() {
+        for &(ra, ja) in entries {
+            for &(rb, jb) in entries {
+                if rb <= ra {
+                    out.push((ra, rb, ja, jb, col));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// `S` assembled and factored as `L D Lᵀ` (unit lower `L`), in the
+/// elimination order of its [`Structure`].
+///
+/// Rank-revealing: a row whose pivot fails [`inverse_pivot`] is an error,
+/// or, with [`DependentRows::Tolerate`], a row whose pivot is below
+/// [`DROP_TOLERANCE`] of its diagonal entry is dropped — `D⁻¹` and its
+/// column of `L` are 0 — so that `S x = b` is solved on the other rows and
+/// the dropped rows' `x` is 0. For a consistent `b` (in the range of `S`,
+/// as `Φ_q M⁻¹ G − γ` is when the constraints are compatible) this is an
+/// exact solution, the *basic* one, and `Φ_qᵀ x` — hence the acceleration —
+/// is the same for every solution. Not the minimum-norm multipliers: that
+/// needs a second solve on the dependent set, and the basic solution is
+/// what the rows' order already defines, costs nothing per step and keeps
+/// a dependent row's multiplier exactly 0. For an inconsistent `b` (a
+/// control law's `Φ` off the manifold) the dropped rows' equations are
+/// simply not enforced; nothing is divided by a vanishing pivot.
+///
+/// Everything the numeric passes read per row is addressed by original row
+/// number (`order` maps elimination positions to rows), so a right-hand side
+/// is solved in place, without a permuted copy. Indices are `u32`: the
+/// structure is read at every step, and half the bytes is half the memory
+/// traffic once it outgrows the caches.
+pub(crate) struct Schur {
+    m: usize,
+    /// `order[i]` is the original row eliminated `i`-th.
+    order: Vec<u32>,
+    /// Columns of the strictly lower `L` (by elimination position).
+    col_ptr: Vec<u32>,
+    /// The original row of each entry of `L`, by columns.
+    row_idx: Vec<u32>,
+    /// For each position `j`, the columns `k < j` with `L_jk ≠ 0` and the slot of `L_jk`.
+    row_ptr: Vec<u32>,
+    row_entries: Vec<(u32, u32)>,
+    /// The products `J[ja] J[jb] / m` that sum to each entry of `S`: the
+    /// diagonal entries (in elimination order) first, then the entries in
+    /// `L`'s slots (zero sums for fill).
+    sum_ptr: Vec<u32>,
+    terms: Vec<(u32, u32, f64)>,
+    /// `L` and `L D` below the diagonal, and `D⁻¹` (by position).
+    lower: Vec<f64>,
+    scaled: Vec<f64>,
+    inv_d: Vec<f64>,
+    /// Column being eliminated, by original row.
+    work: Vec<f64>,
+    /// Length of the Jacobian the terms index.
+    nnz: usize,
+    /// Whether a dependent row is an error or dropped.
+    dependent: DependentRows,
+    /// Rows dropped by the last factorization.
+    dropped: usize,
+    /// `dependent.tolerance()`.
+    tolerance: f64,
+}
+
+/// Entries `slot` of `col_ptr`, `row_ptr` or `sum_ptr` to the next, as a
+/// range, without bounds checks.
+///
+/// # Safety
+/// `slot + 1 < ptr.len()`.
+#[inline(always)]
+unsafe fn span_unchecked(ptr: &[u32], slot: usize) -> std::ops::Range<usize> {
+    unsafe { *ptr.get_unchecked(slot) as usize..*ptr.get_unchecked(slot + 1) as usize }
+}
+
+/// An index into one of the structure arrays; they are stored as `u32`.
+fn index(i: usize) -> u32 {
+    u32::try_from(i).expect("the constraint system has fewer than 2³² entries")
+}
+
+impl Schur {
+    /// The structure of `S = Φ_q M⁻¹ Φ_qᵀ` for this Jacobian pattern, with
+    /// the weights of its products taken from the (constant) mass matrix.
+    pub fn new(pattern: &Pattern, mass: &DiagonalMass, solver: LinearSolver) -> Self {
+        let m = pattern.start.len() - 1;
+        let inv_mass = mass.inverse();
+        let products = products(pattern, inv_mass.len());
+        let sparse = match solver {
+            LinearSolver::Auto => m >= SPARSE_FROM,
+            LinearSolver::Dense => false,
+            LinearSolver::Sparse => true,
+        };
+        let structure = if sparse && m > 0 {
+            crate::linalg::sparse::analyse(m, products.iter().map(|&(a, b, ..)| (a, b)))
+        } else {
+            Structure::dense(m)
+        };
+        let Structure { perm, col_ptr, row_idx } = structure;
+        let order = perm.unwrap_or_else(|| (0..m).collect());
+        let mut position = vec![0; m];
+        order.iter().enumerate().for_each(|(new, &old)| position[old] = new);
+        let mut by_slot: Vec<(usize, (u32, u32, f64))> = products
+            .iter()
+            .map(|&(a, b, ja, jb, col)| {
+                let (i, j) = (position[a].max(position[b]), position[a].min(position[b]));
+                let slot = if i == j {
+                    j
+                } else {
+                    let column = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+                    m + col_ptr[j] + column.binary_search(&i).expect("S's pattern lies inside L's")
+                };
+                (slot, (index(ja), index(jb), inv_mass[col]))
+            })
+            .collect();
+        by_slot.sort_by_key(|&(slot, _)| slot);
+        let mut sum_ptr = vec![0; m + row_idx.len() + 1];
+        for &(slot, _) in &by_slot {
+            sum_ptr[slot + 1] += 1;
+        }
+        for i in 0..sum_ptr.len() - 1 {
+            sum_ptr[i + 1] += sum_ptr[i];
+        }
+        // Row patterns of L, by walking its columns in order.
+        let mut row_ptr = vec![0; m + 1];
+        for &i in &row_idx {
+            row_ptr[i + 1] += 1;
+        }
+        for i in 0..m {
+            row_ptr[i + 1] += row_ptr[i];
+        }
+        let mut fill = row_ptr.clone();
+        let mut row_entries = vec![(0, 0); row_idx.len()];
+        for k in 0..m {
+            for p in col_ptr[k]..col_ptr[k + 1] {
+                let i = row_idx[p];
+                row_entries[fill[i]] = (index(k), index(p));
+                fill[i] += 1;
+            }
+        }
+        let indices = |v: Vec<usize>| v.into_iter().map(index).collect::<Vec<u32>>();
+        let schur = Self {
+            m,
+            lower: vec![0.0; row_idx.len()],
+            scaled: vec![0.0; row_idx.len()],
+            row_idx: row_idx.iter().map(|&i| index(order[i])).collect(),
+            order: indices(order),
+            col_ptr: indices(col_ptr),
+            row_ptr: indices(row_ptr),
+            row_entries,
+            sum_ptr: indices(sum_ptr),
+            terms: by_slot.into_iter().map(|(_, t)| t).collect(),
+            inv_d: vec![0.0; m],
+            work: vec![0.0; m],
+            nnz: pattern.nnz(),
+            dependent: DependentRows::Error,
+            dropped: 0,
+            tolerance: DependentRows::Error.tolerance(),
+        };
+        schur.check();
+        schur
+    }
+
+    /// Checks that every index the structure holds is in bounds of the
+    /// array it indexes, which the unchecked factorization relies on.
+    fn check(&self) {
+        let (m, nl) = (self.m, self.lower.len());
+        let ptr_ok = |ptr: &[u32], len: usize, end: usize| {
+            ptr.len() == len && ptr[0] == 0 && ptr.windows(2).all(|w| w[0] <= w[1]) && ptr[len - 1] as usize == end
+        };
+        let ok = self.order.len() == m
+            && self.order.iter().all(|&i| (i as usize) < m)
+            && ptr_ok(&self.col_ptr, m + 1, nl)
+            && self.row_idx.len() == nl
+            && self.row_idx.iter().all(|&i| (i as usize) < m)
+            && ptr_ok(&self.row_ptr, m + 1, self.row_entries.len())
+            && self.row_entries.iter().all(|&(k, at)| (k as usize) < m && at < self.col_ptr[k as usize + 1])
+            && ptr_ok(&self.sum_ptr, m + nl + 1, self.terms.len())
+            && self.terms.iter().all(|&(a, b, _)| (a as usize) < self.nnz && (b as usize) < self.nnz)
+            && self.scaled.len() == nl
+            && self.inv_d.len() == m
+            && self.work.len() == m;
+        assert!(ok, "inconsistent structure of S");
+        // A row reads each coordinate once, so its diagonal products are squares.
+        let squares = self.terms[..self.sum_ptr[m] as usize].iter().all(|&(a, b, _)| a == b);
+        assert!(squares, "a constraint row reads a coordinate twice");
+    }
+
+    /// Sets what a dependent row does in the next factorizations.
+    pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        (self.dependent, self.tolerance) = (dependent, dependent.tolerance());
+    }
+
+    /// Rows the last factorization dropped as dependent (0 unless tolerated).
+    pub fn dependent_rows(&self) -> usize {
+        self.dropped
+    }
+
+    /// Assembles `S` from the Jacobian values, factors it and solves
+    /// `S x = b` in place. The forward substitution and the diagonal
+    /// scaling join the factorization (column `j` of `L` is final when it is
+    /// applied), which saves two passes over `L` and `b`.
+    pub fn factor_and_solve(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        assert!(jac.len() == self.nnz && b.len() == self.m, "Jacobian or right-hand side of the wrong length");
+        // SAFETY: `new` checked (`check`) that every index in the structure
+        // is in bounds of the array it indexes; `jac` and `b` have the
+        // lengths the terms and rows assume. Unchecked: this loop is bound by
+        // branch throughput, and its bounds checks (some twenty per row of a
+        // chain) cost 18% of the factorization (chain N=10000: 106 → 87 µs).
+        unsafe { self.factor(jac, b)? };
+        self.backward([b.as_mut_ptr()]);
+        Ok(())
+    }
+
+    /// Assembles `S` and factors it, column by column (left-looking: column
+    /// `j` from the finished columns `k < j`), and applies `L⁻¹` then `D⁻¹` to `b`.
+    ///
+    /// # Safety
+    /// `jac.len() == self.nnz` and `b.len() == self.m`.
+    unsafe fn factor(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        let m = self.m;
+        let Self {
+            order,
+            col_ptr,
+            row_idx,
+            row_ptr,
+            row_entries,
+            sum_ptr,
+            terms,
+            lower,
+            scaled,
+            inv_d,
+            work,
+            dependent,
+            dropped,
+            tolerance,
+            ..
+        } = self;
+        let (dependent, tolerance) = (*dependent, *tolerance);
+        // Counted in a local, which stays in a register; stored once at the end.
+        let mut count = 0;
+        *dropped = 0;
+        // Entry `slot` of `S` (see `sum_ptr`), summed in a register.
+        let entry = |slot: usize| -> f64 {
+            // SAFETY (here and below): indices from the checked structure.
+            unsafe {
+                let terms = terms.get_unchecked(span_unchecked(sum_ptr, slot));
+                terms.iter().map(|&(a, b, w)| jac.get_unchecked(a as usize) * jac.get_unchecked(b as usize) * w).sum()
+            }
+        };
+        // A diagonal entry's products are squares (`ja = jb`): one index read, not two.
+        let diagonal = |slot: usize| -> f64 {
+            unsafe {
+                let terms = terms.get_unchecked(span_unchecked(sum_ptr, slot));
+                terms
+                    .iter()
+                    .map(|&(a, _, w)| {
+                        let x = *jac.get_unchecked(a as usize);
+                        x * x * w
+                    })
+                    .sum()
+            }
+        };
+        for j in 0..m {
+            let s_jj = diagonal(j);
+            let own = unsafe { span_unchecked(col_ptr, j) };
+            for p in own.clone() {
+                unsafe { *work.get_unchecked_mut(*row_idx.get_unchecked(p) as usize) = entry(m + p) };
+            }
+            let mut d = s_jj;
+            for &(k, at) in unsafe { row_entries.get_unchecked(span_unchecked(row_ptr, j)) } {
+                let (k, at) = (k as usize, at as usize);
+                // (L D)_jk is known before 1/d_k: the pivot waits on one
+                // multiplication after the division, not two.
+                unsafe {
+                    let u = *scaled.get_unchecked(at);
+                    d -= u * u * inv_d.get_unchecked(k);
+                    for p in at + 1..*col_ptr.get_unchecked(k + 1) as usize {
+                        *work.get_unchecked_mut(*row_idx.get_unchecked(p) as usize) -= lower.get_unchecked(p) * u;
+                    }
+                }
+            }
+            let inv = inverse_pivot(d, s_jj, tolerance, jac, dependent, &mut count, || order[j] as usize)?;
+            unsafe {
+                *inv_d.get_unchecked_mut(j) = inv;
+                let row = *order.get_unchecked(j) as usize;
+                let y = *b.get_unchecked(row);
+                for p in own {
+                    let i = *row_idx.get_unchecked(p) as usize;
+                    let u = *work.get_unchecked(i);
+                    *scaled.get_unchecked_mut(p) = u;
+                    let l = u * inv;
+                    *lower.get_unchecked_mut(p) = l;
+                    *b.get_unchecked_mut(i) -= l * y;
+                }
+                *b.get_unchecked_mut(row) = y * inv;
+            }
+        }
+        *dropped = count;
+        Ok(())
+    }
+
+    /// Solves `S x = b` in place with the current factorization.
+    pub fn solve(&self, b: &mut [f64]) {
+        self.solve_many(&mut [b]);
+    }
+
+    /// Solves `S x = b` in place for up to [`MAX_RIGHT_HAND_SIDES`] vectors
+    /// in one pass over `L`: the control laws solve several right-hand sides
+    /// per evaluation, and the pass (index loads) costs more than the
+    /// arithmetic. Each vector sees exactly the operations of a lone solve.
+    pub fn solve_many(&self, bs: &mut [&mut [f64]]) {
+        assert!(bs.iter().all(|b| b.len() == self.m), "right-hand side of the wrong length");
+        match bs {
+            [] => {}
+            [a] => self.forward_backward([&mut **a]),
+            [a, b] => self.forward_backward([&mut **a, &mut **b]),
+            [a, b, c] => self.forward_backward([&mut **a, &mut **b, &mut **c]),
+            [a, b, c, d] => self.forward_backward([&mut **a, &mut **b, &mut **c, &mut **d]),
+            _ => panic!("at most {MAX_RIGHT_HAND_SIDES} right-hand sides"),
+        }
+    }
+
+    /// `L⁻¹`, `D⁻¹`, then `L⁻ᵀ`, on `K` vectors of length `m` at once.
+    #[inline(always)]
+    fn forward_backward<const K: usize>(&self, mut bs: [&mut [f64]; K]) {
+        let b: [*mut f64; K] = bs.each_mut().map(|b| b.as_mut_ptr());
+        self.forward(b);
+        self.backward(b);
+    }
+
+    /// Applies `L⁻¹` then `D⁻¹` to `K` vectors of length `m` at once.
+    ///
+    /// SAFETY (of the callers): every pointer is to `m` values, and no two
+    /// overlap. `new` checked (`check`) that `order` and `row_idx` hold rows
+    /// < m and that `col_ptr` indexes `lower`.
+    #[inline(always)]
+    fn forward<const K: usize>(&self, b: [*mut f64; K]) {
+        // SAFETY: see above; `solve_many` checked the lengths and takes
+        // distinct borrows.
+        unsafe {
+            for j in 0..self.m {
+                let row = *self.order.get_unchecked(j) as usize;
+                let y: [f64; K] = std::array::from_fn(|k| *b[k].add(row));
+                for p in span_unchecked(&self.col_ptr, j) {
+                    let (i, l) = (*self.row_idx.get_unchecked(p) as usize, *self.lower.get_unchecked(p));
+                    for k in 0..K {
+                        *b[k].add(i) -= l * y[k];
+                    }
+                }
+                let inv = *self.inv_d.get_unchecked(j);
+                for k in 0..K {
+                    *b[k].add(row) = y[k] * inv;
+                }
+            }
+        }
+    }
+
+    /// Applies `L⁻ᵀ` to `K` vectors at once; the callers' contract is `forward`'s.
+    #[inline(always)]
+    fn backward<const K: usize>(&self, b: [*mut f64; K]) {
+        // SAFETY: see `forward`.
+        unsafe {
+            for j in (0..self.m).rev() {
+                let row = *self.order.get_unchecked(j) as usize;
+                let mut y: [f64; K] = std::array::from_fn(|k| *b[k].add(row));
+                for p in span_unchecked(&self.col_ptr, j) {
+                    let (i, l) = (*self.row_idx.get_unchecked(p) as usize, *self.lower.get_unchecked(p));
+                    for k in 0..K {
+                        y[k] -= l * *b[k].add(i);
+                    }
+                }
+                for k in 0..K {
+                    *b[k].add(row) = y[k];
+                }
+            }
+        }
+    }
+}
+
+/// The most right-hand sides [`Schur::solve_many`] takes at once.
+pub(crate) const MAX_RIGHT_HAND_SIDES: usize = 4;
+
+/// `a · b`, for the small dense products of the momentum code.
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// `|x|`.
+pub(crate) fn norm(x: &[f64]) -> f64 {
+    dot(x, x).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows of a star: a hub row on coordinates 0..2 and `arms` chains of
+    /// `len` rows, each row coupling two consecutive coordinate pairs;
+    /// numbered level by level so that the natural order fills in.
+    fn star(arms: usize, len: usize) -> (Pattern, usize) {
+        let mut rows: Vec<Vec<usize>> = vec![vec![0, 1]];
+        let pair = |arm: usize, level: usize| 2 + 2 * (level * arms + arm);
+        for level in 0..len {
+            for arm in 0..arms {
+                let inner = if level == 0 { 0 } else { pair(arm, level - 1) };
+                let outer = pair(arm, level);
+                rows.push(vec![inner, inner + 1, outer, outer + 1]);
+            }
+        }
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new(), read: Vec::new() };
+        for r in rows {
+            pattern.cols.extend(r.iter().map(|&c| c as u32));
+            pattern.read.extend(r.iter().map(|_| true));
+            pattern.start.push(pattern.cols.len() as u32);
+        }
+        (pattern, 2 + 2 * arms * len)
+    }
+
+    /// A `w × w` lattice of coordinate pairs with a row on every edge
+    /// (a net of rods), rows numbered with a stride: a pattern without a
+    /// fill-free order, in a numbering that fills more than AMD's.
+    fn net(w: usize, stride: usize) -> (Pattern, usize) {
+        let pair = |x: usize, y: usize| 2 * (y * w + x);
+        let mut edges = Vec::new();
+        for y in 0..w {
+            for x in 0..w {
+                if x + 1 < w {
+                    edges.push((pair(x, y), pair(x + 1, y)));
+                }
+                if y + 1 < w {
+                    edges.push((pair(x, y), pair(x, y + 1)));
+                }
+            }
+        }
+        let mut pattern = Pattern { start: vec![0], cols: Vec::new(), read: Vec::new() };
+        for r in 0..edges.len() {
+            let (a, b) = edges[(r * stride) % edges.len()];
+            pattern.cols.extend([a, a + 1, b, b + 1].map(|c| c as u32));
+            pattern.read.extend([true; 4]);
+            pattern.start.push(pattern.cols.len() as u32);
+        }
+        (pattern, 2 * w * w)
+    }
+
+    fn values(len: usize, seed: f64) -> Vec<f64> {
+        (0..len).map(|i| (seed + 1.7 * i as f64).sin() + 0.2 * (i % 3) as f64).collect()
+    }
+
+    /// `‖S x − b‖ / ‖b‖` with `S = J M⁻¹ Jᵀ` formed densely.
+    fn residual(pattern: &Pattern, jac: &[f64], inv_mass: &[f64], x: &[f64], b: &[f64]) -> f64 {
+        let m = pattern.start.len() - 1;
+        let mut jt_x = vec![0.0; inv_mass.len()];
+        for r in 0..m {
+            for j in pattern.row(r) {
+                let c = pattern.cols[j] as usize;
+                jt_x[c] += jac[j] * x[r] * inv_mass[c];
+            }
+        }
+        let mut worst = 0.0_f64;
+        for r in 0..m {
+            let s_x: f64 = pattern.row(r).map(|j| jac[j] * jt_x[pattern.cols[j] as usize]).sum();
+            worst = worst.max((s_x - b[r]).abs());
+        }
+        worst / b.iter().fold(0.0_f64, |a, b| a.max(b.abs()))
+    }
+
+    #[test]
+    fn dense_and_reordered_sparse_factors_solve_s() {
+        for (name, (pattern, n)) in [("star", star(5, 12)), ("net", net(8, 17))] {
+            let m = pattern.start.len() - 1;
+            let jac = values(pattern.nnz(), 0.3);
+            let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+            let inv_mass = mass.inverse();
+            for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+                let mut s = Schur::new(&pattern, &mass, solver);
+                // The sparse analysis must have reordered (the natural order fills).
+                let natural = s.order.iter().enumerate().all(|(i, &o)| i == o as usize);
+                assert_eq!(!natural, solver == LinearSolver::Sparse, "{name}");
+                if solver == LinearSolver::Sparse {
+                    let off_diagonal_of_s = products(&pattern, n)
+                        .iter()
+                        .filter(|&&(a, b, ..)| a != b)
+                        .map(|&(a, b, ..)| (a, b))
+                        .collect::<std::collections::BTreeSet<_>>()
+                        .len();
+                    let fill = s.row_idx.len() - off_diagonal_of_s;
+                    // The star is chordal: peeled without fill. The net is not.
+                    assert_eq!(fill == 0, name == "star", "{name}: fill {fill}");
+                }
+                // Solved along with the factorization, and again with it.
+                for seed in [2.0, 2.5] {
+                    let b = values(m, seed);
+                    let mut x = b.clone();
+                    if seed == 2.0 {
+                        s.factor_and_solve(&jac, &mut x).unwrap();
+                    } else {
+                        s.solve(&mut x);
+                    }
+                    let r = residual(&pattern, &jac, inv_mass, &x, &b);
+                    assert!(r < 1e-12, "{name} {solver:?}: relative residual {r:e}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn several_right_hand_sides_are_solved_exactly_as_one_at_a_time() {
+        let (pattern, n) = net(8, 17);
+        let m = pattern.start.len() - 1;
+        let jac = values(pattern.nnz(), 0.3);
+        let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &mass, solver);
+            s.factor_and_solve(&jac, &mut vec![1.0; m]).unwrap();
+            let rhs: Vec<Vec<f64>> = (0..4).map(|k| values(m, 3.0 + k as f64)).collect();
+            let alone: Vec<Vec<f64>> = rhs
+                .iter()
+                .map(|b| {
+                    let mut x = b.clone();
+                    s.solve_many(&mut [&mut x]);
+                    x
+                })
+                .collect();
+            for k in 1..=4 {
+                let mut together = rhs[..k].to_vec();
+                let mut refs: Vec<&mut [f64]> = together.iter_mut().map(|b| b.as_mut_slice()).collect();
+                s.solve_many(&mut refs);
+                assert_eq!(together, alone[..k], "{solver:?}, {k} at once");
+                assert!(residual(&pattern, &jac, mass.inverse(), &together[0], &rhs[0]) < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_dependent_row_is_named_and_a_blown_up_jacobian_is_not_called_singular() {
+        let (pattern, n, jac) = repeated_row(1.0);
+        let mass = DiagonalMass::new(vec![1.0; n]).unwrap();
+        let m = pattern.start.len() - 1;
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &mass, solver);
+            let err = s.factor_and_solve(&jac, &mut vec![1.0; m]).unwrap_err();
+            assert!(matches!(err, Breakdown::Singular(r) if r == m - 1 || r == m - 2), "{solver:?}: {err:?}");
+            let mut bad = values(pattern.nnz(), 0.7);
+            bad[3] = f64::INFINITY;
+            assert_eq!(s.factor_and_solve(&bad, &mut vec![1.0; m]), Err(Breakdown::NonFinite), "{solver:?}");
+            // Tolerated, the blown-up Jacobian is still not called singular.
+            s.set_dependent_rows(DependentRows::Tolerate);
+            assert_eq!(s.factor_and_solve(&bad, &mut vec![1.0; m]), Err(Breakdown::NonFinite), "{solver:?}");
+        }
+    }
+
+    /// A star pattern whose last row repeats the row before it, `scale` times.
+    fn repeated_row(scale: f64) -> (Pattern, usize, Vec<f64>) {
+        let (mut pattern, n) = star(3, 4);
+        let last = pattern.row(pattern.start.len() - 2);
+        let repeated: Vec<u32> = pattern.cols[last.clone()].to_vec();
+        pattern.cols.extend(&repeated);
+        pattern.read.extend(repeated.iter().map(|_| true));
+        pattern.start.push(pattern.cols.len() as u32);
+        let mut jac = values(pattern.nnz(), 0.7);
+        let k = repeated.len();
+        let tail = jac.len() - k;
+        let copy = jac[tail - k..tail].to_vec();
+        jac[tail..].iter_mut().zip(&copy).for_each(|(j, c)| *j = scale * c);
+        (pattern, n, jac)
+    }
+
+    /// `M⁻¹ Φ_qᵀ x`.
+    fn weighted_jt(pattern: &Pattern, jac: &[f64], inv_mass: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; inv_mass.len()];
+        for (r, &xr) in x.iter().enumerate() {
+            for j in pattern.row(r) {
+                let c = pattern.cols[j] as usize;
+                out[c] += inv_mass[c] * jac[j] * xr;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_tolerated_dependent_row_is_dropped_with_a_zero_multiplier_and_the_same_response() {
+        // Twice the row before: dependent, and not of the same scale.
+        let (pattern, n, jac) = repeated_row(2.0);
+        let m = pattern.start.len() - 1;
+        let mass: DiagonalMass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+        let inv_mass = mass.inverse();
+        // b = S y = Φ_q M⁻¹ Φ_qᵀ y: in the range of S.
+        let y = values(m, 4.0);
+        let w = weighted_jt(&pattern, &jac, inv_mass, &y);
+        let b: Vec<f64> = (0..m).map(|r| pattern.row(r).map(|j| jac[j] * w[pattern.cols[j] as usize]).sum()).collect();
+        for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+            let mut s = Schur::new(&pattern, &mass, solver);
+            s.set_dependent_rows(DependentRows::Tolerate);
+            let mut x = b.clone();
+            s.factor_and_solve(&jac, &mut x).unwrap();
+            assert_eq!(s.dependent_rows(), 1, "{solver:?}");
+            let dropped: Vec<usize> = (0..m).filter(|&r| x[r] == 0.0).collect();
+            assert!(dropped == [m - 1] || dropped == [m - 2], "{solver:?}: zero multipliers {dropped:?}");
+            let r = residual(&pattern, &jac, inv_mass, &x, &b);
+            assert!(r < 1e-12, "{solver:?}: relative residual {r:e}");
+            // The response M⁻¹ Φ_qᵀ x is the unique one, though x is not y.
+            let (got, want) = (weighted_jt(&pattern, &jac, inv_mass, &x), &w);
+            let err = got.iter().zip(want).fold(0.0_f64, |a, (g, w)| a.max((g - w).abs()));
+            assert!(err < 1e-12, "{solver:?}: response off by {err:e}");
+            // Further solves with the factorization drop the same row.
+            let mut again = b.clone();
+            s.solve(&mut again);
+            assert_eq!(again, x, "{solver:?}");
+            // An independent system afterwards counts no dropped row.
+            let (indep, _) = star(3, 4);
+            let mut t = Schur::new(&indep, &mass, solver);
+            t.set_dependent_rows(DependentRows::Tolerate);
+            t.factor_and_solve(&values(indep.nnz(), 0.7), &mut vec![1.0; m - 1]).unwrap();
+            assert_eq!(t.dependent_rows(), 0, "{solver:?}");
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! Potentials and non-conservative forces as small local elements.
+//!
+//! A potential element contributes `V` and, by automatic differentiation,
+//! the conservative force `−∇V`. A force element contributes a generalized
+//! force on its coordinates; its power `F·v` is the energy input `Ė` that the
+//! energy constraint integrates.
+
+use crate::ad::scalar::Scalar;
+use crate::model::constraint::seeded;
+use num_dual::Dual64;
+use std::any::Any;
+
+/// Potential energy `V(x)` of `K` coordinates.
+pub trait Potential<const K: usize>: Send + Sync + 'static {
+    /// `V(x)`, for any scalar type (dual numbers give `∇V` and more).
+    fn energy<D: Scalar>(&self, x: [D; K]) -> D;
+}
+
+/// A non-conservative generalized force on `K` coordinates, from their
+/// positions `x`, velocities `xd` and the time.
+pub trait Force<const K: usize>: Send + Sync + 'static {
+    /// The force on each coordinate, for any scalar type.
+    fn force<D: Scalar>(&self, x: [D; K], xd: [D; K], t: D) -> [D; K];
+}
+
+/// A run of potential elements of one type.
+pub(crate) trait PotentialBlock: Send + Sync {
+    /// Returns `V` and adds `∇V` into `grad`.
+    fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64;
+    fn energy(&self, q: &[f64]) -> f64;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// A run of force elements of one type.
+pub(crate) trait ForceBlock: Send + Sync {
+    /// Adds the forces into `f` and returns their power.
+    fn add_forces(&self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> f64;
+    /// Adds `−∂Q/∂v · w` into `out` (one directional dual pass per element).
+    fn add_damping(&self, q: &[f64], v: &[f64], w: &[f64], t: f64, out: &mut [f64]);
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+pub(crate) struct PotentialGroup<P, const K: usize> {
+    pub items: Vec<(P, [usize; K])>,
+}
+
+impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
+    fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64 {
+        let mut total = 0.0;
+        for (p, idx) in &self.items {
+            let (energy, gradient) = energy_and_gradient(p, std::array::from_fn(|j| q[idx[j]]));
+            total += energy;
+            for j in 0..K {
+                grad[idx[j]] += gradient[j];
+            }
+        }
+        total
+    }
+
+    fn energy(&self, q: &[f64]) -> f64 {
+        let mut total = 0.0;
+        for (p, idx) in &self.items {
+            total += p.energy(std::array::from_fn(|j| q[idx[j]]));
+        }
+        total
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// `V(x)` and `∇V(x)`: one scalar dual pass per coordinate (see `constraint.rs`).
+#[inline(always)]
+pub(crate) fn energy_and_gradient<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> (f64, [f64; K]) {
+    if K == 0 {
+        return (p.energy(x), [0.0; K]);
+    }
+    let mut energy = 0.0;
+    let gradient = std::array::from_fn(|j| {
+        let e = p.energy(seeded(&x, j));
+        energy = e.re;
+        e.eps
+    });
+    (energy, gradient)
+}
+
+pub(crate) struct ForceGroup<F, const K: usize> {
+    pub items: Vec<(F, [usize; K])>,
+}
+
+impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
+    fn add_forces(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let mut power = 0.0;
+        for (f, idx) in &self.items {
+            let x = std::array::from_fn(|j| q[idx[j]]);
+            let xd = std::array::from_fn(|j| v[idx[j]]);
+            let fx = f.force(x, xd, t);
+            for j in 0..K {
+                out[idx[j]] += fx[j];
+                power += fx[j] * xd[j];
+            }
+        }
+        power
+    }
+
+    fn add_damping(&self, q: &[f64], v: &[f64], w: &[f64], t: f64, out: &mut [f64]) {
+        for (f, idx) in &self.items {
+            let x = std::array::from_fn(|j| Dual64::from(q[idx[j]]));
+            let along = std::array::from_fn(|j| Dual64::new(v[idx[j]], w[idx[j]]));
+            let fx = f.force(x, along, Dual64::from(t));
+            for j in 0..K {
+                out[idx[j]] -= fx[j].eps;
+            }
+        }
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}

@@ -1,0 +1,19 @@
+//! What a system is: coordinates with a mass matrix, and the small local
+//! elements physics is written in — holonomic constraints, nonholonomic
+//! constraints, potentials and forces, kinetic energies, unit vectors,
+//! functions of time, and the invariants a user declares (momenta, angular
+//! momenta, first integrals) — gathered into a [`Model`] by its builder.
+//!
+//! May import: `error`, `ad`, `linalg`.
+
+pub mod angular;
+pub mod constraint;
+mod definition;
+pub mod force;
+pub mod invariant;
+pub mod kinetic;
+pub mod nonholonomic;
+pub mod timefn;
+pub mod unit_vector;
+
+pub use definition::*;

@@ -1,0 +1,108 @@
+//! Functions of time for drives and applied loads, written once for every
+//! scalar type so that `Φ_t`, `Φ_tt` come from the same dual passes as
+//! everything else.
+
+use crate::ad::scalar::Scalar;
+
+/// `f(t) = Σ_k c_k t^k + Σ_j a_j sin(ω_j t + φ_j)`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TimeFn {
+    /// Polynomial coefficients `c_0, c_1, …`.
+    pub polynomial: Vec<f64>,
+    /// Sine terms `(amplitude, angular frequency, phase)`.
+    pub sines: Vec<[f64; 3]>,
+}
+
+impl TimeFn {
+    /// `f(t) = c`.
+    pub fn constant(c: f64) -> Self {
+        Self { polynomial: vec![c], sines: Vec::new() }
+    }
+
+    /// `c0 + c1 t`.
+    pub fn linear(c0: f64, c1: f64) -> Self {
+        Self { polynomial: vec![c0, c1], sines: Vec::new() }
+    }
+
+    /// `f(t)`, for any scalar type (dual numbers give `ḟ`, `f̈`).
+    pub fn eval<D: Scalar>(&self, t: D) -> D {
+        // Horner for the polynomial.
+        let mut p = D::from(0.0);
+        for &c in self.polynomial.iter().rev() {
+            p = p * t + c;
+        }
+        for &[a, w, phase] in &self.sines {
+            p += (t * w + phase).sin() * a;
+        }
+        p
+    }
+
+    /// Whether every coefficient is finite.
+    pub fn is_finite(&self) -> bool {
+        self.polynomial.iter().chain(self.sines.iter().flatten()).all(|c| c.is_finite())
+    }
+}
+
+/// In scenario files a function of time is a number (a constant) or a table
+/// `{ polynomial = [c0, c1, …], sine = [[amplitude, ω, phase], …] }` with at
+/// least one of the two keys; any other key is refused, so a misspelt key
+/// cannot silently leave `f(t) = 0`.
+#[cfg(feature = "serde")]
+mod serde_format {
+    use super::TimeFn;
+    use serde::de::{self, Deserializer, MapAccess, Visitor, value::MapAccessDeserializer};
+    use serde::{Deserialize, Serialize, Serializer};
+
+    #[derive(Deserialize, Serialize)]
+    #[serde(deny_unknown_fields)]
+    struct Terms {
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        polynomial: Vec<f64>,
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        sine: Vec<[f64; 3]>,
+    }
+
+    struct TimeFnVisitor;
+
+    impl<'de> Visitor<'de> for TimeFnVisitor {
+        type Value = TimeFn;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a number, or a table with `polynomial` and/or `sine`")
+        }
+
+        fn visit_f64<E: de::Error>(self, c: f64) -> Result<TimeFn, E> {
+            Ok(TimeFn::constant(c))
+        }
+
+        fn visit_i64<E: de::Error>(self, c: i64) -> Result<TimeFn, E> {
+            Ok(TimeFn::constant(c as f64))
+        }
+
+        fn visit_u64<E: de::Error>(self, c: u64) -> Result<TimeFn, E> {
+            Ok(TimeFn::constant(c as f64))
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<TimeFn, A::Error> {
+            let Terms { polynomial, sine } = Terms::deserialize(MapAccessDeserializer::new(map))?;
+            if polynomial.is_empty() && sine.is_empty() {
+                return Err(de::Error::custom(
+                    "a function of time needs `polynomial` or `sine` terms (write 0.0 for f(t) = 0)",
+                ));
+            }
+            Ok(TimeFn { polynomial, sines: sine })
+        }
+    }
+
+    impl<'de> Deserialize<'de> for TimeFn {
+        fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+            deserializer.deserialize_any(TimeFnVisitor)
+        }
+    }
+
+    impl Serialize for TimeFn {
+        fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+            Terms { polynomial: self.polynomial.clone(), sine: self.sines.clone() }.serialize(serializer)
+        }
+    }
+}

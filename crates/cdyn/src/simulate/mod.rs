@@ -1,0 +1,11 @@
+//! Running a model: the controlled state equation `ẋ = f(x, t) + U(x, t)`
+//! ([`system`]), and the loop that steps it from a consistent initial state
+//! with observers every `k` steps ([`Simulation`], [`Settings`]).
+//!
+//! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `integrate`,
+//! `control`.
+
+mod stepper;
+pub mod system;
+
+pub use stepper::*;

@@ -1,0 +1,401 @@
+//! The simulation loop: a model, a control law and a scheme stepped from
+//! a consistent initial state, with observers called every `k` steps. A
+//! step that leaves the state non-finite, or the violation past a limit,
+//! stops the run with an error naming the step and time; observers have
+//! seen every step before it.
+
+use crate::control::Control;
+use crate::control::gains::{Operators, Tuning, resolve};
+use crate::control::projection::{Failure, OnFailure};
+use crate::dynamics::diagnostics::Measures;
+use crate::dynamics::momentum::{self, Symmetries};
+use crate::dynamics::{DependentRows, LinearSolver};
+use crate::error::{Error, Part, Problem, Result, positive};
+use crate::integrate::{Buffer, Integrator, Scheme};
+use crate::model::Model;
+use crate::simulate::system::{ControlledSystem, EvalError, System};
+
+/// How to simulate: [`Settings::new`] and the `with_*` setters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Settings {
+    /// The fixed-step scheme.
+    pub scheme: Scheme,
+    /// The step size.
+    pub h: f64,
+    /// The stabilization method.
+    pub control: Control,
+    /// The initial state must satisfy `|Φ|, |Φ̇| ≤` this, unless `None`.
+    pub consistency_tolerance: Option<f64>,
+    /// Stop when `max |Φ|` exceeds this.
+    pub violation_limit: f64,
+    /// Dense or sparse factorization of `Φ_q M⁻¹ Φ_qᵀ` (default: by size).
+    pub solver: LinearSolver,
+    /// Whether a dependent constraint row stops the run (the default) or
+    /// is solved around (redundant constraints, singular positions).
+    pub dependent_rows: DependentRows,
+}
+
+crate::setters!(Settings {
+    /// With this scheme.
+    with_scheme => scheme: Scheme,
+    /// With this step size.
+    with_h => h: f64,
+    /// With this stabilization method.
+    with_control => control: Control,
+    /// With the initial state checked to this `|Φ|, |Φ̇|`, or not checked (`None`).
+    with_consistency_tolerance => consistency_tolerance: Option<f64>,
+    /// Stopping when `max |Φ|` exceeds this.
+    with_violation_limit => violation_limit: f64,
+    /// With this factorization of `Φ_q M⁻¹ Φ_qᵀ`.
+    with_solver => solver: LinearSolver,
+    /// With dependent constraint rows an error or solved around.
+    with_dependent_rows => dependent_rows: DependentRows,
+});
+
+impl Settings {
+    /// These choices, a consistency tolerance of 1e-9, no violation limit
+    /// and the solver chosen by size.
+    pub fn new(scheme: Scheme, h: f64, control: Control) -> Self {
+        Self {
+            scheme,
+            h,
+            control,
+            consistency_tolerance: Some(1e-9),
+            violation_limit: f64::INFINITY,
+            solver: LinearSolver::Auto,
+            dependent_rows: DependentRows::Error,
+        }
+    }
+
+    /// Checks `h`, the gains and the tolerances.
+    pub fn validate(&self) -> Result<()> {
+        positive("h", self.h)?;
+        self.control.validate()?;
+        if let Some(tol) = self.consistency_tolerance {
+            positive("consistency tolerance", tol)?;
+        }
+        if self.violation_limit.is_nan() || self.violation_limit <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "violation limit",
+                value: self.violation_limit,
+                reason: "must be positive",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A running simulation of any controlled [`System`]: the general
+/// [`Simulation`] of a [`Model`], or a [`SmallSimulation`](crate::small::SmallSimulation).
+pub struct Stepper<S: System> {
+    system: S,
+    integrator: Integrator<S::State>,
+    settings: Settings,
+    tuning: Tuning,
+    x: S::State,
+    step: u64,
+    /// Newton iterations of the projection so far, and steps it failed.
+    projection_iterations: u64,
+    projection_failures: u64,
+    /// Steps with dependent constraint rows, if any.
+    rank_loss: Option<RankLoss>,
+}
+
+/// When the constraints lost rank during a run with
+/// [`DependentRows::Tolerate`]: steps in which an evaluation of the
+/// right-hand side dropped dependent rows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct RankLoss {
+    /// The most rows one evaluation dropped.
+    pub max: usize,
+    /// Steps with at least one dropped row.
+    pub steps: u64,
+    /// Start time of the first such step.
+    pub first_time: f64,
+    /// Start time of the last such step.
+    pub last_time: f64,
+}
+
+/// A running simulation of a [`Model`].
+pub type Simulation<'m> = Stepper<ControlledSystem<'m>>;
+
+impl<'m> Simulation<'m> {
+    /// Starts at `t = 0` from `(q0, v0)`, checking the settings and, unless
+    /// disabled, that the initial state satisfies the constraints.
+    pub fn new(model: &'m Model, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        settings.validate()?;
+        check_initial_state(model.n(), q0, v0)?;
+        let e0 = model.kinetic(q0, v0) + model.potential(q0, None);
+        let mut system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
+        system.set_dependent_rows(settings.dependent_rows);
+        system.set_symmetries(momentum::detect(model, q0, v0));
+        Self::start(system, settings, q0, v0)
+    }
+
+    /// The model simulated.
+    pub fn model(&self) -> &'m Model {
+        self.system.model()
+    }
+}
+
+/// Checks an initial state has `n` finite positions and velocities.
+pub(crate) fn check_initial_state(n: usize, q0: &[f64], v0: &[f64]) -> Result<()> {
+    if q0.len() != n || v0.len() != n {
+        let (positions, velocities) = (q0.len(), v0.len());
+        return Err(Problem::StateLength { positions, velocities, n }.at(Part::InitialState));
+    }
+    if let Some((i, &x)) = q0.iter().chain(v0).enumerate().find(|(_, x)| !x.is_finite()) {
+        return Err(Problem::NonFiniteState { index: i, value: x }.at(Part::InitialState));
+    }
+    Ok(())
+}
+
+impl<S: System> Stepper<S> {
+    /// Starts `system` at `t = 0` from a checked `(q0, v0)` with valid `settings`.
+    pub(crate) fn start(mut system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        let n = q0.len();
+        let mut x = system.zero_state();
+        x.as_mut_slice()[..n].copy_from_slice(q0);
+        x.as_mut_slice()[n..2 * n].copy_from_slice(v0);
+        if let Some(tolerance) = settings.consistency_tolerance {
+            let m = system.measure(x.as_slice(), 0.0);
+            if m.phi.abs() > tolerance || m.phi_dot > tolerance {
+                return Err(Error::InconsistentInitialState { phi: m.phi.abs(), phi_dot: m.phi_dot, tolerance });
+            }
+        }
+        // Automatic gains, and the rate × h every control term runs at.
+        // A state the dynamics cannot evaluate fails the first step, which
+        // reports it with the run's record; the gains are then moot.
+        // The projection reads the damping's rate (whether to project `Ψ`).
+        let operators = if settings.control.is_active() || settings.control.projection.is_some() {
+            system.operators(x.as_slice(), 0.0).unwrap_or(Operators { coupling: 1.0, ..Operators::default() })
+        } else {
+            Operators::default()
+        };
+        let (control, tuning) = resolve(settings.control, settings.scheme, settings.h, operators);
+        system.set_control(control);
+        let settings = Settings { control, ..settings };
+        let integrator = Integrator::with_zero(settings.scheme, settings.control.application, system.zero_state());
+        // The gains' evaluation is not a step.
+        system.take_dependent_rows();
+        Ok(Self {
+            system,
+            integrator,
+            settings,
+            tuning,
+            x,
+            step: 0,
+            projection_iterations: 0,
+            projection_failures: 0,
+            rank_loss: None,
+        })
+    }
+
+    /// What the automatic gains were chosen from, and the largest rate × h
+    /// of the control terms ([`crate::control::gains`]).
+    pub fn tuning(&self) -> &Tuning {
+        &self.tuning
+    }
+    /// Newton iterations of the projection so far (the `projection` method).
+    pub fn projection_iterations(&self) -> u64 {
+        self.projection_iterations
+    }
+    /// Steps whose projection did not converge (with `on_failure = continue`).
+    pub fn projection_failures(&self) -> u64 {
+        self.projection_failures
+    }
+    /// Steps in which the constraints lost rank so far; `None` if none did.
+    pub fn rank_loss(&self) -> Option<&RankLoss> {
+        self.rank_loss.as_ref()
+    }
+
+    /// The settings it runs with, its control with the automatic gains chosen.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.step
+    }
+    /// Current time, `step · h` (not accumulated, so it does not drift).
+    pub fn t(&self) -> f64 {
+        self.step as f64 * self.settings.h
+    }
+    /// Current positions.
+    pub fn q(&self) -> &[f64] {
+        &self.x.as_slice()[..self.system.n()]
+    }
+    /// Current velocities.
+    pub fn v(&self) -> &[f64] {
+        let n = self.system.n();
+        &self.x.as_slice()[n..2 * n]
+    }
+    /// `∫Ė dτ` so far.
+    pub fn energy_input(&self) -> f64 {
+        self.x.as_slice()[2 * self.system.n()]
+    }
+    /// `E₀ = T₀ + V₀`.
+    pub fn initial_energy(&self) -> f64 {
+        self.system.e0()
+    }
+    /// Right-hand-side evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.system.evaluations()
+    }
+
+    /// The momenta the system keeps, found at the start, and the declared
+    /// ones it breaks ([`crate::dynamics::momentum::detect`]).
+    pub fn symmetries(&self) -> &Symmetries {
+        self.system.symmetries()
+    }
+
+    /// The value `eᵀ M v` of momentum `j` at the current state: the kept
+    /// ones, then the declared ones the model breaks ([`Symmetries::direction`]).
+    pub fn momentum(&mut self, j: usize) -> f64 {
+        self.system.momentum(j, self.x.as_slice())
+    }
+
+    /// Violations at the current state.
+    pub fn measure(&mut self) -> Measures {
+        let t = self.t();
+        self.system.measure(self.x.as_slice(), t)
+    }
+
+    /// One step of size `h`.
+    pub fn step(&mut self) -> Result<()> {
+        let t = self.t();
+        let step = self.step;
+        let h = self.settings.h;
+        self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
+        self.step += 1;
+        let dropped = match self.settings.dependent_rows {
+            DependentRows::Error => 0,
+            DependentRows::Tolerate => self.system.take_dependent_rows(),
+        };
+        if dropped > 0 {
+            let r = self.rank_loss.get_or_insert(RankLoss { max: 0, steps: 0, first_time: t, last_time: t });
+            (r.max, r.steps, r.last_time) = (r.max.max(dropped), r.steps + 1, t);
+        }
+        if !all_finite(self.x.as_slice()) {
+            return Err(Error::Diverged { step: self.step, t: self.t() });
+        }
+        if let Some(p) = self.settings.control.projection {
+            let t = self.t();
+            match self.system.project(self.x.as_mut_slice(), t, self.settings.h, &p) {
+                Ok(iterations) => self.projection_iterations += u64::from(iterations),
+                Err(f) => {
+                    let (invariant, residual, row, iterations) = match f {
+                        Failure::Breakdown(b, _) => return Err(eval_error(EvalError::at(b, t), self.step, t)),
+                        Failure::Positions { row, residual, iterations } => ("|Φ|", residual, Some(row), iterations),
+                        Failure::Energy { residual } => ("|Ψ|", residual, None, p.max_iterations),
+                    };
+                    if p.on_failure == OnFailure::Stop {
+                        return Err(Error::ProjectionFailed {
+                            step: self.step,
+                            t,
+                            invariant,
+                            residual,
+                            row,
+                            iterations,
+                        });
+                    }
+                    self.projection_failures += 1;
+                }
+            }
+        }
+        // Φ(x_k) was evaluated at the start of this step: checking it costs nothing.
+        if self.settings.violation_limit.is_finite() {
+            let phi = self.system.last_violation();
+            if phi > self.settings.violation_limit {
+                return Err(Error::ViolationLimit { step, t, phi, limit: self.settings.violation_limit });
+            }
+        }
+        Ok(())
+    }
+
+    /// Steps until `t_end`, which must be a whole number of steps (see
+    /// [`steps_to`]), calling `observe` at the start and after every
+    /// `every`-th step and the last.
+    pub fn run<E: From<Error>>(
+        &mut self,
+        t_end: f64,
+        every: u64,
+        mut observe: impl FnMut(&mut Self) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let steps = steps_to(t_end, self.settings.h)?;
+        let every = every.max(1);
+        observe(self)?;
+        while self.step < steps {
+            self.step()?;
+            if self.step.is_multiple_of(every) || self.step == steps {
+                observe(self)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Relative tolerance of "a whole number of steps": absorbs the round-off
+/// of decimal inputs (`20.0 / 0.01` is `1999.9999999999998`), far below any
+/// step a user means.
+const WHOLE_STEPS_TOLERANCE: f64 = 1e-9;
+
+/// Number of steps of size `h` that end exactly at `t_end`.
+///
+/// The rule: `t_end` must be a whole number of steps (to a relative 1e-9).
+/// The last step is never shortened or stretched — a shortened step would
+/// break the fixed step every scheme and the multistep history assume — and
+/// a run never overshoots `t_end`. `h > t_end` and any other `t_end` are an
+/// [`Error::InvalidParameter`] naming `h` or `t_end`; [`nearest_valid_t_end`]
+/// is the end time to suggest instead.
+///
+/// ```
+/// use cdyn::simulate::{nearest_valid_t_end, steps_to};
+/// assert_eq!(steps_to(20.0, 0.01)?, 2000);
+/// assert!(steps_to(0.105, 0.01).is_err());
+/// assert!(steps_to(0.1, 0.5).is_err());
+/// assert!((nearest_valid_t_end(0.1049, 0.01) - 0.1).abs() < 1e-12);
+/// # Ok::<(), cdyn::Error>(())
+/// ```
+pub fn steps_to(t_end: f64, h: f64) -> Result<u64> {
+    positive("t_end", t_end)?;
+    positive("h", h)?;
+    let ratio = t_end / h;
+    if ratio > 1e12 {
+        return Err(Error::InvalidParameter { name: "t_end / h", value: ratio, reason: "more than 1e12 steps" });
+    }
+    let steps = ratio.round();
+    if steps >= 1.0 && (ratio - steps).abs() <= WHOLE_STEPS_TOLERANCE * ratio {
+        Ok(steps as u64)
+    } else if ratio < 1.0 {
+        Err(Error::InvalidParameter { name: "h", value: h, reason: "must not exceed t_end" })
+    } else {
+        Err(Error::InvalidParameter { name: "t_end", value: t_end, reason: "must be a whole number of steps h" })
+    }
+}
+
+/// The end time nearest to `t_end` that [`steps_to`] accepts for `h`: a
+/// whole number of steps, at least one. It is rounded to 12 significant
+/// digits so that it prints as a user would write it (`0.11`, not
+/// `0.10999999999999999`); that moves it far less than the tolerance.
+pub fn nearest_valid_t_end(t_end: f64, h: f64) -> f64 {
+    crate::error::tidy_time((t_end / h).round().max(1.0) * h)
+}
+
+/// The error of a failed evaluation during step `step` (steps taken before
+/// it), at time `t_next` for a state that stopped being finite.
+fn eval_error(e: EvalError, step: u64, t_next: f64) -> Error {
+    match e {
+        EvalError::Singular { t, row } => Error::SingularConstraints { step, t, row },
+        EvalError::NonFinite { .. } => Error::Diverged { step: step + 1, t: t_next },
+        EvalError::Mass { t, coordinate } => Error::MassNotPositive { step, t, coordinate },
+    }
+}
+
+/// Whether every value is finite; without early exit inside a chunk, so
+/// that the test vectorizes.
+fn all_finite(x: &[f64]) -> bool {
+    x.chunks(64).all(|c| c.iter().fold(true, |ok, x| ok & x.is_finite()))
+}
