@@ -1,27 +1,20 @@
-//! The commands of `cdyn` as a library: scenario files, cases, runs,
-//! `compare`, `sweep` and `paper`, shared by the `cdyn` binary and the
+//! The commands of `cdyn` as a library, shared by the `cdyn` binary and the
 //! Python package (crates/cdyn-py), so both read scenarios, run cases and
 //! word errors the same way.
+//!
+//! | folder | what lives there |
+//! |---|---|
+//! | [`io`] | files written whole, the terminal, progress, Ctrl-C |
+//! | [`case`] | the scenario file, the case it builds, running a case |
+//! | [`study`] | what the commands compute from many runs: paper, compare, suite, sweep, bench |
+//! | [`render`] | what they write for people to look at: summaries, plots, heat maps, GIFs, viewers |
+//!
+//! The commands themselves (argument parsing, which of these to call) are
+//! the binary's, in `src/commands/`.
 
 #![deny(missing_docs)]
 
-pub mod alloc_count;
-pub mod bench;
-pub mod compare;
-pub mod frames;
-pub mod gif;
-pub mod heatmap;
-pub mod interrupt;
-pub mod output;
-pub mod paper;
-pub mod plot;
-pub mod progress;
-pub mod report;
-pub mod runner;
-pub mod scenario;
-pub mod suite;
-pub mod suite_plot;
-pub mod sweep;
-pub mod terminal;
-pub mod view3d;
-pub mod viewer;
+pub mod case;
+pub mod io;
+pub mod render;
+pub mod study;

@@ -7,8 +7,11 @@
 //! Every run happens with the GIL released; failures become `cdyn.Error`
 //! subclasses carrying the CLI's one-line message, never a crash.
 
-use cdyn_cli::runner::{Case, CaseResult, Estimate, OUTPUT_LIMIT, Rows, columns, every_to_fit, run_case_in_memory};
-use cdyn_cli::{paper, scenario, sweep};
+use cdyn_cli::case::runner::{
+    Case, CaseResult, Estimate, OUTPUT_LIMIT, Rows, columns, every_to_fit, run_case_in_memory,
+};
+use cdyn_cli::case::scenario;
+use cdyn_cli::study::{paper, sweep};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
@@ -266,7 +269,7 @@ fn compare<'py>(
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let path = scenario.path();
     scenario.parsed.refuse_sweep(&path, "compare").map_err(scenario_error)?;
-    let cases = cdyn_cli::compare::cases(&scenario.parsed, &path).map_err(scenario_error)?;
+    let cases = cdyn_cli::study::compare::cases(&scenario.parsed, &path).map_err(scenario_error)?;
     check_memory(&cases, &scenario.file, multipliers, force)?;
     run_all(py, cases, multipliers)
 }

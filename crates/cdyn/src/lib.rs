@@ -2,15 +2,19 @@
 //!
 //! # Map of the modules
 //!
+//! Each folder's page says what lives there and what it may import; the
+//! imports point down this table, never up.
+//!
 //! | layer | modules |
 //! |---|---|
-//! | what a system is | [`model`] (coordinates, mass, elements), [`constraint`], [`nonholonomic`], [`force`], [`kinetic`], [`scalar`] (the number type physics is written in), [`timefn`] |
-//! | building systems | [`planar`] and [`spatial`] mechanisms, [`models`] (built-ins), [`small`] (sizes known at compile time), [`assemble`] (consistent initial states) |
-//! | what it does, uncontrolled | [`dynamics`] (`Φ`, `λ`, `A`), [`mass`], [`energy`] (`Ψ`), [`system`] (the state equation with its control term) |
-//! | pushing violations back | [`control`] (the laws), [`methods`] (by name, presets), [`gains`] (automatic rates), [`projection`], [`unit_vector`] |
-//! | what it keeps | [`momentum`] (symmetries found, corrections kept orthogonal), [`angular`], [`invariant`] (declared), [`held`] |
-//! | stepping and output | [`integrate`] (schemes), [`simulate`] (the loop), [`record`], [`diagnostics`], `json_float` (with `serde`) |
-//! | checking | [`reference`](mod@reference) (closed-form motions), [`error`] |
+//! | checking and leaves | [`error`], [`reference`](mod@reference) (closed-form motions), [`ad`] (the scalar physics is written in, one-pass Jacobians), [`linalg`] (`M`, `S = Φ_q M⁻¹ Φ_qᵀ` and its factorization), `json_float` (with `serde`) |
+//! | what a system is | [`model`]: coordinates, mass, constraint / force / kinetic elements, nonholonomic rows, unit vectors, time functions, declared invariants |
+//! | what it does, uncontrolled | [`dynamics`]: `Φ`, `λ`, `A`, the energy constraint `Ψ`, diagnostics, the momenta it keeps, assembly onto the constraints |
+//! | stepping | [`integrate`] (the schemes) |
+//! | pushing violations back | [`control`]: the laws, methods by name, automatic gains, the exact projection, held invariants |
+//! | running | [`simulate`] (the state equation and the loop), [`small`] (sizes known at compile time) |
+//! | building systems | [`planar`] and [`spatial`] mechanisms, [`models`] (built-ins) |
+//! | output | [`record`] (statistics, series, sinks) |
 #![deny(missing_docs)]
 
 /// Runs `$body` with the const `$k` equal to the run-time `$n`, one of the

@@ -84,7 +84,7 @@ fn declared_modules(code: &str) -> BTreeSet<String> {
         .filter_map(|l| {
             let l = l.trim_start();
             let l = l.strip_prefix("pub(crate) ").or_else(|| l.strip_prefix("pub ")).unwrap_or(l);
-            l.strip_prefix("mod ").map(|r| ident(r))
+            l.strip_prefix("mod ").map(ident)
         })
         .collect()
 }
@@ -210,10 +210,10 @@ impl Crate {
             let names = graph.entry(file.clone()).or_default();
             let inside = paths(code, "crate::").into_iter().filter(|p| p[0] == name).map(|p| p[1..].to_vec());
             for path in inside.chain(paths(code, "super::")) {
-                if let Some(target) = path.first().and_then(|first| owner.get(first)) {
-                    if target != file {
-                        names.insert(target.clone());
-                    }
+                if let Some(target) = path.first().and_then(|first| owner.get(first))
+                    && target != file
+                {
+                    names.insert(target.clone());
                 }
             }
         }
@@ -257,7 +257,8 @@ fn no_module_imports_its_way_back_to_itself() {
     for krate in ["cdyn", "cdyn-cli"] {
         let c = read(krate);
         let graph = c.top_graph();
-        assert!(graph.len() > 8, "{krate}: only {} modules found", graph.len());
+        let files: usize = c.modules.values().map(BTreeMap::len).sum();
+        assert!(graph.len() >= 4 && files > 20, "{krate}: only {} modules, {files} files found", graph.len());
         no_cycle(&graph, krate);
         for (name, files) in &c.modules {
             if files.len() > 1 {

@@ -4,7 +4,7 @@
 //! centre of mass to the points elements attach to, joints, springs,
 //! ground points), at about real time.
 
-use crate::frames::Frames;
+use crate::case::frames::Frames;
 use anyhow::{Context, Result, anyhow};
 use cdyn::planar::{Anchor, Drawing};
 use image::codecs::gif::{GifEncoder, Repeat};
@@ -38,7 +38,7 @@ pub fn write(path: &Path, drawing: &Drawing, frames: &Frames) -> Result<()> {
     if frames.is_empty() {
         anyhow::bail!("no frames to animate for {}", path.display());
     }
-    crate::plot::ensure_font()?;
+    crate::render::plot::ensure_font()?;
     let view = View::fit(drawing, frames);
     let picked = pick(frames.len(), MAX_FRAMES);
     let span = frames.t[frames.len() - 1] - frames.t[0];
@@ -65,7 +65,7 @@ pub fn write(path: &Path, drawing: &Drawing, frames: &Frames) -> Result<()> {
                 .map_err(|e| anyhow!("cannot encode {}: {e}", path.display()))?;
         }
     }
-    crate::output::write(path, &bytes)
+    crate::io::output::write(path, &bytes)
 }
 
 /// Up to `max` frame indices of `n`, evenly spread, the first and last among them.

@@ -2,7 +2,8 @@
 //! colour bar for the log scale, the value printed in the cell while cells
 //! are large enough to hold it (grey where the run failed).
 
-use crate::plot::write_drawing;
+use crate::render::plot::write_drawing;
+use crate::study::sweep::{Point, Sweep};
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -148,5 +149,56 @@ where
         }
     }
     root.present()?;
+    Ok(())
+}
+
+/// A complete sweep's heat maps over its first two axes (the first alone
+/// when there is one); each cell shows the best value over the remaining
+/// axes. A shard draws none (its grid has holes).
+pub fn sweep_maps(sweep: &Sweep, dir: &Path) -> Result<()> {
+    if sweep.shard.is_some() {
+        return Ok(());
+    }
+    let axes = &sweep.axes;
+    let (x, y) = (&axes[0], axes.get(1));
+    let ny = y.map_or(1, |a| a.values.len());
+    let others: usize = axes.iter().skip(2).map(|a| a.values.len()).product();
+    type Metric = fn(&Point) -> Option<f64>;
+    let metrics: [(&str, &str, Metric); 3] = [
+        ("heat_err", "max |error| against the reference", |p| p.max_abs_err),
+        ("heat_phi", "max |Φ|", |p| Some(p.max_abs_phi)),
+        ("heat_psi", "max |Ψ|", |p| Some(p.max_abs_psi)),
+    ];
+    for (stem, what, metric) in metrics {
+        if sweep.points.iter().all(|p| metric(p).is_none()) {
+            continue;
+        }
+        let mut z = vec![vec![None::<f64>; x.values.len()]; ny];
+        for p in &sweep.points {
+            let i = p.index / others;
+            let (ix, iy) = match y {
+                Some(a) => (i / a.values.len(), i % a.values.len()),
+                None => (i, 0),
+            };
+            let v = if p.error.is_some() { None } else { metric(p) };
+            if let Some(v) = v {
+                let cell = &mut z[iy][ix];
+                *cell = Some(cell.map_or(v, |c| c.min(v)));
+            }
+        }
+        let title = format!("{what}{}", if others > 1 { " (best over the other axes)" } else { "" });
+        let y_values = y.map_or(vec![0.0], |a| a.values.clone());
+        write_heatmap(
+            &dir.join(stem),
+            &HeatMap {
+                title: &title,
+                x_label: &x.name,
+                x_values: &x.values,
+                y_label: y.map_or("", |a| a.name.as_str()),
+                y_values: &y_values,
+                z: &z,
+            },
+        )?;
+    }
     Ok(())
 }

@@ -2,10 +2,10 @@
 //! per sample, written as the run goes so that a run which fails keeps what
 //! it wrote, plus the series and statistics the summary and figures need.
 
-use crate::frames::Frames;
-use crate::interrupt;
-use crate::output::AtomicFile;
-use crate::progress;
+use crate::case::frames::Frames;
+use crate::io::interrupt;
+use crate::io::output::AtomicFile;
+use crate::io::progress;
 use anyhow::{Context, Result};
 use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sample, Series, Sink};

@@ -26,7 +26,7 @@
 //!   of the machine, which hits the methods of one trial alike, cancels.
 //! - Allocations per step, counted by the binary's global allocator.
 
-use crate::alloc_count::allocations;
+use crate::io::alloc_count::allocations;
 use anyhow::Result;
 use cdyn::baseline::{HandWritten, HandWrittenChain};
 use cdyn::control::methods::{self, MethodGains};

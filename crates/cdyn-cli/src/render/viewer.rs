@@ -3,8 +3,8 @@
 //! with play/pause, speed and a time slider, the Φ, Ψ and error plots with
 //! a cursor on the same time, the summary table and the method and gains.
 
-use crate::output;
-use crate::runner::{Case, CaseResult};
+use crate::case::runner::{Case, CaseResult};
+use crate::io::output;
 use anyhow::{Context, Result};
 use serde_json::{Value, json};
 use std::path::Path;
@@ -51,7 +51,7 @@ impl ViewerArgs {
         if self.gif {
             let drawn = cases.iter().zip(results).find_map(|(c, r)| Some((c.example.drawing.as_ref()?, &r.frames)));
             if let Some((drawing, frames)) = drawn.filter(|(_, f)| !f.is_empty()) {
-                crate::gif::write(&dir.join(GIF), drawing, frames)?;
+                crate::render::gif::write(&dir.join(GIF), drawing, frames)?;
             }
         }
         Ok(())

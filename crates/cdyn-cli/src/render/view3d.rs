@@ -5,8 +5,8 @@
 //! joints attach to; joints as rings; ground points as squares; distance
 //! joints as the rod between their two ends.
 
-use crate::frames::Frames;
-use crate::plot::{FONT, write_drawing};
+use crate::case::frames::Frames;
+use crate::render::plot::{FONT, write_drawing};
 use anyhow::Result;
 use cdyn::spatial::Sketch;
 use plotters::coord::Shift;

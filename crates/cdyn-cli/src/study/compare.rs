@@ -2,12 +2,10 @@
 //! paper's test, with the scenario's gains or target rates, then the
 //! `robust` preset and exact `projection`.
 
-use crate::report;
-use crate::runner::{Case, CaseResult};
-use crate::scenario::Scenario;
+use crate::case::runner::Case;
+use crate::case::scenario::Scenario;
 use anyhow::Result;
 use cdyn::control::methods::compare_cases;
-use serde_json::json;
 use std::path::Path;
 
 /// Every method as a case of the scenario's model, integrator and output.
@@ -32,20 +30,4 @@ pub fn cases(scenario: &Scenario, path: &Path) -> Result<Vec<Case>> {
             Ok(case)
         })
         .collect()
-}
-
-/// Runs the cases into `dir` (until one is interrupted) with the summary, figures and gains used.
-pub fn run(cases: &[Case], path: &Path, dir: &Path) -> Result<Vec<CaseResult>> {
-    let results = report::run_cases(cases, dir)?;
-    let methods: Vec<_> =
-        cases.iter().map(|c| json!({ "name": c.name, "control": format!("{:?}", c.settings.control) })).collect();
-    let extra = json!({
-        "scenario": path.display().to_string(),
-        "methods": methods,
-        "assembly": cases.first().and_then(|c| c.assembly.as_ref()).map(report::assembly_json),
-    });
-    report::write_summary(dir, &results, extra)?;
-    let stem = path.file_stem().map_or("compare".into(), |s| s.to_string_lossy().into_owned());
-    report::write_figures(dir, &stem, &results, report::RUN_FIGURES)?;
-    Ok(results)
 }

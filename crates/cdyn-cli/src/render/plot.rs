@@ -49,7 +49,7 @@ pub struct Figure<'a> {
     pub series: &'a [Series],
 }
 
-const FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 pub(crate) const FONT: &str = "sans-serif";
 const SIZE: (u32, u32) = (1200, 800);
 /// Upper bound on tick labels per axis; also sets how many decimals a label needs.
@@ -68,7 +68,7 @@ pub fn write_figure(stem: &Path, fig: &Figure) -> Result<()> {
 
 /// Writes `<stem>.png` and `<stem>.svg` of `size`, drawn by `png` and `svg`
 /// (the same drawing on each backend). Both are drawn in memory and written
-/// atomically ([`crate::output`]), so a failed write leaves no truncated
+/// atomically ([`crate::io::output`]), so a failed write leaves no truncated
 /// figure and its message is the I/O error, not a dump of plotters' error types.
 pub fn write_drawing(
     stem: &Path,
@@ -85,11 +85,11 @@ pub fn write_drawing(
     image::codecs::png::PngEncoder::new(&mut encoded)
         .write_image(&pixels, size.0, size.1, image::ColorType::Rgb8)
         .map_err(|e| anyhow!("cannot encode figure {}: {e}", png_path.display()))?;
-    crate::output::write(&png_path, &encoded)?;
+    crate::io::output::write(&png_path, &encoded)?;
     let mut text = String::new();
     svg(SVGBackend::with_string(&mut text, size).into_drawing_area())
         .with_context(|| format!("cannot draw figure {}", svg_path.display()))?;
-    crate::output::write(&svg_path, text.as_bytes())
+    crate::io::output::write(&svg_path, text.as_bytes())
 }
 
 /// Registers the shipped font once; every figure needs it (there are no system fonts).

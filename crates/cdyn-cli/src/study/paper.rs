@@ -1,14 +1,11 @@
 //! `cdyn paper`: the test of the paper's Example 1 (AB-3, h = 0.01,
 //! t ∈ [0, 20], α_g = α_e = 40, Baumgarte β = 40 critically damped).
 
-use crate::report;
-use crate::runner::{Case, CaseResult};
+use crate::case::runner::Case;
 use anyhow::Result;
 use cdyn::control::methods::{MethodGains, independent_cases, redundant_cases};
 use cdyn::models::{Example, PendulumParams, cartesian_pendulum, theta_pendulum};
 use cdyn::{Scheme, Settings};
-use serde_json::json;
-use std::path::Path;
 
 /// The paper's step size.
 pub const H: f64 = 0.01;
@@ -39,18 +36,4 @@ pub fn cases() -> Result<Vec<Case>> {
         }
     }
     Ok(cases)
-}
-
-/// Runs `cases` (the paper's, from [`cases`]) into `dir` until one is interrupted, writes the summary and figures, and returns
-/// the results (failed cases carry their error).
-pub fn run(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
-    let results = report::run_cases(cases, dir)?;
-    let setup = json!({
-        "problem": "Example 1: unit pendulum in Cartesian coordinates, X(0)=1, Y(0)=0, VX(0)=0, VY(0)=2, g=1",
-        "scheme": "ab3 (rk4 start-up)", "h": H, "t_end": T_END,
-        "gains": { "zeta": 20.0, "alpha_e": 40.0, "rho_q": 0.0, "baumgarte_alpha": 2.0 * 40f64.sqrt(), "baumgarte_beta": 40.0 },
-    });
-    report::write_summary(dir, &results, json!({ "setup": setup }))?;
-    report::write_figures(dir, "Example 1 [AB-3, h = 0.01]", &results, report::PAPER_FIGURES)?;
-    Ok(results)
 }

@@ -1,9 +1,10 @@
 //! What a set of cases leaves behind: `summary.json`, the figures, and a
 //! table on the terminal.
 
-use crate::output;
-use crate::plot::{self, Figure, Scale};
-use crate::runner::{Case, CaseResult, run_case};
+use crate::case::runner::{Case, CaseResult, run_case};
+use crate::io::output;
+use crate::render::plot::{self, Figure, Scale};
+use crate::study::paper;
 use anyhow::Result;
 use cdyn::json_float::JsonFloat;
 use serde_json::json;
@@ -12,7 +13,7 @@ use std::path::Path;
 /// Runs `cases` into `dir` in turn; an interrupted case is the last.
 pub fn run_cases(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
     let mut results = Vec::new();
-    let bar = crate::progress::bar(crate::runner::Estimate::steps(cases), "steps");
+    let bar = crate::io::progress::bar(crate::case::runner::Estimate::steps(cases), "steps");
     for case in cases {
         let result = run_case(case, dir, &bar)?;
         let interrupted = result.interrupted;
@@ -30,8 +31,8 @@ pub fn file_names(cases: &[Case], stems: Stems) -> Vec<String> {
     let csv = cases.iter().map(|c| format!("{}.csv", c.name));
     let figures = stems.iter().flat_map(|s| ["png", "svg"].map(|ext| format!("{s}.{ext}")));
     // The viewer's files too: a run without --html leaves no page of an earlier run.
-    let viewer = ["summary.json", crate::viewer::FILE, crate::viewer::GIF].map(String::from);
-    let view3d = ["png", "svg"].map(|ext| format!("{}.{ext}", crate::view3d::STEM));
+    let viewer = ["summary.json", crate::render::viewer::FILE, crate::render::viewer::GIF].map(String::from);
+    let view3d = ["png", "svg"].map(|ext| format!("{}.{ext}", crate::render::view3d::STEM));
     csv.chain(figures).chain(viewer).chain(view3d).collect()
 }
 
@@ -188,4 +189,34 @@ pub fn assembly_line(a: &cdyn::dynamics::assemble::Assembly) -> String {
         "assembly: {} Newton iterations, max |Φ| {:.2e} → {:.2e}, max |Φ̇| {:.2e} → {:.2e}, max |Δq| = {:.2e}, max |Δv| = {:.2e}",
         a.newton_iterations, a.phi_before, a.phi_after, a.phi_dot_before, a.phi_dot_after, a.max_dq, a.max_dv
     )
+}
+
+/// `cdyn compare`: runs the cases ([`crate::study::compare::cases`]) into `dir` (until one is interrupted) with the summary, figures and gains used.
+pub fn compare(cases: &[Case], path: &Path, dir: &Path) -> Result<Vec<CaseResult>> {
+    let results = run_cases(cases, dir)?;
+    let methods: Vec<_> =
+        cases.iter().map(|c| json!({ "name": c.name, "control": format!("{:?}", c.settings.control) })).collect();
+    let extra = json!({
+        "scenario": path.display().to_string(),
+        "methods": methods,
+        "assembly": cases.first().and_then(|c| c.assembly.as_ref()).map(assembly_json),
+    });
+    write_summary(dir, &results, extra)?;
+    let stem = path.file_stem().map_or("compare".into(), |s| s.to_string_lossy().into_owned());
+    write_figures(dir, &stem, &results, RUN_FIGURES)?;
+    Ok(results)
+}
+
+/// `cdyn paper`: runs `cases` (the paper's, from [`crate::study::paper::cases`]) into `dir` until one is interrupted, writes the summary and figures, and returns
+/// the results (failed cases carry their error).
+pub fn paper(cases: &[Case], dir: &Path) -> Result<Vec<CaseResult>> {
+    let results = run_cases(cases, dir)?;
+    let setup = json!({
+        "problem": "Example 1: unit pendulum in Cartesian coordinates, X(0)=1, Y(0)=0, VX(0)=0, VY(0)=2, g=1",
+        "scheme": "ab3 (rk4 start-up)", "h": paper::H, "t_end": paper::T_END,
+        "gains": { "zeta": 20.0, "alpha_e": 40.0, "rho_q": 0.0, "baumgarte_alpha": 2.0 * 40f64.sqrt(), "baumgarte_beta": 40.0 },
+    });
+    write_summary(dir, &results, json!({ "setup": setup }))?;
+    write_figures(dir, "Example 1 [AB-3, h = 0.01]", &results, PAPER_FIGURES)?;
+    Ok(results)
 }

@@ -3,8 +3,8 @@
 //! (dots) and to `projection` (squares) on a log axis, one colour per
 //! scheme and step. A run that stopped is a cross at the right edge.
 
-use crate::plot::write_drawing;
-use crate::suite::{Group, Suite};
+use crate::render::plot::write_drawing;
+use crate::study::suite::{Group, Suite};
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;

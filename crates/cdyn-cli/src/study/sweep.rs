@@ -1,5 +1,5 @@
 //! `cdyn sweep`: a grid over gains and step sizes, run in parallel (rayon),
-//! with a table and heat maps of the worst error and violations — the
+//! with a table (and heat maps, `render::heatmap`) of the worst error and violations — the
 //! question the paper leaves open, how to choose gains.
 //!
 //! Every grid point is an independent, deterministic run, and results are
@@ -7,9 +7,8 @@
 //! of threads. `--shard I/N` runs the points with `index % N == I`; `cdyn
 //! merge` joins shard outputs into exactly what one run writes.
 
-use crate::heatmap::{HeatMap, write_heatmap};
-use crate::runner::run_case_quietly;
-use crate::scenario::Scenario;
+use crate::case::runner::run_case_quietly;
+use crate::case::scenario::Scenario;
 use anyhow::{Context, Result, anyhow, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -111,7 +110,7 @@ pub fn worker_threads(requested: Option<usize>) -> Result<Option<usize>> {
     let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
     let max = max_threads(cores);
     if n > max {
-        crate::terminal::eprint_line(&format!(
+        crate::io::terminal::eprint_line(&format!(
             "notice: --threads {n} is more than {max} (4 per core on {cores} cores, at most 256); using {max}"
         ));
         return Ok(Some(max));
@@ -328,61 +327,11 @@ pub fn merge(parts: Vec<Sweep>) -> Result<Sweep> {
     Ok(Sweep { scenario: first.scenario, scenario_hash: first.scenario_hash, axes: first.axes, shard: None, points })
 }
 
-/// Writes `sweep.json`, and for a complete sweep the heat maps.
+/// Writes `sweep.json` (the heat maps are drawn by
+/// [`crate::render::heatmap::sweep_maps`]).
 pub fn write(sweep: &Sweep, dir: &Path) -> Result<()> {
     let path = dir.join("sweep.json");
-    crate::output::write(&path, (serde_json::to_string_pretty(sweep)? + "\n").as_bytes())?;
-    if sweep.shard.is_none() {
-        heat_maps(sweep, dir)?;
-    }
-    Ok(())
-}
-
-/// Heat maps over the first two axes (the first alone when there is one);
-/// each cell shows the best value over the remaining axes.
-fn heat_maps(sweep: &Sweep, dir: &Path) -> Result<()> {
-    let axes = &sweep.axes;
-    let (x, y) = (&axes[0], axes.get(1));
-    let ny = y.map_or(1, |a| a.values.len());
-    let others: usize = axes.iter().skip(2).map(|a| a.values.len()).product();
-    type Metric = fn(&Point) -> Option<f64>;
-    let metrics: [(&str, &str, Metric); 3] = [
-        ("heat_err", "max |error| against the reference", |p| p.max_abs_err),
-        ("heat_phi", "max |Φ|", |p| Some(p.max_abs_phi)),
-        ("heat_psi", "max |Ψ|", |p| Some(p.max_abs_psi)),
-    ];
-    for (stem, what, metric) in metrics {
-        if sweep.points.iter().all(|p| metric(p).is_none()) {
-            continue;
-        }
-        let mut z = vec![vec![None::<f64>; x.values.len()]; ny];
-        for p in &sweep.points {
-            let i = p.index / others;
-            let (ix, iy) = match y {
-                Some(a) => (i / a.values.len(), i % a.values.len()),
-                None => (i, 0),
-            };
-            let v = if p.error.is_some() { None } else { metric(p) };
-            if let Some(v) = v {
-                let cell = &mut z[iy][ix];
-                *cell = Some(cell.map_or(v, |c| c.min(v)));
-            }
-        }
-        let title = format!("{what}{}", if others > 1 { " (best over the other axes)" } else { "" });
-        let y_values = y.map_or(vec![0.0], |a| a.values.clone());
-        write_heatmap(
-            &dir.join(stem),
-            &HeatMap {
-                title: &title,
-                x_label: &x.name,
-                x_values: &x.values,
-                y_label: y.map_or("", |a| a.name.as_str()),
-                y_values: &y_values,
-                z: &z,
-            },
-        )?;
-    }
-    Ok(())
+    crate::io::output::write(&path, (serde_json::to_string_pretty(sweep)? + "\n").as_bytes())
 }
 
 /// Above this many points the printed table holds only the best

@@ -2,7 +2,7 @@
 //! integrator and the output sampling, in TOML. Every mistake becomes one
 //! line naming the file and the key.
 
-use crate::runner::Case;
+use crate::case::runner::Case;
 use anyhow::{Result, anyhow, bail};
 use cdyn::control::methods::{MethodKeys, Preset};
 use cdyn::dynamics::DependentRows;

@@ -11,10 +11,10 @@
 //! largest over every step after `t = 0`; those at `t = 0` (the assembly's)
 //! are kept apart.
 
-use crate::compare;
-use crate::runner::Case;
-use crate::scenario::{self, Scenario};
-use crate::terminal::print;
+use crate::case::runner::Case;
+use crate::case::scenario::{self, Scenario};
+use crate::io::terminal::print;
+use crate::study::compare;
 use anyhow::{Context, Result, anyhow};
 use cdyn::json_float::JsonFloat;
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
@@ -219,7 +219,7 @@ fn model(name: String, path: PathBuf, light: bool) -> Result<Model> {
 pub fn run(extra: &[PathBuf], light: bool) -> Result<Suite> {
     let models = models(extra, light)?;
     let start = Instant::now();
-    let bar = crate::progress::bar(models.len() as u64, "models");
+    let bar = crate::io::progress::bar(models.len() as u64, "models");
     let groups: Vec<Vec<Group>> = models
         .par_iter()
         .map(|m| {
@@ -483,10 +483,10 @@ impl Suite {
 }
 
 /// Writes `dir/suite.json`, whole or not at all (the figure is
-/// [`crate::suite_plot::write`]'s, which reads this module's types).
+/// [`crate::render::suite_plot::write`]'s, which reads this module's types).
 pub fn write(suite: &Suite, dir: &Path) -> Result<()> {
     let text = serde_json::to_string_pretty(&suite.json())? + "\n";
-    crate::output::write(&dir.join("suite.json"), text.as_bytes())
+    crate::io::output::write(&dir.join("suite.json"), text.as_bytes())
 }
 
 /// A number for the table: scientific, `inf` or `-`.

@@ -1,0 +1,9 @@
+//! One run: the scenario file and its typed keys ([`scenario`]), the case
+//! it builds and how a case is run, to files or in memory ([`runner`]),
+//! and the positions kept for the viewer's animation ([`frames`]).
+//!
+//! May import: `io`.
+
+pub mod frames;
+pub mod runner;
+pub mod scenario;

@@ -1,0 +1,15 @@
+//! What the commands write for people to look at: the summary and figures
+//! of a set of runs ([`report`]), plots ([`plot`]), heat maps
+//! ([`heatmap`]), the suite's figure ([`suite_plot`]), animated GIFs
+//! ([`gif`]), the HTML viewer ([`viewer`]) and the spatial views
+//! ([`view3d`]).
+//!
+//! May import: `io`, `case`, `study`.
+
+pub mod gif;
+pub mod heatmap;
+pub mod plot;
+pub mod report;
+pub mod suite_plot;
+pub mod view3d;
+pub mod viewer;
