@@ -2,7 +2,7 @@
 //! binary and the Python package: the paper's cases ([`paper`]), a model
 //! under every method ([`compare`]), the method suite with its verdicts
 //! ([`suite`]), grids over gains and steps ([`sweep`]), and the cost of a
-//! step ([`bench`]). Nothing here draws; the figures are in `render`.
+//! step ([`bench`](mod@bench)). Nothing here draws; the figures are in `render`.
 //!
 //! May import: `io`, `case`.
 
