@@ -3,7 +3,7 @@ constraint and energy violations pushed back (CVSGF), from Python.
 
 A thin layer over the Rust library and the ``cdyn`` command line: scenarios
 are read, cases run and errors worded exactly as ``cdyn run``, ``cdyn
-compare``, ``cdyn sweep`` and ``cdyn paper`` do. Runs release the GIL.
+compare``, ``cdyn sweep``, ``cdyn suite`` and ``cdyn paper`` do. Runs release the GIL.
 
 >>> import cdyn
 >>> s = cdyn.model("pendulum", scheme="rk4", h=0.01, t_end=1.0)
@@ -34,6 +34,7 @@ __all__ = [
     "Scenario",
     "Result",
     "Sweep",
+    "Suite",
     "load",
     "loads",
     "from_dict",
@@ -42,6 +43,7 @@ __all__ = [
     "run",
     "compare",
     "sweep",
+    "suite",
     "example1",
 ]
 
@@ -199,6 +201,34 @@ class Sweep:
         return f"<cdyn.Sweep {len(self.summary['points'])} points over {[a['name'] for a in self.summary['axes']]}>"
 
 
+class Suite:
+    """The method suite's result, as ``cdyn suite`` computes it: ``summary``
+    is ``suite.json`` as a dict (equal to the CLI's file), ``table`` the
+    table and summary lines it prints."""
+
+    __slots__ = {
+        "summary": "suite.json as a dict: light, cases (one per model, scheme and step), summary.",
+        "table": "The table and the check counts cdyn suite prints.",
+    }
+
+    def __init__(self, text: str, table: str) -> None:
+        self.summary: Dict[str, Any] = json.loads(text)
+        self.table: str = table
+
+    @property
+    def cases(self) -> List[Dict[str, Any]]:
+        """One entry per model, scheme and step: its runs (one per method) and checks."""
+        return list(self.summary["cases"])
+
+    @property
+    def misses(self) -> List[str]:
+        """Every failed check, ``model scheme h=… (letter): numbers``."""
+        return list(self.summary["summary"]["misses"])
+
+    def __repr__(self) -> str:
+        return f"<cdyn.Suite {len(self.summary['cases'])} groups, {len(self.misses)} misses>"
+
+
 def load(path: Union[str, "os.PathLike[str]"]) -> Scenario:
     """Reads and checks the scenario file at ``path`` (as ``cdyn run`` does)."""
     return _cdyn.load(os.fspath(path))
@@ -285,6 +315,14 @@ def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:
     (default: one per core), as ``cdyn sweep`` does; the result does not
     depend on ``threads``."""
     return Sweep(_cdyn.run_sweep(scenario(source), threads))
+
+
+def suite(scenarios: Sequence[Union[str, "os.PathLike[str]"]] = (), *, light: bool = False) -> Suite:
+    """Judges every method of ``cdyn compare`` on the shipped models (a few,
+    shorter, with ``light``) and the scenario files ``scenarios``, at AB-3
+    and RK-4, h and h/2, against a fine reference, as ``cdyn suite`` does;
+    the result's ``summary`` equals the CLI's ``suite.json``."""
+    return Suite(*_cdyn.run_suite([os.fspath(p) for p in scenarios], light))
 
 
 def example1(*, multipliers: bool = False) -> Dict[str, Result]:

@@ -1,7 +1,7 @@
 """Type stubs of the native module ``cdyn._cdyn`` (use the ``cdyn`` package's functions)."""
 
 import os
-from typing import Any, Dict, List, Mapping, Optional, Union
+from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 __version__: str
 
@@ -33,3 +33,4 @@ def run(scenario: Scenario, multipliers: bool = False, force: bool = False) -> D
 def compare(scenario: Scenario, multipliers: bool = False, force: bool = False) -> List[Dict[str, Any]]: ...
 def paper_cases(multipliers: bool = False) -> List[Dict[str, Any]]: ...
 def run_sweep(scenario: Scenario, threads: Optional[int] = None) -> str: ...
+def run_suite(scenarios: List[str], light: bool = False) -> Tuple[str, str]: ...

@@ -168,3 +168,19 @@ def test_numpy_numbers_in_a_dict_and_the_toml_round_trip():
     again = cdyn.loads(s.to_toml())
     assert same_bits(cdyn.run(again).table, r.table)
     assert s.file == "<dict>" and not s.has_sweep and "<dict>" in repr(s)
+
+
+def test_suite_is_the_clis_suite_json_and_table(cli, tmp_path):
+    extra = EXAMPLES / "suite" / "satellite_planar.toml"
+    out = cli("suite", "--light", extra, "--out", tmp_path)
+    assert out.returncode == 0, out.stderr
+    result = cdyn.suite([extra], light=True)
+    written = (tmp_path / "suite.json").read_text()
+    assert result.summary == json.loads(written)
+    assert result.table in out.stdout
+    # Every model, both schemes and both steps; the misses are the CLI's, named.
+    models = {c["model"] for c in result.cases}
+    assert "satellite_planar" in models and len(result.cases) == 4 * len(models)
+    assert result.misses == json.loads(written)["summary"]["misses"]
+    with pytest.raises(cdyn.ScenarioError, match="nothing.toml"):
+        cdyn.suite([tmp_path / "nothing.toml"], light=True)

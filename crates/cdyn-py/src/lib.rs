@@ -11,7 +11,7 @@ use cdyn_cli::case::runner::{
     Case, CaseResult, Estimate, OUTPUT_LIMIT, Rows, columns, every_to_fit, run_case_in_memory,
 };
 use cdyn_cli::case::scenario;
-use cdyn_cli::study::{paper, sweep};
+use cdyn_cli::study::{paper, suite, sweep};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
@@ -296,6 +296,17 @@ fn run_sweep(py: Python<'_>, scenario: &Scenario, threads: Option<usize>) -> PyR
     serde_json::to_string(&result).map_err(|e| Error::new_err(e.to_string()))
 }
 
+/// Runs the method suite (`cdyn suite`: the shipped models, the light part
+/// of them with `light`, and `scenarios`); returns `suite.json` as text and
+/// the table `cdyn suite` prints.
+#[pyfunction]
+#[pyo3(signature = (scenarios, light = false))]
+fn run_suite(py: Python<'_>, scenarios: Vec<PathBuf>, light: bool) -> PyResult<(String, String)> {
+    let result = py.detach(|| suite::run(&scenarios, light)).map_err(scenario_error)?;
+    let json = serde_json::to_string_pretty(&result.json()).map_err(|e| Error::new_err(e.to_string()))? + "\n";
+    Ok((json, suite::table(&result) + &suite::summary(&result)))
+}
+
 /// The native module.
 #[pymodule]
 fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -311,6 +322,7 @@ fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(paper_cases, m)?)?;
     m.add_function(wrap_pyfunction!(run_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(run_suite, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -9,7 +9,12 @@ use std::path::{Path, PathBuf};
 
 /// Runs the suite (the shipped models and `scenarios`), writes suite.json and suite.png into `out`.
 pub fn suite(scenarios: &[PathBuf], out: &Path, light: bool) -> Result<()> {
+    let start = std::time::Instant::now();
     let result = suite::run(scenarios, light)?;
+    for (model, seconds) in &result.seconds {
+        print(&format!("  {model}: {seconds:.1} s\n"))?;
+    }
+    print(&format!("suite: {} models in {:.1} s\n", result.seconds.len(), start.elapsed().as_secs_f64()))?;
     output_dir(out)?;
     suite_plot::write(&result, out)?;
     suite::write(&result, out)?;

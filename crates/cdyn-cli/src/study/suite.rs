@@ -13,7 +13,6 @@
 
 use crate::case::runner::Case;
 use crate::case::scenario::{self, Scenario};
-use crate::io::terminal::print;
 use crate::study::compare;
 use anyhow::{Context, Result, anyhow};
 use cdyn::json_float::JsonFloat;
@@ -164,6 +163,8 @@ pub struct Group {
 pub struct Suite {
     /// Whether it was the `--light` suite.
     pub light: bool,
+    /// Each model's name and the wall-clock seconds it took (not in suite.json).
+    pub seconds: Vec<(String, f64)>,
     /// One per model, scheme and step.
     pub groups: Vec<Group>,
 }
@@ -218,9 +219,8 @@ fn model(name: String, path: PathBuf, light: bool) -> Result<Model> {
 /// Runs the suite: the shipped models (`light`: a few, shorter) and `extra`.
 pub fn run(extra: &[PathBuf], light: bool) -> Result<Suite> {
     let models = models(extra, light)?;
-    let start = Instant::now();
     let bar = crate::io::progress::bar(models.len() as u64, "models");
-    let groups: Vec<Vec<Group>> = models
+    let done: Vec<(Vec<Group>, f64)> = models
         .par_iter()
         .map(|m| {
             let groups = run_model(m);
@@ -229,12 +229,13 @@ pub fn run(extra: &[PathBuf], light: bool) -> Result<Suite> {
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
-    print(&format!("suite: {} models in {:.1} s\n", models.len(), start.elapsed().as_secs_f64()))?;
-    Ok(Suite { light, groups: groups.into_iter().flatten().collect() })
+    let seconds = models.iter().zip(&done).map(|(m, (_, s))| (m.name.clone(), *s)).collect();
+    Ok(Suite { light, seconds, groups: done.into_iter().flat_map(|(g, _)| g).collect() })
 }
 
 /// The reference, then every case of the model.
-fn run_model(model: &Model) -> Result<Vec<Group>> {
+/// Its groups and the seconds they took.
+fn run_model(model: &Model) -> Result<(Vec<Group>, f64)> {
     let start = Instant::now();
     let file = model.path.display().to_string();
     let first = &model.setups[0].2[0];
@@ -269,8 +270,7 @@ fn run_model(model: &Model) -> Result<Vec<Group>> {
             runs,
         });
     }
-    print(&format!("  {}: {:.1} s\n", model.name, start.elapsed().as_secs_f64()))?;
-    Ok(groups)
+    Ok((groups, start.elapsed().as_secs_f64()))
 }
 
 /// Positions of the model without control, RK-4 at `interval / 20`, at `t = k·interval`.
