@@ -4,6 +4,8 @@
 //!
 //! May import: `io`.
 
+mod build;
 pub mod frames;
 pub mod runner;
 pub mod scenario;
+mod wording;
