@@ -13,5 +13,7 @@ pub mod held;
 mod laws;
 pub mod methods;
 pub mod projection;
+mod term;
 
 pub use laws::*;
+pub use term::*;

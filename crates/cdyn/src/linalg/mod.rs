@@ -1,13 +1,17 @@
 //! Linear algebra: the mass matrix `M` and every product with it
 //! ([`mass`]), the `m × m` system `S = Φ_q M⁻¹ Φ_qᵀ` with its `L D Lᵀ`
-//! factorization (`schur`), and the symbolic analysis of a sparse `S`
+//! factorization (`schur`; its pivot test and the dense factorization in
+//! `ldl`), and the symbolic analysis of a sparse `S`
 //! (`sparse`, done once per model).
 //!
 //! May import: `error`.
 
+mod ldl;
 pub mod mass;
 mod schur;
 pub(crate) mod sparse;
 
-pub use schur::{Breakdown, DependentRows, LinearSolver, SPARSE_FROM};
-pub(crate) use schur::{DenseLdl, Schur, dot, inverse_pivot, norm};
+pub use ldl::{Breakdown, DependentRows};
+pub(crate) use ldl::{DenseLdl, inverse_pivot};
+pub use schur::{LinearSolver, SPARSE_FROM};
+pub(crate) use schur::{Schur, dot, norm};

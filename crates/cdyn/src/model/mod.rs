@@ -7,6 +7,7 @@
 //! May import: `error`, `ad`, `linalg`.
 
 pub mod angular;
+mod builder;
 pub mod constraint;
 mod definition;
 pub mod force;
@@ -16,4 +17,5 @@ pub mod nonholonomic;
 pub mod timefn;
 pub mod unit_vector;
 
+pub use builder::*;
 pub use definition::*;
