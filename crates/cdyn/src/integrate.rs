@@ -1,12 +1,14 @@
 //! Fixed-step schemes as data (Eqs. 54–59): their weights, order and
 //! start-up, and one step `x_k → x_{k+1}` with the control term either in
-//! the right-hand side or integrated by a separate Euler step.
+//! the right-hand side or integrated by a separate Euler step. Explicit
+//! one-step (Runge–Kutta), multistep (Adams–Bashforth) and
+//! predictor-corrector (Adams–Bashforth–Moulton, PECE) formulas.
 //!
 //! The integrator knows nothing of models: it sees a right-hand side split
 //! into `f` (what the scheme integrates) and the control term `U`.
 
 /// A fixed-step scheme. In scenario files it is written by its
-/// [`SchemeInfo::name`]: `euler`, `ab2`, `ab3`, `rk4`.
+/// [`SchemeInfo::name`]: `euler`, `ab2`, `ab3`, `rk4`, `abm4`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(try_from = "String", into = "&'static str"))]
@@ -20,6 +22,12 @@ pub enum Scheme {
     AdamsBashforth3,
     /// The classical Runge–Kutta method, order 4.
     RungeKutta4,
+    /// Adams–Bashforth–Moulton, order 4, in PECE mode: the four-step
+    /// Adams–Bashforth predictor, one evaluation there, the three-step
+    /// Adams–Moulton corrector, and the evaluation at the corrected state
+    /// that starts the next step: two evaluations a step, half of RK-4's,
+    /// with an error constant about 19/270 of AB-4's (RK-4 start-up).
+    AdamsBashforthMoulton4,
 }
 
 /// Where the control term is integrated (Eqs. 54–59). Scenario files write
@@ -53,6 +61,14 @@ pub enum Application {
 pub enum Formula {
     /// `x_{k+1} = x_k + h Σ_j w_j F_{k−j}`
     Multistep(&'static [f64]),
+    /// Predict `x* = x_k + h Σ_j p_j F_{k−j}`, evaluate `F* = F(x*, t_{k+1})`,
+    /// correct `x_{k+1} = x_k + h (c_0 F* + Σ_j c_{j+1} F_{k−j})` (PECE).
+    PredictorCorrector {
+        /// Predictor weights, newest first.
+        predictor: &'static [f64],
+        /// Corrector weights: `F*`'s, then the past evaluations', newest first.
+        corrector: &'static [f64],
+    },
     /// An explicit Butcher tableau: `a` is strictly lower-triangular, row by row.
     RungeKutta {
         /// Stage coefficients `a_ij`, one row per stage.
@@ -67,7 +83,7 @@ pub enum Formula {
 /// Everything that distinguishes one scheme from another.
 #[derive(Debug, Clone, Copy)]
 pub struct SchemeInfo {
-    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`.
+    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`, `abm4`.
     pub name: &'static str,
     /// Order of accuracy.
     pub order: u32,
@@ -87,7 +103,13 @@ const RK4_C: &[f64] = &[0.0, 0.5, 0.5, 1.0];
 
 impl Scheme {
     /// Every scheme.
-    pub const ALL: [Scheme; 4] = [Scheme::Euler, Scheme::AdamsBashforth2, Scheme::AdamsBashforth3, Scheme::RungeKutta4];
+    pub const ALL: [Scheme; 5] = [
+        Scheme::Euler,
+        Scheme::AdamsBashforth2,
+        Scheme::AdamsBashforth3,
+        Scheme::RungeKutta4,
+        Scheme::AdamsBashforthMoulton4,
+    ];
 
     /// Order, cost, history, start-up and formula of this scheme.
     pub fn info(self) -> SchemeInfo {
@@ -124,10 +146,21 @@ impl Scheme {
                 startup: None,
                 formula: Formula::RungeKutta { a: RK4_A, b: RK4_B, c: RK4_C },
             },
+            Scheme::AdamsBashforthMoulton4 => SchemeInfo {
+                name: "abm4",
+                order: 4,
+                evaluations: 2,
+                history: 4,
+                startup: Some(Scheme::RungeKutta4),
+                formula: Formula::PredictorCorrector {
+                    predictor: &[55.0 / 24.0, -59.0 / 24.0, 37.0 / 24.0, -9.0 / 24.0],
+                    corrector: &[9.0 / 24.0, 19.0 / 24.0, -5.0 / 24.0, 1.0 / 24.0],
+                },
+            },
         }
     }
 
-    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`).
+    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`, `abm4`).
     pub fn from_name(name: &str) -> Option<Scheme> {
         Scheme::ALL.into_iter().find(|s| s.info().name == name)
     }
@@ -218,7 +251,8 @@ impl<B: Buffer> Integrator<B> {
             .flatten()
             .map(|s| match s.info().formula {
                 Formula::RungeKutta { b, .. } => b.len(),
-                Formula::Multistep(_) => 1,
+                // The evaluation at the predicted state.
+                Formula::Multistep(_) | Formula::PredictorCorrector { .. } => 1,
             })
             .max()
             .unwrap_or(1);
@@ -268,6 +302,25 @@ impl<B: Buffer> Integrator<B> {
                 let f: [&[f64]; 3] = std::array::from_fn(|j| self.past(if j < w.len() { j } else { 0 }));
                 advance(x, h, w, f, joined.then_some(self.u.as_slice()));
                 control_pending = !joined;
+            }
+            Formula::PredictorCorrector { predictor, corrector } => {
+                let (history, newest) = (&self.history, self.newest);
+                let past = |j: usize| history[(newest + j) % history.len()].as_slice();
+                let f = [past(0), past(1), past(2), past(3)];
+                let stage_x = self.stage_x.as_mut_slice();
+                stage_x.copy_from_slice(x);
+                accumulate(stage_x, h, predictor, f);
+                let predicted = self.stages[0].as_mut_slice();
+                if control && !split {
+                    rhs.eval(self.stage_x.as_slice(), t + h, predicted, Some(self.u.as_mut_slice()))?;
+                    add(predicted, self.u.as_slice());
+                } else {
+                    // U(x_k) stays in `u` for the forward Euler control step.
+                    rhs.eval(self.stage_x.as_slice(), t + h, predicted, None)?;
+                }
+                let past = |j: usize| self.history[(self.newest + j) % self.history.len()].as_slice();
+                let f = [self.stages[0].as_slice(), past(0), past(1), past(2)];
+                accumulate(x, h, corrector, f);
             }
             Formula::RungeKutta { a, b, c } => {
                 self.stages[0].as_mut_slice().copy_from_slice(self.history[self.newest].as_slice());
@@ -349,8 +402,113 @@ fn advance(x: &mut [f64], h: f64, w: &[f64], f: [&[f64]; 3], u: Option<&[f64]>) 
     }
 }
 
+/// `x += h Σ_j w_j f_j` in one pass, for the four weights of a predictor
+/// or a corrector.
+#[inline(always)]
+fn accumulate(x: &mut [f64], h: f64, w: &[f64], f: [&[f64]; 4]) {
+    let [w0, w1, w2, w3] = [h * w[0], h * w[1], h * w[2], h * w[3]];
+    let n = x.len();
+    let (f0, f1, f2, f3) = (&f[0][..n], &f[1][..n], &f[2][..n], &f[3][..n]);
+    for i in 0..n {
+        x[i] += w0 * f0[i] + w1 * f1[i] + w2 * f2[i] + w3 * f3[i];
+    }
+}
+
 fn add(a: &mut [f64], b: &[f64]) {
     for (a, b) in a.iter_mut().zip(b) {
         *a += b;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `ẋ = λ x`, with the control term `U = μ x` when `mu` is given; counts evaluations.
+    struct Linear {
+        lambda: f64,
+        mu: Option<f64>,
+        evaluations: usize,
+    }
+
+    impl Rhs for Linear {
+        type Error = ();
+        fn state_len(&self) -> usize {
+            1
+        }
+        fn has_control(&self) -> bool {
+            self.mu.is_some()
+        }
+        fn eval(&mut self, x: &[f64], _: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), ()> {
+            self.evaluations += 1;
+            f[0] = self.lambda * x[0];
+            if let Some(u) = u {
+                u[0] = self.mu.unwrap_or(0.0) * x[0];
+            }
+            Ok(())
+        }
+    }
+
+    /// RK-4's step of `ẋ = λ x`: `x (1 + z + z²/2 + z³/6 + z⁴/24)`, `z = h λ`.
+    fn rk4(x: f64, z: f64) -> f64 {
+        x * (1.0 + z + z * z / 2.0 + z.powi(3) / 6.0 + z.powi(4) / 24.0)
+    }
+
+    /// ABM-4 PECE's step of `ẋ = λ x` from the states `y` (oldest first), by hand.
+    fn abm4(y: [f64; 4], lambda: f64, h: f64) -> f64 {
+        let f = y.map(|y| lambda * y);
+        let predicted = y[3] + h / 24.0 * (55.0 * f[3] - 59.0 * f[2] + 37.0 * f[1] - 9.0 * f[0]);
+        y[3] + h / 24.0 * (9.0 * lambda * predicted + 19.0 * f[3] - 5.0 * f[2] + f[1])
+    }
+
+    #[test]
+    fn abm4_starts_with_three_rk4_steps_then_predicts_and_corrects_at_two_evaluations_a_step() {
+        let (lambda, h) = (-1.3, 0.1);
+        let mut rhs = Linear { lambda, mu: None, evaluations: 0 };
+        let mut integrator = Integrator::new(Scheme::AdamsBashforthMoulton4, Application::InRhs, 1);
+        let mut x = [1.0];
+        let mut y = vec![1.0];
+        for k in 0..3 {
+            assert_eq!(integrator.active_scheme(), Scheme::RungeKutta4);
+            integrator.step(&mut rhs, &mut x, k as f64 * h, h).unwrap();
+            y.push(rk4(y[k], h * lambda));
+            assert!((x[0] - y[k + 1]).abs() < 1e-15, "start-up step {k}: {} against {}", x[0], y[k + 1]);
+        }
+        assert_eq!(rhs.evaluations, 12);
+        for k in 3..6 {
+            assert_eq!(integrator.active_scheme(), Scheme::AdamsBashforthMoulton4);
+            integrator.step(&mut rhs, &mut x, k as f64 * h, h).unwrap();
+            y.push(abm4([y[k - 3], y[k - 2], y[k - 1], y[k]], lambda, h));
+            assert!((x[0] - y[k + 1]).abs() < 1e-15, "step {k}: {} against {}", x[0], y[k + 1]);
+        }
+        assert_eq!(rhs.evaluations, 12 + 3 * 2);
+    }
+
+    #[test]
+    fn abm4_applies_the_control_as_the_multistep_schemes_do() {
+        let (lambda, mu, h) = (-0.7, -2.0, 0.05);
+        // In the right-hand side: the scheme integrates ẋ = (λ + μ) x.
+        let mut rhs = Linear { lambda, mu: Some(mu), evaluations: 0 };
+        let mut integrator = Integrator::new(Scheme::AdamsBashforthMoulton4, Application::InRhs, 1);
+        let mut alone = Linear { lambda: lambda + mu, mu: None, evaluations: 0 };
+        let mut reference = Integrator::new(Scheme::AdamsBashforthMoulton4, Application::InRhs, 1);
+        let (mut x, mut r) = ([1.0], [1.0]);
+        for k in 0..6 {
+            integrator.step(&mut rhs, &mut x, k as f64 * h, h).unwrap();
+            reference.step(&mut alone, &mut r, k as f64 * h, h).unwrap();
+            assert!((x[0] - r[0]).abs() < 1e-15, "step {k}");
+        }
+        // Split, forward Euler (Eq. 58): the scheme's step of ẋ = λ x, plus h U(x_k).
+        let mut rhs = Linear { lambda, mu: Some(mu), evaluations: 0 };
+        let mut integrator = Integrator::new(Scheme::AdamsBashforthMoulton4, Application::ForwardEuler, 1);
+        let mut x = [1.0];
+        let mut y = vec![1.0];
+        for k in 0..6 {
+            integrator.step(&mut rhs, &mut x, k as f64 * h, h).unwrap();
+            let stepped =
+                if k < 3 { rk4(y[k], h * lambda) } else { abm4([y[k - 3], y[k - 2], y[k - 1], y[k]], lambda, h) };
+            y.push(stepped + h * mu * y[k]);
+            assert!((x[0] - y[k + 1]).abs() < 1e-15, "step {k}: {} against {}", x[0], y[k + 1]);
+        }
     }
 }

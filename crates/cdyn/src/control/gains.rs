@@ -89,6 +89,9 @@ pub fn real_stability_interval(scheme: Scheme) -> f64 {
         Formula::Multistep(_) => 6.0 / 11.0,
         // RK-4: the real root x > 0 of 1 − x + x²/2 − x³/6 + x⁴/24 = 1.
         Formula::RungeKutta { .. } => 2.785_293_563_405_282,
+        // ABM-4 PECE: where a complex pair of roots of its characteristic
+        // polynomial leaves the unit circle (not at ζ = −1; the test finds it).
+        Formula::PredictorCorrector { .. } => 1.284_816_263_107_07,
     }
 }
 
@@ -267,6 +270,30 @@ pub fn resolve(control: Control, scheme: Scheme, h: f64, operators: Operators) -
 mod tests {
     use super::*;
 
+    /// The largest root modulus of a PECE scheme on `ẏ = λ y` at `z = h λ`:
+    /// `y_{k+1} = y_k + z (c_0 y* + Σ_j c_{j+1} y_{k−j})` with the prediction
+    /// `y* = y_k + z Σ_j p_j y_{k−j}`, as the eigenvalues of its companion matrix.
+    fn pece_spectral_radius(p: &[f64], c: &[f64], z: f64) -> f64 {
+        let k = p.len();
+        // y_{k+1} = Σ_j a_j y_{k−j}.
+        let mut a = vec![0.0; k];
+        a[0] = 1.0 + z * c[0];
+        for j in 0..k {
+            a[j] += z * c[0] * z * p[j];
+        }
+        for (j, cj) in c[1..].iter().enumerate() {
+            a[j] += z * cj;
+        }
+        let mut m = nalgebra::DMatrix::zeros(k, k);
+        for j in 0..k {
+            m[(0, j)] = a[j];
+        }
+        for i in 1..k {
+            m[(i, i - 1)] = 1.0;
+        }
+        m.complex_eigenvalues().iter().map(|e| e.norm()).fold(0.0, f64::max)
+    }
+
     #[test]
     fn the_real_stability_intervals_end_where_the_amplification_reaches_the_unit_circle() {
         for scheme in Scheme::ALL {
@@ -280,6 +307,14 @@ mod tests {
                     let z = -1.0_f64;
                     z.powi(k) - z.powi(k - 1)
                         + x * w.iter().enumerate().map(|(j, w)| w * z.powi(k - 1 - j as i32)).sum::<f64>()
+                }
+                // Its roots leave the unit circle at ±i rather than −1: the largest
+                // root's modulus is 1 there, below just inside and above just outside.
+                Formula::PredictorCorrector { predictor, corrector } => {
+                    let radius = |x: f64| pece_spectral_radius(predictor, corrector, -x);
+                    assert!(radius(x * (1.0 - 1e-6)) <= 1.0 + 1e-12 && radius(x * (1.0 + 1e-6)) > 1.0, "{scheme:?}");
+                    assert!((0..1000).all(|k| radius(x * k as f64 / 1000.0) <= 1.0 + 1e-12), "{scheme:?}");
+                    radius(x) - 1.0
                 }
             };
             assert!(at_boundary.abs() < 1e-12, "{scheme:?}: {at_boundary}");
