@@ -85,8 +85,8 @@ enum Command {
         #[command(flatten)]
         listing: ListingArgs,
     },
-    /// Judge every method of `cdyn compare` on many models (examples/suite and any given) at AB-3 and RK-4,
-    /// h and h/2, against a fine reference; writes suite.json and suite.png. Misses of its checks are reported, not fatal.
+    /// Judge every method of `cdyn compare` on many models (examples/suite and any given) at AB-3, RK-4
+    /// and ABM-4, h and h/2, against a fine reference; writes suite.json and suite.png. Misses of its checks are reported, not fatal.
     #[command(after_help = "Example: cdyn suite --out out/suite --light")]
     Suite {
         /// More scenarios (TOML) to add to the shipped ones.

@@ -24,7 +24,7 @@ fn methods() -> Vec<&'static str> {
 
 /// Checks that miss in the light suite: (model, scheme, h, check, measured and why).
 /// Check "projection" would mean the projection run stopped.
-const KNOWN_MISSES: [(&str, &str, f64, &str, &str); 2] = [
+const KNOWN_MISSES: [(&str, &str, f64, &str, &str); 3] = [
     (
         "mixed_masses",
         "ab3",
@@ -39,6 +39,14 @@ const KNOWN_MISSES: [(&str, &str, f64, &str, &str); 2] = [
         0.001,
         "c",
         "robust 6.65e-5 vs none 1.12e-4 (0.59x): exact projection ends at the same 6.65e-5 (AB-3's phase error)",
+    ),
+    (
+        "pendulum_rest",
+        "abm4",
+        0.005,
+        "a",
+        "robust 1.28e-9 vs projection 6.27e-10 (2.05x), both far below none's 3.47e-9: at 1e-9 the projection's \
+         own tolerance (|phi| 1e-10 left after each step) and ABM-4's error are of one size, and which is ahead is chance",
     ),
 ];
 
@@ -87,7 +95,7 @@ fn the_light_suite_has_every_case_and_its_checks_hold_but_the_known_misses() {
     let suite: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("suite.json")).unwrap()).unwrap();
     assert_eq!(suite["light"], true);
     let cases = suite["cases"].as_array().unwrap();
-    assert_eq!(cases.len(), MODELS.len() * 4);
+    assert_eq!(cases.len(), MODELS.len() * 6);
 
     let models: BTreeSet<&str> = cases.iter().map(|c| c["model"].as_str().unwrap()).collect();
     assert_eq!(models, MODELS.into_iter().collect());
@@ -101,7 +109,17 @@ fn the_light_suite_has_every_case_and_its_checks_hold_but_the_known_misses() {
         let mut setups: Vec<(String, f64)> =
             of_model.iter().map(|c| (c["scheme"].as_str().unwrap().to_string(), num(&c["h"]) / coarse)).collect();
         setups.sort_by(|a, b| a.partial_cmp(b).unwrap());
-        assert_eq!(setups, [("ab3".into(), 0.5), ("ab3".into(), 1.0), ("rk4".into(), 0.5), ("rk4".into(), 1.0)]);
+        assert_eq!(
+            setups,
+            [
+                ("ab3".into(), 0.5),
+                ("ab3".into(), 1.0),
+                ("abm4".into(), 0.5),
+                ("abm4".into(), 1.0),
+                ("rk4".into(), 0.5),
+                ("rk4".into(), 1.0)
+            ]
+        );
         for case in of_model {
             let (scheme, h) = (case["scheme"].as_str().unwrap(), num(&case["h"]));
             let label = format!("{model} {scheme} h={h}");
@@ -170,7 +188,7 @@ fn the_light_suite_has_every_case_and_its_checks_hold_but_the_known_misses() {
     let known_checks = KNOWN_MISSES.iter().filter(|k| k.3 != "projection").count();
     assert_eq!(suite["summary"]["misses"].as_array().unwrap().len(), known_checks);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("checks over 16 (model, scheme, h)"), "{stdout}");
+    assert!(stdout.contains("checks over 24 (model, scheme, h)"), "{stdout}");
 }
 
 #[test]

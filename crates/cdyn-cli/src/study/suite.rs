@@ -1,5 +1,5 @@
-//! `cdyn suite`: every method of `cdyn compare` on many models, at AB-3 and
-//! RK-4 and at the scenario's `h` and `h/2`, judged against a fine reference,
+//! `cdyn suite`: every method of `cdyn compare` on many models, at AB-3,
+//! RK-4 and ABM-4 and at the scenario's `h` and `h/2`, judged against a fine reference,
 //! so that a method which makes the answer worse than no control shows.
 //!
 //! The reference is the same model without control, RK-4 with step `h/20`
@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The schemes every model runs at.
-const SCHEMES: [Scheme; 2] = [Scheme::AdamsBashforth3, Scheme::RungeKutta4];
+const SCHEMES: [Scheme; 3] = [Scheme::AdamsBashforth3, Scheme::RungeKutta4, Scheme::AdamsBashforthMoulton4];
 /// The step sizes every model runs at, as divisors of the scenario's `h`.
 const DIVISORS: [u64; 2] = [1, 2];
 /// The reference step is the scenario's `h` over this.
