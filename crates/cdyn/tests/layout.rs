@@ -134,9 +134,14 @@ fn read(krate: &str) -> Crate {
         } else {
             for entry in std::fs::read_dir(src.join(&name)).unwrap() {
                 let path = entry.unwrap().path();
+                let stem = path.file_stem().unwrap().to_string_lossy().to_string();
                 if path.extension().is_some_and(|e| e == "rs") {
-                    let stem = path.file_stem().unwrap().to_string_lossy().to_string();
                     files.insert(if stem == "mod" { String::new() } else { stem }, code(&path));
+                } else if path.join("mod.rs").exists() {
+                    // A module split into a folder of its own counts as one file of its folder.
+                    let mut nested: Vec<_> = std::fs::read_dir(&path).unwrap().map(|e| e.unwrap().path()).collect();
+                    nested.sort();
+                    files.insert(stem, nested.iter().map(|p| code(p)).collect::<Vec<_>>().join("\n"));
                 }
             }
         }

@@ -1,0 +1,62 @@
+//! The mass matrix at one state as the laws see it: whichever kind the model has.
+
+use super::{BlockMass, DenseMass, DiagonalMass, MassMatrix};
+
+/// The mass matrix at one state: constant diagonal, or `M(q)` evaluated
+/// there. Each product matches once, outside its loops, so the diagonal
+/// kind runs its own loops unchanged.
+#[derive(Debug, Clone, Copy)]
+pub enum MassAt<'a> {
+    /// A constant diagonal `M`.
+    Diagonal(&'a DiagonalMass),
+    /// `M(q)` at the state of the last evaluation.
+    Dense(&'a DenseMass),
+    /// A block-diagonal `M(q)` at the state of the last evaluation.
+    Blocks(&'a BlockMass),
+}
+
+/// Forwards each product to the kind at hand.
+macro_rules! either {
+    ($self:ident, $m:ident => $e:expr) => {
+        match $self {
+            MassAt::Diagonal($m) => $e,
+            MassAt::Dense($m) => $e,
+            MassAt::Blocks($m) => $e,
+        }
+    };
+}
+
+impl MassMatrix for MassAt<'_> {
+    #[inline(always)]
+    fn n(&self) -> usize {
+        either!(self, m => m.n())
+    }
+    #[inline(always)]
+    fn mul(&self, x: &[f64], out: &mut [f64]) {
+        either!(self, m => m.mul(x, out))
+    }
+    #[inline(always)]
+    fn solve(&self, x: &[f64], out: &mut [f64]) {
+        either!(self, m => m.solve(x, out))
+    }
+    #[inline(always)]
+    fn kinetic(&self, v: &[f64]) -> f64 {
+        either!(self, m => m.kinetic(v))
+    }
+    #[inline(always)]
+    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
+        either!(self, m => m.psi_v_norm2(v))
+    }
+    #[inline(always)]
+    fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
+        either!(self, m => m.psi_v_dot(v, x, extra, init))
+    }
+    #[inline(always)]
+    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        either!(self, m => m.add_psi_v(v, scale, out))
+    }
+    #[inline(always)]
+    fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
+        either!(self, m => m.add_inverse_psi_v(v, scale, out))
+    }
+}
