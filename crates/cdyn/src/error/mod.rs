@@ -1,0 +1,217 @@
+//! The library's one error type. Every variant says where (step, time,
+//! constraint row, the part of a model) and what, as data, so a caller can
+//! print a one-line message or name the entry of its own input at fault.
+
+use thiserror::Error;
+
+mod keys;
+mod part;
+mod problem;
+
+pub use keys::KeyProblem;
+pub use part::Part;
+pub use problem::Problem;
+
+/// Everything that can go wrong while building a model or simulating it.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A setting or parameter outside its domain.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// The parameter's name as the caller wrote it (`h`, `rod_length`).
+        name: &'static str,
+        /// The refused value.
+        value: f64,
+        /// Why it was refused, e.g. "must be finite and positive".
+        reason: &'static str,
+    },
+    /// A model that cannot be simulated as described.
+    #[error("invalid model: {at}{problem}")]
+    InvalidModel {
+        /// The part of the model at fault.
+        at: Part,
+        /// What is wrong with it.
+        problem: Problem,
+    },
+    /// The initial state is off the constraints by more than the tolerance.
+    #[error(
+        "initial state violates the constraints: max |Φ| = {phi:.3e}, max |Φ̇| = {phi_dot:.3e} (tolerance {tolerance:.1e})"
+    )]
+    InconsistentInitialState {
+        /// Largest constraint violation.
+        phi: f64,
+        /// Largest velocity-constraint violation.
+        phi_dot: f64,
+        /// The tolerance it exceeds.
+        tolerance: f64,
+    },
+    /// `Φ_q M⁻¹ Φ_qᵀ` is singular: the constraints are redundant or degenerate here.
+    #[error(
+        "singular constraint matrix at step {step}, t = {}: constraint row {row} is linearly dependent on the others (if the constraints are redundant, set dependent_rows = \"tolerate\")", Time(*t)
+    )]
+    SingularConstraints {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+        /// The dependent constraint row.
+        row: usize,
+    },
+    /// The mass matrix `M(q)` of kinetic-energy elements is not positive definite at the state.
+    #[error(
+        "mass matrix M(q) not positive definite at step {step}, t = {}: coordinate {coordinate} has no inertia there", Time(*t)
+    )]
+    MassNotPositive {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+        /// The coordinate whose pivot failed.
+        coordinate: usize,
+    },
+    /// The state stopped being finite.
+    #[error("simulation diverged at step {step}, t = {}: the state is no longer finite", Time(*t))]
+    Diverged {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+    },
+    /// The constraint violation grew past the configured limit.
+    #[error(
+        "simulation diverged at step {step}, t = {}: max |Φ| = {phi:.3e} exceeds the limit {limit:.1e}",
+        Time(*t)
+    )]
+    ViolationLimit {
+        /// Steps taken before the failure.
+        step: u64,
+        /// Time of the failure.
+        t: f64,
+        /// The violation reached.
+        phi: f64,
+        /// The configured limit.
+        limit: f64,
+    },
+    /// The exact projection (the `projection` method) did not converge.
+    #[error(
+        "projection did not converge at step {step}, t = {}: {invariant} = {residual:.3e}{} after {iterations} Newton iterations (raise max_iterations or tolerance, or set on_failure = \"continue\")",
+        Time(*t),
+        row.map_or(String::new(), |r| format!(" in constraint row {r}"))
+    )]
+    ProjectionFailed {
+        /// Steps taken, including the one whose result could not be projected.
+        step: u64,
+        /// Time of the state that could not be projected.
+        t: f64,
+        /// `|Φ|` or `|Ψ|`.
+        invariant: &'static str,
+        /// The worst violation left.
+        residual: f64,
+        /// The worst constraint row, for `|Φ|`.
+        row: Option<usize>,
+        /// Newton iterations taken.
+        iterations: u32,
+    },
+    /// Method keys that do not describe one method.
+    #[error("{0}")]
+    Method(#[from] KeyProblem),
+    /// A combination of settings this kind of simulation does not offer.
+    #[error("{0}")]
+    Unsupported(&'static str),
+    /// The pendulum's energy lies within a relative 1e-10 of the upright
+    /// energy: the period diverges and the elliptic closed form of the
+    /// reference solution degenerates.
+    #[error("pendulum energy lies on the separatrix (just reaches the top); no elliptic closed form")]
+    Separatrix,
+}
+
+impl Error {
+    /// The constraint row a simulation error is about, if any.
+    pub fn row(&self) -> Option<usize> {
+        match self {
+            Error::SingularConstraints { row, .. } => Some(*row),
+            Error::InvalidModel { problem: Problem::SingularAssembly { row, .. }, .. } => Some(*row),
+            Error::ProjectionFailed { row, .. } => *row,
+            _ => None,
+        }
+    }
+
+    /// The same error, said of `part`: a refused parameter becomes an
+    /// [`Error::InvalidModel`] at `part`; an invalid model error of the whole
+    /// model is moved to `part`; other errors are kept.
+    pub fn at(self, part: Part) -> Error {
+        match self {
+            Error::InvalidParameter { name, value, reason } => {
+                Error::InvalidModel { at: part, problem: Problem::Parameter { name, value, reason } }
+            }
+            Error::InvalidModel { at: Part::Model, problem } => Error::InvalidModel { at: part, problem },
+            other => other,
+        }
+    }
+}
+
+impl From<Problem> for Error {
+    /// A problem of the whole model.
+    fn from(problem: Problem) -> Self {
+        Error::InvalidModel { at: Part::Model, problem }
+    }
+}
+
+/// A time as people write it: `step · h` rounded to 12 significant digits
+/// (`0.3`, not the `0.30000000000000004` of `3 × 0.1`), far below any step.
+pub fn tidy_time(t: f64) -> f64 {
+    format!("{t:.11e}").parse().unwrap_or(t)
+}
+
+/// A time in a message: [`tidy_time`], in plain decimals between 1e-4 and
+/// 1e9 and with an exponent outside (not 309 digits for 1e308).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Time(pub f64);
+
+impl std::fmt::Display for Time {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = tidy_time(self.0);
+        if t == 0.0 || (1e-4..1e9).contains(&t.abs()) { write!(f, "{t}") } else { write!(f, "{t:e}") }
+    }
+}
+
+/// The library's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Checks that `value` is finite; names it otherwise.
+pub fn finite(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() { Ok(value) } else { Err(Error::InvalidParameter { name, value, reason: "must be finite" }) }
+}
+
+/// Checks that `value` is finite and positive; names it otherwise.
+pub fn positive(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter { name, value, reason: "must be finite and positive" })
+    }
+}
+
+/// Checks that `value` is finite and not negative; names it otherwise.
+pub fn non_negative(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter { name, value, reason: "must be finite and not negative" })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_print_as_written() {
+        assert_eq!(Time(3.0 * 0.1).to_string(), "0.3");
+        assert_eq!(Time(1e308).to_string(), "1e308");
+        assert_eq!(Time(2.5e-6).to_string(), "2.5e-6");
+        assert_eq!(Time(0.0).to_string(), "0");
+        assert_eq!(Time(4766.0 * 0.001).to_string(), "4.766");
+    }
+}
