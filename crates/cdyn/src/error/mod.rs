@@ -1,6 +1,10 @@
 //! The library's one error type. Every variant says where (step, time,
 //! constraint row, the part of a model) and what, as data, so a caller can
 //! print a one-line message or name the entry of its own input at fault.
+//! The parts of a model ([`Part`]), their problems ([`Problem`]) and the
+//! method-key combinations refused ([`KeyProblem`]) have files of their own.
+//!
+//! May import: nothing of the crate.
 
 use thiserror::Error;
 

@@ -1,6 +1,6 @@
 //! Which part of a model an error is about.
 
-/// The part of a model an [`Error::InvalidModel`] is about.
+/// The part of a model an [`Error::InvalidModel`](super::Error::InvalidModel) is about.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Part {
