@@ -12,6 +12,8 @@ pub mod diagnostics;
 pub mod energy;
 pub(crate) mod manifold;
 pub mod momentum;
+mod solver;
 mod uncontrolled;
 
+pub use solver::BLOCKS_FROM;
 pub use uncontrolled::*;
