@@ -15,14 +15,18 @@ use crate::case::runner::Case;
 use crate::case::scenario::{self, Scenario};
 use crate::study::compare;
 use anyhow::{Context, Result, anyhow};
-use cdyn::json_float::JsonFloat;
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
 use cdyn::{Control, Scheme, Simulation};
 use rayon::prelude::*;
 use serde::Serialize;
-use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+mod output;
+mod verdicts;
+
+pub use output::{summary, table, write};
+use verdicts::verdicts;
 
 /// The schemes every model runs at.
 const SCHEMES: [Scheme; 3] = [Scheme::AdamsBashforth3, Scheme::RungeKutta4, Scheme::AdamsBashforthMoulton4];
@@ -363,194 +367,4 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
         run.projection_iterations_per_step = Some(sim.projection_iterations() as f64 / sim.steps().max(1) as f64);
     }
     run
-}
-
-/// The checks of [`CHECKS`] on one group. A robust run that stopped fails
-/// every check that applies.
-fn verdicts(runs: &[Run], none: usize, robust: usize, projection: usize, free_motion: bool) -> Vec<Verdict> {
-    let (none, robust, projection) = (&runs[none], &runs[robust], &runs[projection]);
-    let ok = robust.error.is_none();
-    let (r, n, p) = (robust.max_error, none.max_error, projection.max_error);
-    let verdict =
-        |applies: bool, pass: bool, numbers: String| Verdict { applies, pass: !applies || ok && pass, numbers };
-    let phi = none.max_abs_phi > 1e-8;
-    // Ψ is not robust's to hold where its energy term was left out.
-    let psi = free_motion && !robust.energy_left_out && none.max_abs_psi > 1e-8;
-    vec![
-        verdict(true, r <= 2.0 * p, format!("robust {r:.3e}, projection {p:.3e}")),
-        verdict(p <= n, r <= n, format!("robust {r:.3e}, none {n:.3e}, projection {p:.3e}")),
-        verdict(n > 1e-4, r <= n / 10.0, format!("robust {r:.3e}, none {n:.3e}")),
-        verdict(
-            phi || psi,
-            (!phi || robust.max_abs_phi <= none.max_abs_phi / 10.0)
-                && (!psi || robust.max_abs_psi <= none.max_abs_psi / 10.0),
-            format!(
-                "max|phi| robust {:.3e}, none {:.3e}; max|psi| robust {:.3e}, none {:.3e}",
-                robust.max_abs_phi, none.max_abs_phi, robust.max_abs_psi, none.max_abs_psi
-            ),
-        ),
-        {
-            let worst =
-                runs.iter().filter(|r| r.error.is_none()).filter_map(|r| r.linear_momentum_drift.map(|d| (d, r)));
-            let worst = worst.max_by(|a, b| a.0.total_cmp(&b.0));
-            let numbers = worst.map_or(String::new(), |(d, r)| format!("largest {d:.3e} of its scale ({})", r.method));
-            let applies = none.linear_momentum_drift.is_some();
-            verdict(applies, worst.is_none_or(|(d, _)| d <= cdyn::dynamics::momentum::ROUND_OFF), numbers)
-        },
-        match (robust.momentum_drift, none.momentum_drift) {
-            (Some(r), Some(n)) => verdict(
-                true,
-                r <= n.max(cdyn::dynamics::momentum::ROUND_OFF),
-                format!("robust {r:.3e}, none {n:.3e} of the scale"),
-            ),
-            _ => verdict(false, true, String::new()),
-        },
-    ]
-}
-
-impl Group {
-    /// `model scheme h=…`, how the summary names the group.
-    pub fn label(&self) -> String {
-        format!("{} {} h={}", self.model, self.scheme, self.h)
-    }
-
-    fn json(&self) -> serde_json::Value {
-        let flags = |f: fn(&Verdict) -> bool| -> serde_json::Map<String, serde_json::Value> {
-            CHECKS.iter().zip(&self.verdicts).map(|((k, _), v)| (k.to_string(), f(v).into())).collect()
-        };
-        let numbers: serde_json::Map<_, _> =
-            CHECKS.iter().zip(&self.verdicts).map(|((k, _), v)| (k.to_string(), v.numbers.clone().into())).collect();
-        json!({
-            "model": self.model,
-            "file": self.file,
-            "scheme": self.scheme,
-            "h": JsonFloat(self.h),
-            "t_end": JsonFloat(self.t_end),
-            "sample_interval": JsonFloat(self.sample_interval),
-            "reference_h": JsonFloat(self.reference_h),
-            "baseline": self.baseline,
-            "free_motion": self.free_motion,
-            "runs": self.runs,
-            "checks": flags(|v| v.pass),
-            "applies": flags(|v| v.applies),
-            "compared": numbers,
-        })
-    }
-}
-
-impl Suite {
-    /// For each check: groups where it applies, and where it passed among those.
-    fn counts(&self) -> Vec<(usize, usize)> {
-        (0..CHECKS.len())
-            .map(|i| {
-                let applies = self.groups.iter().filter(|g| g.verdicts[i].applies);
-                (applies.clone().count(), applies.filter(|g| g.verdicts[i].pass).count())
-            })
-            .collect()
-    }
-
-    /// Every failed check: `model scheme h=… (a): numbers`.
-    pub fn misses(&self) -> Vec<String> {
-        let mut out = Vec::new();
-        for g in &self.groups {
-            for ((k, _), v) in CHECKS.iter().zip(&g.verdicts) {
-                if !v.pass {
-                    out.push(format!("{} ({k}): {}", g.label(), v.numbers));
-                }
-            }
-        }
-        out
-    }
-
-    /// `suite.json`: every run's numbers, the checks per group, and their counts.
-    pub fn json(&self) -> serde_json::Value {
-        let counts: serde_json::Map<_, _> = CHECKS
-            .iter()
-            .zip(self.counts())
-            .map(|((k, text), (applies, pass))| {
-                (k.to_string(), json!({ "check": text, "applies": applies, "pass": pass }))
-            })
-            .collect();
-        json!({
-            "light": self.light,
-            "error_metric": "max over t = k*sample_interval of max_i |q_i - q_ref,i| (positions); inf if the run stopped",
-            "reference": "the model without control, rk4, step reference_h = sample_interval / 20",
-            "violations": "max over every step after t = 0; runs[].initial = [|phi|, |phi_dot|, |psi|] at t = 0",
-            "cases": self.groups.iter().map(Group::json).collect::<Vec<_>>(),
-            "summary": { "groups": self.groups.len(), "checks": counts, "misses": self.misses() },
-        })
-    }
-}
-
-/// Writes `dir/suite.json`, whole or not at all (the figure is
-/// [`crate::render::suite_plot::write`]'s, which reads this module's types).
-pub fn write(suite: &Suite, dir: &Path) -> Result<()> {
-    let text = serde_json::to_string_pretty(&suite.json())? + "\n";
-    crate::io::output::write(&dir.join("suite.json"), text.as_bytes())
-}
-
-/// A number for the table: scientific, `inf` or `-`.
-fn num(x: f64) -> String {
-    if x.is_nan() { "-".into() } else { format!("{x:.2e}") }
-}
-
-/// The table: a row per model, scheme, step and method; the checks under each group.
-pub fn table(suite: &Suite) -> String {
-    let mut out = format!(
-        "{:<24} {:<4} {:>8} {:<22} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
-        "model", "", "h", "method", "max err", "/none", "/proj", "max|phi|", "max|psi|"
-    );
-    for g in &suite.groups {
-        for r in &g.runs {
-            out += &format!(
-                "{:<24} {:<4} {:>8} {:<22} {:>9} {:>9} {:>9} {:>9} {:>9}{}\n",
-                g.model,
-                g.scheme,
-                g.h,
-                r.method,
-                num(r.max_error),
-                num(r.error_vs_none),
-                num(r.error_vs_projection),
-                num(r.max_abs_phi),
-                num(r.max_abs_psi),
-                r.error.as_ref().map_or(String::new(), |e| format!("  stopped: {e}")),
-            );
-        }
-        let marks: Vec<String> = CHECKS
-            .iter()
-            .zip(&g.verdicts)
-            .map(|((k, _), v)| {
-                format!(
-                    "{k} {}",
-                    if !v.applies {
-                        "n/a"
-                    } else if v.pass {
-                        "ok"
-                    } else {
-                        "MISS"
-                    }
-                )
-            })
-            .collect();
-        out += &format!("{:<24} checks: {}\n\n", "", marks.join(", "));
-    }
-    out
-}
-
-/// How many groups pass each check, and the misses.
-pub fn summary(suite: &Suite) -> String {
-    let mut out = format!("checks over {} (model, scheme, h):\n", suite.groups.len());
-    for ((k, text), (applies, pass)) in CHECKS.iter().zip(suite.counts()) {
-        out += &format!("  {k}) {text}: {pass} of {applies} pass");
-        if applies < suite.groups.len() {
-            out += &format!(" ({} where it does not apply)", suite.groups.len() - applies);
-        }
-        out += "\n";
-    }
-    let misses = suite.misses();
-    out += &format!("misses: {}\n", misses.len());
-    for m in misses {
-        out += &format!("  {m}\n");
-    }
-    out
 }
