@@ -1,0 +1,76 @@
+//! The table `cdyn bench` prints.
+
+use super::*;
+
+/// The table printed on the terminal.
+pub fn table(r: &Report) -> String {
+    let e = &r.example1;
+    let mut out = format!(
+        "Example 1, cvsgf_energy, AB-3 ({} runs of {} steps, best of {}):\n",
+        e.runs_per_trial, e.steps_per_run, e.trials
+    );
+    out += &format!("  cdyn (SmallSystem)   {:>8.1} ns/step  overhead {:.2}×\n", e.cdyn_ns_per_step, e.overhead_ratio);
+    out += &format!(
+        "  cdyn (general Model) {:>8.1} ns/step  overhead {:.2}×\n",
+        e.general_ns_per_step, e.general_overhead_ratio
+    );
+    out += &format!("  hand-written         {:>8.1} ns/step\n", e.handwritten_ns_per_step);
+    for (title, runs, exponent) in [
+        ("N-link chain", &r.chain, r.chain_cost_exponent),
+        ("spatial chain (rods in Euler parameters, spherical joints)", &r.spatial_chain, r.spatial_chain_cost_exponent),
+    ] {
+        out += &format!("{title}, CVSGF + energy, AB-3, h = 1e-3:\n");
+        out += &format!("  {:>6} {:>8} {:>12} {:>12} {:>8}\n", "N", "steps", "µs/step", "max|Φ|", "solver");
+        for c in runs {
+            out += &format!(
+                "  {:>6} {:>8} {:>12.2} {:>12.3e} {:>8}\n",
+                c.n, c.steps, c.us_per_step, c.max_abs_phi, c.solver
+            );
+        }
+        if let Some(p) = exponent {
+            out += &format!("  cost exponent (N ≥ 100): {p:.3}\n");
+        }
+    }
+    if let Some(b) = r.spatial_handwritten.first() {
+        out += &format!(
+            "spatial chain, cdyn against hand-written (fresh runs of the steps shown, best of {} interleaved trials):\n",
+            b.trials
+        );
+        out += &format!("  {:>6} {:>8} {:>12} {:>14} {:>9}\n", "N", "steps", "cdyn µs", "hand µs", "ratio");
+        for b in &r.spatial_handwritten {
+            out += &format!(
+                "  {:>6} {:>8} {:>12.2} {:>14.2} {:>8.2}×\n",
+                b.n, b.steps_per_run, b.cdyn_us_per_step, b.handwritten_us_per_step, b.overhead_ratio
+            );
+        }
+    }
+    if let Some(m) = r.methods.first() {
+        out += &format!(
+            "Methods, AB-3 (median of {} interleaved trials; ratio to cvsgf_energy within a trial, median):\n",
+            m.trials
+        );
+    }
+    out += &format!(
+        "  {:>8} {:>6} {:>7} {:>8} {:>13} {:>12} {:>7} {:>10} {:>10}\n",
+        "model", "N", "h", "steps", "method", "µs/step", "ratio", "iter/step", "max|Φ|"
+    );
+    for m in &r.methods {
+        for c in &m.methods {
+            let iterations = c.projection_iterations_per_step.map_or("-".into(), |i| format!("{i:.3}"));
+            out += &format!(
+                "  {:>8} {:>6} {:>7} {:>8} {:>13} {:>12.3} {:>6.2}× {:>10} {:>10.2e}\n",
+                m.model,
+                m.n,
+                m.h,
+                m.steps_per_run * m.runs_per_trial,
+                c.method,
+                c.us_per_step,
+                c.ratio_to_cvsgf_energy,
+                iterations,
+                c.max_abs_phi
+            );
+        }
+    }
+    out += &format!("allocations per step (max): {}\n", r.max_allocations_per_step);
+    out
+}
