@@ -102,22 +102,40 @@ pub(crate) trait ConstraintBlock: Send + Sync {
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
+/// The methods of [`ConstraintBlock`] that every group of `R`-row
+/// elements on `K` coordinates (`items`) has alike, holonomic or not; the
+/// caller's `local` differentiates one element.
+macro_rules! group_layout {
+    () => {
+        fn rows(&self) -> usize {
+            self.items.len() * R
+        }
+
+        fn width(&self) -> usize {
+            K
+        }
+
+        fn columns(&self, out: &mut Vec<u32>) {
+            columns_of::<_, K, R>(&self.items, out);
+        }
+
+        fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
+            evaluate_items(&self.items, q, v, t, out, local);
+        }
+
+        fn as_any_mut(&mut self) -> &mut dyn Any {
+            self
+        }
+    };
+}
+pub(crate) use group_layout;
+
 pub(crate) struct ConstraintGroup<C, const K: usize, const R: usize> {
     pub items: Vec<(C, [usize; K])>,
 }
 
 impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for ConstraintGroup<C, K, R> {
-    fn rows(&self) -> usize {
-        self.items.len() * R
-    }
-
-    fn width(&self) -> usize {
-        K
-    }
-
-    fn columns(&self, out: &mut Vec<u32>) {
-        columns_of::<_, K, R>(&self.items, out);
-    }
+    group_layout!();
 
     fn reads(&self, out: &mut Vec<bool>) {
         for (c, _) in &self.items {
@@ -125,19 +143,11 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
         }
     }
 
-    fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
-        evaluate_items(&self.items, q, v, t, out, local);
-    }
-
     fn values(&self, q: &[f64], t: f64, phi: &mut [f64]) {
         for (e, (c, idx)) in self.items.iter().enumerate() {
             let rows = c.eval(std::array::from_fn(|j| q[idx[j]]), t);
             phi[e * R..(e + 1) * R].copy_from_slice(&rows);
         }
-    }
-
-    fn as_any_mut(&mut self) -> &mut dyn Any {
-        self
     }
 }
 

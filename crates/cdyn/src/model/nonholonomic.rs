@@ -36,7 +36,7 @@
 //!   rows too; they only make it more cautious (larger `μ_max`).
 
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::{ConstraintBlock, ConstraintValues, Local, columns_of, evaluate_items};
+use crate::model::constraint::{ConstraintBlock, ConstraintValues, Local, columns_of, evaluate_items, group_layout};
 use num_dual::Dual64;
 use std::any::Any;
 
@@ -82,29 +82,11 @@ pub(crate) struct NonholonomicGroup<C, const K: usize, const R: usize> {
 }
 
 impl<C: Nonholonomic<K, R>, const K: usize, const R: usize> ConstraintBlock for NonholonomicGroup<C, K, R> {
-    fn rows(&self) -> usize {
-        self.items.len() * R
-    }
-
-    fn width(&self) -> usize {
-        K
-    }
-
-    fn columns(&self, out: &mut Vec<u32>) {
-        columns_of::<_, K, R>(&self.items, out);
-    }
-
-    fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
-        evaluate_items(&self.items, q, v, t, out, local);
-    }
+    group_layout!();
 
     /// Nonholonomic rows have no position-level value.
     fn values(&self, _q: &[f64], _t: f64, phi: &mut [f64]) {
         phi.fill(0.0);
-    }
-
-    fn as_any_mut(&mut self) -> &mut dyn Any {
-        self
     }
 }
 
