@@ -28,6 +28,15 @@ pub enum Scheme {
     /// that starts the next step: two evaluations a step, half of RK-4's,
     /// with an error constant about 19/270 of AB-4's (RK-4 start-up).
     AdamsBashforthMoulton4,
+    /// RATTLE: velocity Verlet with constraint forces, order 2, one
+    /// evaluation a step; `Φ = 0` and `Φ̇ = 0` hold to round-off after every
+    /// step, and with a constant `M` and conservative forces the energy
+    /// stays in a bounded band for all time (symplectic). It steps the
+    /// positions and velocities apart, so it needs the model's constraints,
+    /// not a right-hand side: a [`Simulation`](crate::simulate::Simulation)
+    /// takes it ([`crate::simulate::rattle`]), with no control law in the
+    /// right-hand side (`projection` may follow it).
+    Rattle,
 }
 
 /// Where the control term is integrated (Eqs. 54–59). Scenario files write
@@ -69,6 +78,9 @@ pub enum Formula {
         /// Corrector weights: `F*`'s, then the past evaluations', newest first.
         corrector: &'static [f64],
     },
+    /// Velocity Verlet with constraint forces ([`Scheme::Rattle`]): not a
+    /// combination of right-hand sides, stepped by the simulation itself.
+    Rattle,
     /// An explicit Butcher tableau: `a` is strictly lower-triangular, row by row.
     RungeKutta {
         /// Stage coefficients `a_ij`, one row per stage.
@@ -83,7 +95,7 @@ pub enum Formula {
 /// Everything that distinguishes one scheme from another.
 #[derive(Debug, Clone, Copy)]
 pub struct SchemeInfo {
-    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`, `abm4`.
+    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`.
     pub name: &'static str,
     /// Order of accuracy.
     pub order: u32,
@@ -103,7 +115,18 @@ const RK4_C: &[f64] = &[0.0, 0.5, 0.5, 1.0];
 
 impl Scheme {
     /// Every scheme.
-    pub const ALL: [Scheme; 5] = [
+    pub const ALL: [Scheme; 6] = [
+        Scheme::Euler,
+        Scheme::AdamsBashforth2,
+        Scheme::AdamsBashforth3,
+        Scheme::RungeKutta4,
+        Scheme::AdamsBashforthMoulton4,
+        Scheme::Rattle,
+    ];
+
+    /// The schemes that step any right-hand side `ẋ = f + U` with an
+    /// [`Integrator`], under every control law: all but RATTLE.
+    pub const GENERAL: [Scheme; 5] = [
         Scheme::Euler,
         Scheme::AdamsBashforth2,
         Scheme::AdamsBashforth3,
@@ -157,10 +180,18 @@ impl Scheme {
                     corrector: &[9.0 / 24.0, 19.0 / 24.0, -5.0 / 24.0, 1.0 / 24.0],
                 },
             },
+            Scheme::Rattle => SchemeInfo {
+                name: "rattle",
+                order: 2,
+                evaluations: 1,
+                history: 1,
+                startup: None,
+                formula: Formula::Rattle,
+            },
         }
     }
 
-    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`, `abm4`).
+    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`).
     pub fn from_name(name: &str) -> Option<Scheme> {
         Scheme::ALL.into_iter().find(|s| s.info().name == name)
     }
@@ -252,7 +283,7 @@ impl<B: Buffer> Integrator<B> {
             .map(|s| match s.info().formula {
                 Formula::RungeKutta { b, .. } => b.len(),
                 // The evaluation at the predicted state.
-                Formula::Multistep(_) | Formula::PredictorCorrector { .. } => 1,
+                Formula::Multistep(_) | Formula::PredictorCorrector { .. } | Formula::Rattle => 1,
             })
             .max()
             .unwrap_or(1);
@@ -283,6 +314,11 @@ impl<B: Buffer> Integrator<B> {
     }
 
     /// Advances `x` from `t` to `t + h`.
+    ///
+    /// # Panics
+    ///
+    /// For [`Scheme::Rattle`], which steps a model, not a right-hand side
+    /// (a [`Simulation`](crate::simulate::Simulation) takes it).
     #[inline]
     pub fn step<R: Rhs>(&mut self, rhs: &mut R, x: &mut [f64], t: f64, h: f64) -> Result<(), R::Error> {
         let active = self.active_scheme().info();
@@ -322,6 +358,7 @@ impl<B: Buffer> Integrator<B> {
                 let f = [self.stages[0].as_slice(), past(0), past(1), past(2)];
                 accumulate(x, h, corrector, f);
             }
+            Formula::Rattle => panic!("RATTLE steps a model's positions and velocities, not a right-hand side"),
             Formula::RungeKutta { a, b, c } => {
                 self.stages[0].as_mut_slice().copy_from_slice(self.history[self.newest].as_slice());
                 for i in 1..b.len() {

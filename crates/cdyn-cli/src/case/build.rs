@@ -6,7 +6,7 @@ use crate::case::runner::Case;
 use crate::case::scenario::{GravitySpec, InvariantSpec, Scenario, SpatialEntries, read_bounded};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
-use cdyn::Settings;
+use cdyn::{Scheme, Settings};
 use cdyn::control::methods::{MethodKeys, Preset};
 use cdyn::dynamics::assemble::assemble_with;
 use cdyn::error::{Part, positive};
@@ -41,9 +41,14 @@ impl Scenario {
         Ok(())
     }
 
-    /// The method as written, or the `robust` preset when there is no `[method]`.
+    /// The method as written; without `[method]`, the `robust` preset, or
+    /// no control for `rattle`, which holds the constraints itself.
     pub fn method(&self) -> MethodKeys {
-        self.method.clone().unwrap_or(MethodKeys { preset: Some(Preset::Robust), ..MethodKeys::default() })
+        let default = match self.integrator.scheme {
+            Scheme::Rattle => MethodKeys::default(),
+            _ => MethodKeys { preset: Some(Preset::Robust), ..MethodKeys::default() },
+        };
+        self.method.clone().unwrap_or(default)
     }
 
     /// The case this scenario describes; `path` names it in errors.

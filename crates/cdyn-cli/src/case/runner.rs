@@ -130,6 +130,8 @@ pub struct CaseResult {
     pub tuning: Option<cdyn::control::gains::Tuning>,
     /// Mean Newton iterations per step of the `projection` method.
     pub projection_iterations_per_step: Option<f64>,
+    /// Mean iterations per step of RATTLE's position step (`scheme = "rattle"`).
+    pub rattle_iterations_per_step: Option<f64>,
     /// Steps in which constraint rows were dropped as dependent
     /// (`dependent_rows = "tolerate"`): the most rows at once, how many
     /// steps, the first and last; `null` if none were.
@@ -150,6 +152,7 @@ struct Method {
     control: Option<cdyn::Control>,
     tuning: Option<cdyn::control::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
+    rattle_iterations_per_step: Option<f64>,
     frames: Frames,
     rank_loss: Option<RankLoss>,
 }
@@ -173,6 +176,7 @@ impl CaseResult {
             control: method.control,
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
+            rattle_iterations_per_step: method.rattle_iterations_per_step,
             dependent_rows: method.rank_loss,
             interrupted: method.interrupted,
             frames: method.frames,
@@ -332,6 +336,8 @@ fn simulate<K: Sink>(
                     .projection
                     .is_some()
                     .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
+                rattle_iterations_per_step: (case.settings.scheme == cdyn::Scheme::Rattle)
+                    .then(|| sim.rattle_iterations() as f64 / sim.steps().max(1) as f64),
                 frames,
                 rank_loss: sim.rank_loss().copied(),
             };

@@ -1,10 +1,13 @@
 //! `cdyn compare`: one model under every stabilization method of the
 //! paper's test, with the scenario's gains or target rates, then the
-//! `robust` preset and exact `projection`.
+//! `robust` preset and exact `projection`. RATTLE holds the constraints
+//! itself and takes no control law in the right-hand side: with it, the
+//! comparison is no control against `projection`.
 
 use crate::case::runner::Case;
 use crate::case::scenario::Scenario;
 use anyhow::Result;
+use cdyn::Scheme;
 use cdyn::control::methods::compare_cases;
 use std::path::Path;
 
@@ -20,8 +23,10 @@ pub fn cases(scenario: &Scenario, path: &Path) -> Result<Vec<Case>> {
         .map_err(|e| anyhow::anyhow!("{file}: [method] {e}"))?;
     // A model without constraints has nothing for geometric control to do.
     let methods = compare_cases(&gains, base.example.model.m() > 0);
+    let rattle = base.settings.scheme == Scheme::Rattle;
     methods
         .into_iter()
+        .filter(|(_, control)| !(rattle && control.is_active()))
         .map(|(name, control)| {
             let mut case = scenario.case(path)?;
             case.name = name.to_string();

@@ -117,6 +117,23 @@ pub enum Error {
         /// Newton iterations taken.
         iterations: u32,
     },
+    /// RATTLE's position step did not bring the constraints back to `Φ = 0`.
+    #[error(
+        "RATTLE's position step did not converge at step {step}, t = {}: |Φ| = {residual:.3e} in constraint row {row} after {iterations} iterations (take a smaller h)",
+        Time(*t)
+    )]
+    RattleFailed {
+        /// Steps taken, including the one that failed.
+        step: u64,
+        /// Time the step was to reach.
+        t: f64,
+        /// The worst violation left.
+        residual: f64,
+        /// The worst constraint row.
+        row: usize,
+        /// Iterations taken.
+        iterations: u32,
+    },
     /// Method keys that do not describe one method.
     #[error("{0}")]
     Method(#[from] KeyProblem),
@@ -137,6 +154,7 @@ impl Error {
             Error::SingularConstraints { row, .. } => Some(*row),
             Error::InvalidModel { problem: Problem::SingularAssembly { row, .. }, .. } => Some(*row),
             Error::ProjectionFailed { row, .. } => *row,
+            Error::RattleFailed { row, .. } => Some(*row),
             _ => None,
         }
     }

@@ -1,10 +1,11 @@
 //! Running a model: the controlled state equation `ẋ = f(x, t) + U(x, t)`
-//! ([`system`]), and the loop that steps it from a consistent initial state
+//! ([`system`]), RATTLE's step of a model ([`rattle`]), and the loop that steps it from a consistent initial state
 //! with observers every `k` steps ([`Simulation`], [`Settings`]).
 //!
 //! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `integrate`,
 //! `control`.
 
+pub mod rattle;
 mod stepper;
 pub mod system;
 

@@ -13,7 +13,7 @@ use crate::dynamics::{DependentRows, LinearSolver};
 use crate::error::{Error, Part, Problem, Result, positive};
 use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
-use crate::simulate::system::{ControlledSystem, EvalError, System};
+use crate::simulate::system::{ControlledSystem, EvalError, RattleFailure, System};
 
 /// How to simulate: [`Settings::new`] and the `with_*` setters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,6 +100,8 @@ pub struct Stepper<S: System> {
     projection_failures: u64,
     /// Steps with dependent constraint rows, if any.
     rank_loss: Option<RankLoss>,
+    /// Iterations of RATTLE's position step so far.
+    rattle_iterations: u64,
 }
 
 /// When the constraints lost rank during a run with
@@ -155,6 +157,18 @@ pub(crate) fn check_initial_state(n: usize, q0: &[f64], v0: &[f64]) -> Result<()
 impl<S: System> Stepper<S> {
     /// Starts `system` at `t = 0` from a checked `(q0, v0)` with valid `settings`.
     pub(crate) fn start(mut system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        if settings.scheme == Scheme::Rattle {
+            if !system.offers_rattle() {
+                return Err(Error::Unsupported(
+                    "scheme rattle steps a general model (Simulation), not a SmallSimulation",
+                ));
+            }
+            if settings.control.is_active() {
+                return Err(Error::Unsupported(
+                    "scheme rattle holds Φ = 0 and Φ̇ = 0 itself: use no control law (method none), or projection to hold the energy as well",
+                ));
+            }
+        }
         let n = q0.len();
         let mut x = system.zero_state();
         x.as_mut_slice()[..n].copy_from_slice(q0);
@@ -190,6 +204,7 @@ impl<S: System> Stepper<S> {
             projection_iterations: 0,
             projection_failures: 0,
             rank_loss: None,
+            rattle_iterations: 0,
         })
     }
 
@@ -205,6 +220,10 @@ impl<S: System> Stepper<S> {
     /// Steps whose projection did not converge (with `on_failure = continue`).
     pub fn projection_failures(&self) -> u64 {
         self.projection_failures
+    }
+    /// Iterations of RATTLE's position step so far ([`Scheme::Rattle`]).
+    pub fn rattle_iterations(&self) -> u64 {
+        self.rattle_iterations
     }
     /// Steps in which the constraints lost rank so far; `None` if none did.
     pub fn rank_loss(&self) -> Option<&RankLoss> {
@@ -268,7 +287,17 @@ impl<S: System> Stepper<S> {
         let t = self.t();
         let step = self.step;
         let h = self.settings.h;
-        self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
+        if self.settings.scheme == Scheme::Rattle {
+            match self.system.rattle(self.x.as_mut_slice(), t, h) {
+                Ok(iterations) => self.rattle_iterations += u64::from(iterations),
+                Err(RattleFailure::Eval(e)) => return Err(eval_error(e, step, t + h)),
+                Err(RattleFailure::Positions { row, residual, iterations }) => {
+                    return Err(Error::RattleFailed { step: step + 1, t: t + h, residual, row, iterations });
+                }
+            }
+        } else {
+            self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
+        }
         self.step += 1;
         let dropped = match self.settings.dependent_rows {
             DependentRows::Error => 0,

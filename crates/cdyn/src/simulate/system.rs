@@ -13,6 +13,7 @@ use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::integrate::{Buffer, Rhs};
 use crate::linalg::mass::{MassAt, MassMatrix};
 use crate::model::Model;
+use crate::simulate::rattle;
 
 /// A failed evaluation of the right-hand side.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,6 +79,17 @@ pub trait System: Rhs<Error = EvalError> {
     /// Projects the state `x` at time `t` onto the invariants (the
     /// `projection` method); returns the Newton iterations taken.
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure>;
+    /// Whether it can be stepped by [`Scheme::Rattle`](crate::Scheme::Rattle).
+    fn offers_rattle(&self) -> bool {
+        false
+    }
+    /// One RATTLE step of the state `x` from `t` to `t + h`
+    /// ([`crate::simulate::rattle`]); returns the iterations of its position
+    /// step. Called only where [`offers_rattle`](Self::offers_rattle).
+    fn rattle(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<u32, RattleFailure> {
+        let _ = (x, t, h);
+        unreachable!("a system that does not offer RATTLE")
+    }
     /// The momenta the system keeps ([`crate::dynamics::momentum`]); none unless it finds them.
     fn symmetries(&self) -> &Symmetries {
         &NO_SYMMETRIES
@@ -87,6 +99,24 @@ pub trait System: Rhs<Error = EvalError> {
         let _ = (j, x);
         0.0
     }
+}
+
+/// Why a RATTLE step failed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum RattleFailure {
+    /// The dynamics could not be evaluated.
+    Eval(EvalError),
+    /// The position step did not reach `Φ = 0` within
+    /// [`MAX_ITERATIONS`](crate::simulate::rattle::MAX_ITERATIONS).
+    Positions {
+        /// The worst constraint row.
+        row: usize,
+        /// Its `|Φ|`.
+        residual: f64,
+        /// Iterations taken.
+        iterations: u32,
+    },
 }
 
 static NO_SYMMETRIES: Symmetries = Symmetries::NONE;
@@ -123,6 +153,8 @@ pub struct ControlledSystem<'m> {
     held: Held,
     /// A rotation's field `ξ(q)`, for [`System::momentum`].
     turned: Vec<f64>,
+    /// RATTLE's buffers, made at its first step.
+    rattle: Option<rattle::Work>,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -150,6 +182,7 @@ impl<'m> ControlledSystem<'m> {
             momenta: Momenta::NONE,
             held: Held::default(),
             turned: vec![0.0; model.n()],
+            rattle: None,
         }
     }
 
@@ -309,7 +342,27 @@ impl System for ControlledSystem<'_> {
         };
         momentum::value(self.model, q, v, direction, &mut self.work)
     }
+    fn offers_rattle(&self) -> bool {
+        true
+    }
+    fn rattle(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<u32, RattleFailure> {
+        let n = self.model.n();
+        let (q, rest) = x.split_at_mut(n);
+        let (v, e) = rest.split_at_mut(n);
+        let work = self.rattle.get_or_insert_with(|| rattle::Work::new(self.model));
+        let taken = rattle::step(self.model, &mut self.dynamics, q, v, &mut e[0], t, h, work, &mut self.evaluations);
+        self.dependent = self.dependent.max(self.dynamics.dependent_rows());
+        taken.map_err(|f| match f {
+            rattle::Failure::Breakdown(b, t) => RattleFailure::Eval(EvalError::at(b, t)),
+            rattle::Failure::Positions { row, residual, iterations } => {
+                RattleFailure::Positions { row, residual, iterations }
+            }
+        })
+    }
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
+        if let Some(work) = &mut self.rattle {
+            work.forget();
+        }
         let n = self.model.n();
         let (q, rest) = x.split_at_mut(n);
         let (v, e) = rest.split_at_mut(n);

@@ -12,13 +12,14 @@ use std::time::Instant;
 /// One method's cost on one model, over the interleaved trials of a [`MethodComparison`].
 #[derive(Debug, Serialize)]
 pub struct MethodCost {
-    /// `cvsgf_energy`, `robust` or `projection`.
+    /// `cvsgf_energy`, `robust` or `projection` (AB-3), or `rattle` (RATTLE, no control).
     pub method: &'static str,
     /// Median over the trials.
     pub us_per_step: f64,
     /// Median over the trials of this method's time over `cvsgf_energy`'s in the same trial.
     pub ratio_to_cvsgf_energy: f64,
-    /// Newton iterations of the projection per step (`projection` only).
+    /// Newton iterations of the projection per step (`projection`), or of
+    /// RATTLE's position step (`rattle`).
     pub projection_iterations_per_step: Option<f64>,
     /// Largest `|Φ|` seen, sampled (outside the clock) every [`PHI_EVERY`] steps and at the end.
     pub max_abs_phi: f64,
@@ -33,7 +34,7 @@ pub struct MethodComparison {
     pub model: &'static str,
     /// Bodies: 1 for Example 1, `N` for the chain.
     pub n: usize,
-    /// Step size, AB-3.
+    /// Step size.
     pub h: f64,
     /// Every run starts afresh (set-up untimed) and lasts this many steps.
     pub steps_per_run: u64,
@@ -45,8 +46,10 @@ pub struct MethodComparison {
     pub methods: Vec<MethodCost>,
 }
 
-/// The methods compared, by name; the first is the one ratios are taken to.
-pub const METHODS: [&str; 3] = ["cvsgf_energy", "robust", "projection"];
+/// The methods compared, by name; the first is the one ratios are taken
+/// to. The first three step with AB-3; `rattle` is RATTLE with no control,
+/// which holds the constraints itself.
+pub const METHODS: [&str; 4] = ["cvsgf_energy", "robust", "projection", "rattle"];
 
 /// Steps between samples of `|Φ|` in a [`MethodComparison`]: the clock is
 /// read this often, which costs well under 1 % even of Example 1's step.
@@ -64,7 +67,8 @@ pub(super) struct MethodRun {
     seconds: f64,
     allocations: u64,
     max_abs_phi: f64,
-    projection_iterations: u64,
+    /// Of the projection, or of RATTLE's position step.
+    iterations: u64,
 }
 
 /// One fresh run of `steps` steps of `ex` (set-up, including the automatic
@@ -87,7 +91,7 @@ pub(super) fn method_run(ex: &Example, settings: Settings, steps: u64, phi: &mut
         seconds,
         allocations: allocs,
         max_abs_phi: worst,
-        projection_iterations: sim.projection_iterations(),
+        iterations: sim.projection_iterations() + sim.rattle_iterations(),
     })
 }
 
@@ -104,7 +108,9 @@ pub(super) fn compare_methods(
     runs: u64,
     trials: usize,
 ) -> Result<MethodComparison> {
-    let controls = [cvsgf_energy, methods::robust(), methods::projection()];
+    let ab3 = |control| Settings::new(Scheme::AdamsBashforth3, h, control);
+    let settings = [ab3(cvsgf_energy), ab3(methods::robust()), ab3(methods::projection()), Settings::new(Scheme::Rattle, h, Control::none())];
+    let controls = settings.map(|s| s.control);
     let k = controls.len();
     let mut phi = vec![0.0; ex.model.m()];
     let (mut seconds, mut ratios) = (vec![vec![0.0; trials]; k], vec![vec![0.0; trials]; k]);
@@ -112,13 +118,12 @@ pub(super) fn compare_methods(
     for trial in 0..trials {
         for i in 0..k {
             let c = (i + trial) % k;
-            let settings = Settings::new(Scheme::AdamsBashforth3, h, controls[c]);
             for _ in 0..runs {
-                let r = method_run(ex, settings, steps, &mut phi)?;
+                let r = method_run(ex, settings[c], steps, &mut phi)?;
                 seconds[c][trial] += r.seconds;
                 allocs[c] = allocs[c].max(r.allocations);
                 worst[c] = worst[c].max(r.max_abs_phi);
-                iterations[c] += r.projection_iterations;
+                iterations[c] += r.iterations;
             }
         }
         for c in 0..k {
@@ -131,9 +136,8 @@ pub(super) fn compare_methods(
             method: METHODS[c],
             us_per_step: median(seconds[c].clone()) / total_steps * 1e6,
             ratio_to_cvsgf_energy: median(ratios[c].clone()),
-            projection_iterations_per_step: controls[c]
-                .projection
-                .map(|_| iterations[c] as f64 / (total_steps * trials as f64)),
+            projection_iterations_per_step: (controls[c].projection.is_some() || settings[c].scheme == Scheme::Rattle)
+                .then(|| iterations[c] as f64 / (total_steps * trials as f64)),
             max_abs_phi: worst[c],
             allocations_per_step: allocs[c] as f64 / steps as f64,
         })

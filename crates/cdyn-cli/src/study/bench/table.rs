@@ -46,7 +46,7 @@ pub fn table(r: &Report) -> String {
     }
     if let Some(m) = r.methods.first() {
         out += &format!(
-            "Methods, AB-3 (median of {} interleaved trials; ratio to cvsgf_energy within a trial, median):\n",
+            "Methods, AB-3, and RATTLE without control (median of {} interleaved trials; ratio to cvsgf_energy within a trial, median):\n",
             m.trials
         );
     }
