@@ -280,7 +280,9 @@ fn steps_do_not_allocate() {
     // RATTLE, alone and followed by the projection, on constant, block and dense M(q).
     for control in [Control::none()].into_iter().chain(projections()) {
         let settings = |h| Settings::new(Scheme::Rattle, h, control);
-        for (name, ex, h) in [("pendulum", &pendulum, 0.01), ("chain", &chain, 1e-3), ("four-bar in angles", &four_bar, 1e-3)] {
+        for (name, ex, h) in
+            [("pendulum", &pendulum, 0.01), ("chain", &chain, 1e-3), ("four-bar in angles", &four_bar, 1e-3)]
+        {
             let n = allocations_per_run(ex, settings(h), 5, 200);
             assert_eq!(n, 0, "{name}, rattle, {control:?}: {n} allocations in 200 steps");
         }

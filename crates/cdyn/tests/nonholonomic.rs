@@ -272,14 +272,12 @@ fn sled_on_an_incline_follows_its_closed_form_with_and_without_control() {
 fn sled_errors_converge_at_each_schemes_order() {
     let sled = Sled { g: G_INCLINE, theta0: 0.3, omega: 2.0, u0: 1.0 };
     let m = sled.mechanism();
-    for (scheme, h, order) in
-    [
+    for (scheme, h, order) in [
         (Scheme::AdamsBashforth2, 4e-3, 2.0),
         (Scheme::AdamsBashforth3, 4e-3, 3.0),
         (Scheme::RungeKutta4, 2e-2, 4.0),
         (Scheme::Rattle, 4e-3, 2.0),
-    ]
-    {
+    ] {
         let coarse = run(&m, scheme, h, 4.0, Control::none(), |t| sled.exact(t)).error;
         let fine = run(&m, scheme, h / 2.0, 4.0, Control::none(), |t| sled.exact(t)).error;
         let observed = (coarse / fine).log2();

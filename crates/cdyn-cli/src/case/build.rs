@@ -6,13 +6,13 @@ use crate::case::runner::Case;
 use crate::case::scenario::{GravitySpec, InvariantSpec, Scenario, SpatialEntries, read_bounded};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
-use cdyn::{Scheme, Settings};
 use cdyn::control::methods::{MethodKeys, Preset};
 use cdyn::dynamics::assemble::assemble_with;
 use cdyn::error::{Part, positive};
 use cdyn::models::{Example, Kind};
 use cdyn::planar::{Element, Group, Mechanism};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
+use cdyn::{Scheme, Settings};
 use std::path::Path;
 
 /// The built-in model `kind`, its parameters read from `parameters`, which

@@ -296,7 +296,9 @@ impl<S: System> Stepper<S> {
                 }
             }
         } else {
-            self.integrator.step(&mut self.system, self.x.as_mut_slice(), t, h).map_err(|e| eval_error(e, step, t + h))?;
+            self.integrator
+                .step(&mut self.system, self.x.as_mut_slice(), t, h)
+                .map_err(|e| eval_error(e, step, t + h))?;
         }
         self.step += 1;
         let dropped = match self.settings.dependent_rows {

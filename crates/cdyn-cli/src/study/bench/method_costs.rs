@@ -109,7 +109,12 @@ pub(super) fn compare_methods(
     trials: usize,
 ) -> Result<MethodComparison> {
     let ab3 = |control| Settings::new(Scheme::AdamsBashforth3, h, control);
-    let settings = [ab3(cvsgf_energy), ab3(methods::robust()), ab3(methods::projection()), Settings::new(Scheme::Rattle, h, Control::none())];
+    let settings = [
+        ab3(cvsgf_energy),
+        ab3(methods::robust()),
+        ab3(methods::projection()),
+        Settings::new(Scheme::Rattle, h, Control::none()),
+    ];
     let controls = settings.map(|s| s.control);
     let k = controls.len();
     let mut phi = vec![0.0; ex.model.m()];
