@@ -153,8 +153,8 @@ pub struct ControlledSystem<'m> {
     held: Held,
     /// A rotation's field `ξ(q)`, for [`System::momentum`].
     turned: Vec<f64>,
-    /// RATTLE's buffers, made at its first step.
-    rattle: Option<rattle::Work>,
+    /// RATTLE's buffers (allocated here, so that no step allocates).
+    rattle: rattle::Work,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -182,7 +182,7 @@ impl<'m> ControlledSystem<'m> {
             momenta: Momenta::NONE,
             held: Held::default(),
             turned: vec![0.0; model.n()],
-            rattle: None,
+            rattle: rattle::Work::new(model),
         }
     }
 
@@ -349,7 +349,7 @@ impl System for ControlledSystem<'_> {
         let n = self.model.n();
         let (q, rest) = x.split_at_mut(n);
         let (v, e) = rest.split_at_mut(n);
-        let work = self.rattle.get_or_insert_with(|| rattle::Work::new(self.model));
+        let work = &mut self.rattle;
         let taken = rattle::step(self.model, &mut self.dynamics, q, v, &mut e[0], t, h, work, &mut self.evaluations);
         self.dependent = self.dependent.max(self.dynamics.dependent_rows());
         taken.map_err(|f| match f {
@@ -360,9 +360,7 @@ impl System for ControlledSystem<'_> {
         })
     }
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
-        if let Some(work) = &mut self.rattle {
-            work.forget();
-        }
+        self.rattle.forget();
         let n = self.model.n();
         let (q, rest) = x.split_at_mut(n);
         let (v, e) = rest.split_at_mut(n);
