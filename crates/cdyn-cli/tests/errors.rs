@@ -93,6 +93,11 @@ fn bad_scenarios_get_one_line_naming_the_problem() {
 #[test]
 fn bad_keys_of_the_robust_methods_get_one_line_naming_the_key() {
     let method = |keys: &str| GOOD.replace("geometric = \"cvsgf\"\nzeta = 20.0", keys);
+    // Generalized-α with no control, and these [integrator] keys.
+    let alpha = |keys: &str| {
+        GOOD.replace("[method]\ngeometric = \"cvsgf\"\nzeta = 20.0\n", "")
+            .replace("scheme = \"ab3\"", &format!("scheme = \"generalized_alpha\"\n{keys}"))
+    };
     let velocity =
         |alpha_v: &str| method(&format!("geometric = \"cvsgf\"\nzeta = 20.0\nvelocity = \"gradient\"\n{alpha_v}"));
     let cases: Vec<(String, &[&str])> = vec![
@@ -112,6 +117,15 @@ fn bad_keys_of_the_robust_methods_get_one_line_naming_the_key() {
         (method("preset = \"projection\"\nmax_iterations = -1"), &["bad.toml", "max_iterations", "-1"]),
         (method("preset = \"projection\"\non_failure = \"ignore\""), &["bad.toml", "on_failure", "ignore"]),
         (method("geometric = \"cvsgf\"\nzeta = 20.0\ntolerance = 1e-9"), &["bad.toml", "tolerance", "projection"]),
+        (
+            GOOD.replace("t_end = 1.0", "t_end = 1.0\nrho_inf = 0.5"),
+            &["bad.toml", "rho_inf", "generalized_alpha", "ab3"],
+        ),
+        (alpha("rho_inf = 1.5"), &["bad.toml", "rho_inf", "1.5", "[0, 1]"]),
+        (alpha("newton_iterations = 0"), &["bad.toml", "newton iterations", "at least 1"]),
+        (alpha("newton_iterations = 2\nnewton_tolerance = 1e-8"), &["bad.toml", "newton_iterations", "exclude"]),
+        (alpha("newton_tolerance = -1.0"), &["bad.toml", "newton tolerance", "positive"]),
+        (alpha("newton_tolerance = 1e-300\nnewton_max_iterations = 1"), &["Newton", "step 1", "converge"]),
     ];
     for (text, needles) in cases {
         let (line, _) = error_of(&text);

@@ -8,7 +8,8 @@
 //! into `f` (what the scheme integrates) and the control term `U`.
 
 /// A fixed-step scheme. In scenario files it is written by its
-/// [`SchemeInfo::name`]: `euler`, `ab2`, `ab3`, `rk4`, `abm4`.
+/// [`SchemeInfo::name`]: `euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`,
+/// `generalized_alpha`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(try_from = "String", into = "&'static str"))]
@@ -37,6 +38,14 @@ pub enum Scheme {
     /// takes it ([`crate::simulate::rattle`]), with no control law in the
     /// right-hand side (`projection` may follow it).
     Rattle,
+    /// Generalized-α (Chung–Hulbert) on the index-3 equations: implicit,
+    /// order 2, unconditionally stable on linear problems, with numerical
+    /// damping of the modes far above `1/h` set by `ρ∞`; `Φ = 0` holds to
+    /// the Newton tolerance after every step. For stiff springs and
+    /// dampers at steps an explicit scheme cannot take. Like RATTLE it
+    /// steps a model ([`crate::simulate::generalized_alpha`]), configured
+    /// by [`Settings::generalized_alpha`](crate::simulate::Settings::generalized_alpha).
+    GeneralizedAlpha,
 }
 
 /// Where the control term is integrated (Eqs. 54–59). Scenario files write
@@ -81,6 +90,9 @@ pub enum Formula {
     /// Velocity Verlet with constraint forces ([`Scheme::Rattle`]): not a
     /// combination of right-hand sides, stepped by the simulation itself.
     Rattle,
+    /// Generalized-α ([`Scheme::GeneralizedAlpha`]): implicit, stepped by
+    /// the simulation itself with a Newton iteration.
+    GeneralizedAlpha,
     /// An explicit Butcher tableau: `a` is strictly lower-triangular, row by row.
     RungeKutta {
         /// Stage coefficients `a_ij`, one row per stage.
@@ -95,7 +107,7 @@ pub enum Formula {
 /// Everything that distinguishes one scheme from another.
 #[derive(Debug, Clone, Copy)]
 pub struct SchemeInfo {
-    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`.
+    /// Its name in scenario files and outputs: `euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`, `generalized_alpha`.
     pub name: &'static str,
     /// Order of accuracy.
     pub order: u32,
@@ -115,17 +127,18 @@ const RK4_C: &[f64] = &[0.0, 0.5, 0.5, 1.0];
 
 impl Scheme {
     /// Every scheme.
-    pub const ALL: [Scheme; 6] = [
+    pub const ALL: [Scheme; 7] = [
         Scheme::Euler,
         Scheme::AdamsBashforth2,
         Scheme::AdamsBashforth3,
         Scheme::RungeKutta4,
         Scheme::AdamsBashforthMoulton4,
         Scheme::Rattle,
+        Scheme::GeneralizedAlpha,
     ];
 
     /// The schemes that step any right-hand side `ẋ = f + U` with an
-    /// [`Integrator`], under every control law: all but RATTLE.
+    /// [`Integrator`], under every control law: all but RATTLE and generalized-α.
     pub const GENERAL: [Scheme; 5] = [
         Scheme::Euler,
         Scheme::AdamsBashforth2,
@@ -188,10 +201,27 @@ impl Scheme {
                 startup: None,
                 formula: Formula::Rattle,
             },
+            Scheme::GeneralizedAlpha => SchemeInfo {
+                name: "generalized_alpha",
+                order: 2,
+                // At least two: the predictor's and one correction's (more as Newton needs).
+                evaluations: 2,
+                history: 1,
+                startup: None,
+                formula: Formula::GeneralizedAlpha,
+            },
         }
     }
 
-    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`).
+    /// Whether the scheme steps a model's positions and velocities itself
+    /// (RATTLE, generalized-α) rather than a right-hand side: such schemes
+    /// hold `Φ = 0` themselves and take no control law in the right-hand
+    /// side, only `projection` after the step.
+    pub fn steps_model(self) -> bool {
+        matches!(self.info().formula, Formula::Rattle | Formula::GeneralizedAlpha)
+    }
+
+    /// The scheme with this name (`euler`, `ab2`, `ab3`, `rk4`, `abm4`, `rattle`, `generalized_alpha`).
     pub fn from_name(name: &str) -> Option<Scheme> {
         Scheme::ALL.into_iter().find(|s| s.info().name == name)
     }
@@ -283,7 +313,10 @@ impl<B: Buffer> Integrator<B> {
             .map(|s| match s.info().formula {
                 Formula::RungeKutta { b, .. } => b.len(),
                 // The evaluation at the predicted state.
-                Formula::Multistep(_) | Formula::PredictorCorrector { .. } | Formula::Rattle => 1,
+                Formula::Multistep(_)
+                | Formula::PredictorCorrector { .. }
+                | Formula::Rattle
+                | Formula::GeneralizedAlpha => 1,
             })
             .max()
             .unwrap_or(1);
@@ -358,7 +391,9 @@ impl<B: Buffer> Integrator<B> {
                 let f = [self.stages[0].as_slice(), past(0), past(1), past(2)];
                 accumulate(x, h, corrector, f);
             }
-            Formula::Rattle => panic!("RATTLE steps a model's positions and velocities, not a right-hand side"),
+            Formula::Rattle | Formula::GeneralizedAlpha => {
+                panic!("RATTLE and generalized-α step a model's positions and velocities, not a right-hand side")
+            }
             Formula::RungeKutta { a, b, c } => {
                 self.stages[0].as_mut_slice().copy_from_slice(self.history[self.newest].as_slice());
                 for i in 1..b.len() {

@@ -277,16 +277,19 @@ fn steps_do_not_allocate() {
             }
         }
     }
-    // RATTLE, alone and followed by the projection, on constant, block and dense M(q).
-    for control in [Control::none()].into_iter().chain(projections()) {
-        let settings = |h| Settings::new(Scheme::Rattle, h, control);
+    // RATTLE and generalized-α, alone and followed by the projection, on constant, block and dense M(q).
+    for (scheme, control) in [Scheme::Rattle, Scheme::GeneralizedAlpha]
+        .into_iter()
+        .flat_map(|s| [Control::none()].into_iter().chain(projections()).map(move |c| (s, c)))
+    {
+        let settings = |h| Settings::new(scheme, h, control);
         for (name, ex, h) in
             [("pendulum", &pendulum, 0.01), ("chain", &chain, 1e-3), ("four-bar in angles", &four_bar, 1e-3)]
         {
             let n = allocations_per_run(ex, settings(h), 5, 200);
-            assert_eq!(n, 0, "{name}, rattle, {control:?}: {n} allocations in 200 steps");
+            assert_eq!(n, 0, "{name}, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
         let n = allocations_stepping(Simulation::new(&spatial, settings(1e-3), &sq0, &sv0).unwrap(), 5, 200);
-        assert_eq!(n, 0, "spatial chain, rattle, {control:?}: {n} allocations in 200 steps");
+        assert_eq!(n, 0, "spatial chain, {scheme:?}, {control:?}: {n} allocations in 200 steps");
     }
 }

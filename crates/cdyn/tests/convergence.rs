@@ -31,6 +31,7 @@ fn every_scheme_converges_at_its_order() {
                 Scheme::RungeKutta4 => 4e-2,
                 Scheme::AdamsBashforthMoulton4 => 2e-2,
                 Scheme::Rattle => 1e-2,
+                Scheme::GeneralizedAlpha => 1e-2,
                 other => panic!("no step chosen for {other:?}: add one here"),
             };
             let errors: Vec<f64> =

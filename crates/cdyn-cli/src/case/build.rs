@@ -6,13 +6,13 @@ use crate::case::runner::Case;
 use crate::case::scenario::{GravitySpec, InvariantSpec, Scenario, SpatialEntries, read_bounded};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
+use cdyn::Settings;
 use cdyn::control::methods::{MethodKeys, Preset};
 use cdyn::dynamics::assemble::assemble_with;
 use cdyn::error::{Part, positive};
 use cdyn::models::{Example, Kind};
 use cdyn::planar::{Element, Group, Mechanism};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
-use cdyn::{Scheme, Settings};
 use std::path::Path;
 
 /// The built-in model `kind`, its parameters read from `parameters`, which
@@ -42,10 +42,11 @@ impl Scenario {
     }
 
     /// The method as written; without `[method]`, the `robust` preset, or
-    /// no control for `rattle`, which holds the constraints itself.
+    /// no control for `rattle` and `generalized_alpha`, which hold the
+    /// constraints themselves.
     pub fn method(&self) -> MethodKeys {
         let default = match self.integrator.scheme {
-            Scheme::Rattle => MethodKeys::default(),
+            s if s.steps_model() => MethodKeys::default(),
             _ => MethodKeys { preset: Some(Preset::Robust), ..MethodKeys::default() },
         };
         self.method.clone().unwrap_or(default)
@@ -70,7 +71,9 @@ impl Scenario {
             ),
             other => integrator(other),
         })?;
-        let mut settings = Settings::new(i.scheme, h, control).with_dependent_rows(i.dependent_rows);
+        let mut settings = Settings::new(i.scheme, h, control)
+            .with_dependent_rows(i.dependent_rows)
+            .with_generalized_alpha(i.generalized_alpha().map_err(|e| anyhow!("{file}: [integrator] {e}"))?);
         let init = &self.initial;
         if let Some(tol) = init.tolerance {
             settings.consistency_tolerance =

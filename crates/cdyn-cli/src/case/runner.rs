@@ -132,6 +132,8 @@ pub struct CaseResult {
     pub projection_iterations_per_step: Option<f64>,
     /// Mean iterations per step of RATTLE's position step (`scheme = "rattle"`).
     pub rattle_iterations_per_step: Option<f64>,
+    /// Generalized-α's Newton iteration (`scheme = "generalized_alpha"`).
+    pub newton: Option<NewtonReport>,
     /// Steps in which constraint rows were dropped as dependent
     /// (`dependent_rows = "tolerate"`): the most rows at once, how many
     /// steps, the first and last; `null` if none were.
@@ -145,6 +147,16 @@ pub struct CaseResult {
     pub frames: Frames,
 }
 
+/// What generalized-α's Newton iteration did over a run.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct NewtonReport {
+    /// Mean corrections per step.
+    pub corrections_per_step: f64,
+    /// The largest `|Δq|∞` a step left uncorrected: below the tolerance
+    /// when it converges, what `newton_iterations` reached otherwise.
+    pub newton_correction: f64,
+}
+
 /// What a run reports of its method besides the record.
 #[derive(Default)]
 struct Method {
@@ -153,6 +165,7 @@ struct Method {
     tuning: Option<cdyn::control::gains::Tuning>,
     projection_iterations_per_step: Option<f64>,
     rattle_iterations_per_step: Option<f64>,
+    newton: Option<NewtonReport>,
     frames: Frames,
     rank_loss: Option<RankLoss>,
 }
@@ -177,6 +190,7 @@ impl CaseResult {
             tuning: method.tuning,
             projection_iterations_per_step: method.projection_iterations_per_step,
             rattle_iterations_per_step: method.rattle_iterations_per_step,
+            newton: method.newton,
             dependent_rows: method.rank_loss,
             interrupted: method.interrupted,
             frames: method.frames,
@@ -338,6 +352,10 @@ fn simulate<K: Sink>(
                     .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
                 rattle_iterations_per_step: (case.settings.scheme == cdyn::Scheme::Rattle)
                     .then(|| sim.rattle_iterations() as f64 / sim.steps().max(1) as f64),
+                newton: (case.settings.scheme == cdyn::Scheme::GeneralizedAlpha).then(|| NewtonReport {
+                    corrections_per_step: sim.newton_iterations() as f64 / sim.steps().max(1) as f64,
+                    newton_correction: sim.newton_correction(),
+                }),
                 frames,
                 rank_loss: sim.rank_loss().copied(),
             };

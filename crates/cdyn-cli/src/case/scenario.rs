@@ -9,6 +9,7 @@ use cdyn::control::methods::MethodKeys;
 use cdyn::dynamics::DependentRows;
 use cdyn::models::Kind;
 use cdyn::planar::{Body, Element};
+use cdyn::simulate::generalized_alpha::{GeneralizedAlpha, Newton};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -181,6 +182,52 @@ pub struct IntegratorSpec {
     /// `"tolerate"` (solved without it; redundant constraints).
     #[serde(default)]
     pub dependent_rows: DependentRows,
+    /// Generalized-α's spectral radius at infinite frequency, in [0, 1] (default 0.9).
+    pub rho_inf: Option<f64>,
+    /// Generalized-α's Newton tolerance, relative to the largest coordinate (default 1e-10).
+    pub newton_tolerance: Option<f64>,
+    /// Generalized-α's Newton corrections allowed per step (default 20).
+    pub newton_max_iterations: Option<u32>,
+    /// Generalized-α with exactly this many Newton corrections a step
+    /// (real-time runs), in place of a tolerance.
+    pub newton_iterations: Option<u32>,
+}
+
+impl IntegratorSpec {
+    /// Generalized-α's settings from `rho_inf` and the `newton_*` keys,
+    /// which no other scheme reads (so they are refused with one).
+    pub fn generalized_alpha(&self) -> Result<GeneralizedAlpha> {
+        let keys = [
+            ("rho_inf", self.rho_inf.is_some()),
+            ("newton_tolerance", self.newton_tolerance.is_some()),
+            ("newton_max_iterations", self.newton_max_iterations.is_some()),
+            ("newton_iterations", self.newton_iterations.is_some()),
+        ];
+        let given = || keys.iter().filter(|(_, given)| *given).map(|(key, _)| *key);
+        if self.scheme != Scheme::GeneralizedAlpha
+            && let Some(key) = given().next()
+        {
+            bail!(
+                "{key} is read by scheme = \"generalized_alpha\" only; scheme {} would ignore it",
+                self.scheme.info().name
+            );
+        }
+        let mut settings = GeneralizedAlpha::new();
+        if let Some(rho) = self.rho_inf {
+            settings = settings.with_rho_inf(rho);
+        }
+        let default = GeneralizedAlpha::new().newton;
+        let Newton::Converge { tolerance, max_iterations } = default else { unreachable!("converges by default") };
+        settings.newton = match (self.newton_iterations, self.newton_tolerance, self.newton_max_iterations) {
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => bail!(
+                "newton_iterations (a fixed count) and newton_tolerance / newton_max_iterations (iterate to a tolerance) exclude each other"
+            ),
+            (Some(fixed), ..) => Newton::fixed(fixed),
+            (None, t, k) => Newton::converge(t.unwrap_or(tolerance), k.unwrap_or(max_iterations)),
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
 }
 
 /// `[output]`.

@@ -7,7 +7,6 @@
 use crate::case::runner::Case;
 use crate::case::scenario::Scenario;
 use anyhow::Result;
-use cdyn::Scheme;
 use cdyn::control::methods::compare_cases;
 use std::path::Path;
 
@@ -23,10 +22,11 @@ pub fn cases(scenario: &Scenario, path: &Path) -> Result<Vec<Case>> {
         .map_err(|e| anyhow::anyhow!("{file}: [method] {e}"))?;
     // A model without constraints has nothing for geometric control to do.
     let methods = compare_cases(&gains, base.example.model.m() > 0);
-    let rattle = base.settings.scheme == Scheme::Rattle;
+    // RATTLE and generalized-α take no right-hand-side control: none and projection.
+    let steps_model = base.settings.scheme.steps_model();
     methods
         .into_iter()
-        .filter(|(_, control)| !(rattle && control.is_active()))
+        .filter(|(_, control)| !(steps_model && control.is_active()))
         .map(|(name, control)| {
             let mut case = scenario.case(path)?;
             case.name = name.to_string();

@@ -95,6 +95,8 @@ pub fn real_stability_interval(scheme: Scheme) -> f64 {
         // RATTLE integrates no control term; velocity Verlet is stable for
         // an oscillation ẍ = −ω²x while h ω < 2.
         Formula::Rattle => 2.0,
+        // Generalized-α is A-stable: no limit on h λ.
+        Formula::GeneralizedAlpha => f64::INFINITY,
     }
 }
 
@@ -319,7 +321,7 @@ mod tests {
                     assert!((0..1000).all(|k| radius(x * k as f64 / 1000.0) <= 1.0 + 1e-12), "{scheme:?}");
                     radius(x) - 1.0
                 }
-                Formula::Rattle => unreachable!("not among the general schemes"),
+                Formula::Rattle | Formula::GeneralizedAlpha => unreachable!("not among the general schemes"),
             };
             assert!(at_boundary.abs() < 1e-12, "{scheme:?}: {at_boundary}");
         }

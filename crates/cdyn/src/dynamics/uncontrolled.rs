@@ -117,6 +117,40 @@ impl Dynamics {
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the
     /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
     pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
+        self.evaluate_forces(model, q, v, t)?;
+        if model.m() == 0 {
+            return Ok(());
+        }
+        match &mut self.solver {
+            Solver::Constant(schur) => {
+                if self.reuse && self.factored_at == Some(t) && self.factored_q == q {
+                    schur.solve(&mut self.lambda);
+                } else {
+                    self.factored_at = None;
+                    schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
+                    if self.reuse {
+                        self.factored_q.copy_from_slice(q);
+                        self.factored_at = Some(t);
+                    }
+                }
+            }
+            Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
+            Solver::Blocks(b) => b.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
+        }
+        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
+        let mut acc = std::mem::take(&mut self.acc);
+        self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
+        self.acc = acc;
+        Ok(())
+    }
+
+    /// The first half of [`evaluate`](Self::evaluate): `V`, `G`, `M(q)`
+    /// and the constraints (`Φ`, `Φ̇`, `Φ_t`, `γ`, `Φ_q`) at `(q, v, t)`,
+    /// without the multipliers: what an implicit scheme's Newton residual
+    /// reads. [`lambda`](Self::lambda) and [`acc`](Self::acc) are then not
+    /// the multipliers and accelerations of this state.
+    #[inline(always)]
+    pub fn evaluate_forces(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
         self.grad_potential.fill(0.0);
         self.potential = model.potential(q, Some(&mut self.grad_potential));
         for (f, g) in self.force.iter_mut().zip(&self.grad_potential) {
@@ -144,29 +178,6 @@ impl Dynamics {
         }
         // λ starts as the right-hand side of (Φ_q M⁻¹ Φ_qᵀ) λ = Φ_q M⁻¹ G − γ   (Eqs. 6–7)
         model.constraints(q, v, t, self.constraints.pass(&self.acc, &mut self.lambda));
-        if model.m() == 0 {
-            return Ok(());
-        }
-        match &mut self.solver {
-            Solver::Constant(schur) => {
-                if self.reuse && self.factored_at == Some(t) && self.factored_q == q {
-                    schur.solve(&mut self.lambda);
-                } else {
-                    self.factored_at = None;
-                    schur.factor_and_solve(&self.constraints.jac, &mut self.lambda)?;
-                    if self.reuse {
-                        self.factored_q.copy_from_slice(q);
-                        self.factored_at = Some(t);
-                    }
-                }
-            }
-            Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
-            Solver::Blocks(b) => b.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
-        }
-        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        let mut acc = std::mem::take(&mut self.acc);
-        self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
-        self.acc = acc;
         Ok(())
     }
 

@@ -134,6 +134,23 @@ pub enum Error {
         /// Iterations taken.
         iterations: u32,
     },
+    /// Generalized-α's Newton iteration failed.
+    #[error(
+        "generalized-α's Newton iteration {cause} at step {step}, t = {}: |Δq| = {correction:.3e} after {iterations} corrections (take a smaller h, or allow more newton iterations)",
+        Time(*t)
+    )]
+    NewtonFailed {
+        /// Steps taken, including the one that failed.
+        step: u64,
+        /// Time the step was to reach.
+        t: f64,
+        /// `did not converge`, or `met a singular matrix`.
+        cause: &'static str,
+        /// `|Δq|∞` of the correction that would come next (NaN where singular).
+        correction: f64,
+        /// Corrections taken.
+        iterations: u32,
+    },
     /// Method keys that do not describe one method.
     #[error("{0}")]
     Method(#[from] KeyProblem),

@@ -2,7 +2,8 @@
 //! ([`mass`]), the `m × m` system `S = Φ_q M⁻¹ Φ_qᵀ` with its `L D Lᵀ`
 //! factorization (`schur`; its pivot test and the dense factorization in
 //! `ldl`), and the symbolic analysis of a sparse `S`
-//! (`sparse`, done once per model).
+//! (`sparse`, done once per model); the sparse LU of an implicit step's
+//! Newton matrix (`sparse_lu`).
 //!
 //! May import: `error`.
 
@@ -10,6 +11,7 @@ mod ldl;
 pub mod mass;
 mod schur;
 pub(crate) mod sparse;
+pub(crate) mod sparse_lu;
 
 pub use ldl::{Breakdown, DependentRows};
 pub(crate) use ldl::{DenseLdl, inverse_pivot};

@@ -99,6 +99,10 @@ pub(crate) trait ConstraintBlock: Send + Sync {
     fn evaluate(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>);
     /// `Φ` only, in plain `f64`.
     fn values(&self, q: &[f64], t: f64, phi: &mut [f64]);
+    /// Whether its rows are position-level constraints `Φ(q, t)` (not velocity-level only).
+    fn holonomic(&self) -> bool {
+        true
+    }
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 

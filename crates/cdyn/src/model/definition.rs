@@ -313,6 +313,32 @@ impl Model {
         self.forces.iter().for_each(|b| b.add_damping(q, v, w, t, out));
     }
 
+    /// The `(row, column)` of the entries [`add_iteration_values`](Self::add_iteration_values)
+    /// writes: each potential's Hessian block, then each force's Jacobian block.
+    pub(crate) fn iteration_entries(&self, out: &mut Vec<(u32, u32)>) {
+        self.potentials.iter().for_each(|p| p.hessian_entries(out));
+        self.forces.iter().for_each(|f| f.jacobian_entries(out));
+    }
+
+    /// `c_q K + c_v C` of an implicit step's Newton matrix, entry by entry
+    /// in the order of [`iteration_entries`](Self::iteration_entries):
+    /// `K = ∇²V − ∂F/∂q` and `C = −∂F/∂v` of the potentials and forces.
+    pub(crate) fn iteration_values(&self, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, out: &mut [f64]) {
+        let mut at = 0;
+        for p in &self.potentials {
+            at += p.hessians(q, c_q, &mut out[at..]);
+        }
+        for f in &self.forces {
+            at += f.jacobians(q, v, t, c_q, c_v, &mut out[at..]);
+        }
+    }
+
+    /// For each constraint row, whether it is holonomic (a position-level
+    /// `Φ`) rather than nonholonomic (velocity-level only).
+    pub(crate) fn holonomic_rows(&self) -> Vec<bool> {
+        self.constraints.iter().flat_map(|b| std::iter::repeat_n(b.holonomic(), b.rows())).collect()
+    }
+
     /// Kinetic energy `T(q, v) = ½ vᵀ M(q) v`.
     pub fn kinetic(&self, q: &[f64], v: &[f64]) -> f64 {
         self.kinetic_and_gradient(q, v, None)

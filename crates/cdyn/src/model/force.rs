@@ -7,7 +7,7 @@
 
 use crate::ad::scalar::Scalar;
 use crate::model::constraint::seeded;
-use num_dual::Dual64;
+use num_dual::{Dual64, HyperDual64};
 use std::any::Any;
 
 /// Potential energy `V(x)` of `K` coordinates.
@@ -28,6 +28,10 @@ pub(crate) trait PotentialBlock: Send + Sync {
     /// Returns `V` and adds `∇V` into `grad`.
     fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64;
     fn energy(&self, q: &[f64]) -> f64;
+    /// The `(row, column)` of each entry of [`add_hessians`](Self::add_hessians), element after element.
+    fn hessian_entries(&self, out: &mut Vec<(u32, u32)>);
+    /// Writes `scale · ∇²V` of each element (`K × K`, row-major) into `out`; returns the entries written.
+    fn hessians(&self, q: &[f64], scale: f64, out: &mut [f64]) -> usize;
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
@@ -37,7 +41,22 @@ pub(crate) trait ForceBlock: Send + Sync {
     fn add_forces(&self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> f64;
     /// Adds `−∂Q/∂v · w` into `out` (one directional dual pass per element).
     fn add_damping(&self, q: &[f64], v: &[f64], w: &[f64], t: f64, out: &mut [f64]);
+    /// The `(row, column)` of each entry of [`jacobians`](Self::jacobians), element after element.
+    fn jacobian_entries(&self, out: &mut Vec<(u32, u32)>);
+    /// Writes `−(c_q ∂f/∂x + c_v ∂f/∂ẋ)` of each element (`K × K`,
+    /// row-major) into `out` — one dual pass per coordinate, seeded in
+    /// both — and returns the entries written.
+    fn jacobians(&self, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, out: &mut [f64]) -> usize;
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// The `(row, column)` of every entry of each element's `K × K` block, row-major.
+fn block_entries<T, const K: usize>(items: &[(T, [usize; K])], out: &mut Vec<(u32, u32)>) {
+    for (_, idx) in items {
+        for i in idx {
+            out.extend(idx.iter().map(|j| (*i as u32, *j as u32)));
+        }
+    }
 }
 
 pub(crate) struct PotentialGroup<P, const K: usize> {
@@ -63,6 +82,30 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
             total += p.energy(std::array::from_fn(|j| q[idx[j]]));
         }
         total
+    }
+
+    fn hessian_entries(&self, out: &mut Vec<(u32, u32)>) {
+        block_entries(&self.items, out);
+    }
+
+    fn hessians(&self, q: &[f64], scale: f64, out: &mut [f64]) -> usize {
+        let hyper = |x: &[f64; K], i: usize, j: usize, p: &P| {
+            let x = std::array::from_fn(|k| {
+                HyperDual64::new(x[k], f64::from(u8::from(k == i)), f64::from(u8::from(k == j)), 0.0)
+            });
+            p.energy(x).eps1eps2
+        };
+        for ((p, idx), block) in self.items.iter().zip(out.chunks_exact_mut(K * K)) {
+            let x = std::array::from_fn(|j| q[idx[j]]);
+            for i in 0..K {
+                for j in i..K {
+                    let h = scale * hyper(&x, i, j, p);
+                    block[i * K + j] = h;
+                    block[j * K + i] = h;
+                }
+            }
+        }
+        self.items.len() * K * K
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
@@ -113,6 +156,24 @@ impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
                 out[idx[j]] -= fx[j].eps;
             }
         }
+    }
+
+    fn jacobian_entries(&self, out: &mut Vec<(u32, u32)>) {
+        block_entries(&self.items, out);
+    }
+
+    fn jacobians(&self, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, out: &mut [f64]) -> usize {
+        for ((f, idx), block) in self.items.iter().zip(out.chunks_exact_mut(K * K)) {
+            for j in 0..K {
+                let x = std::array::from_fn(|k| Dual64::new(q[idx[k]], if k == j { c_q } else { 0.0 }));
+                let xd = std::array::from_fn(|k| Dual64::new(v[idx[k]], if k == j { c_v } else { 0.0 }));
+                let column = f.force(x, xd, Dual64::from(t));
+                for i in 0..K {
+                    block[i * K + j] = -column[i].eps;
+                }
+            }
+        }
+        self.items.len() * K * K
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {

@@ -88,6 +88,9 @@ impl<C: Nonholonomic<K, R>, const K: usize, const R: usize> ConstraintBlock for 
     fn values(&self, _q: &[f64], _t: f64, phi: &mut [f64]) {
         phi.fill(0.0);
     }
+    fn holonomic(&self) -> bool {
+        false
+    }
 }
 
 /// Differentiates one element at positions `x`, velocities `v`, free

@@ -1,10 +1,13 @@
 //! Running a model: the controlled state equation `ẋ = f(x, t) + U(x, t)`
-//! ([`system`]), RATTLE's step of a model ([`rattle`]), and the loop that steps it from a consistent initial state
-//! with observers every `k` steps ([`Simulation`], [`Settings`]).
+//! ([`system`]), the schemes that step a model itself — RATTLE
+//! ([`rattle`]) and generalized-α ([`generalized_alpha`]) — and the loop
+//! that steps it from a consistent initial state with observers every `k`
+//! steps ([`Simulation`], [`Settings`]).
 //!
 //! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `integrate`,
 //! `control`.
 
+pub mod generalized_alpha;
 pub mod rattle;
 mod stepper;
 pub mod system;

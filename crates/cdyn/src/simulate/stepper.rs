@@ -13,7 +13,8 @@ use crate::dynamics::{DependentRows, LinearSolver};
 use crate::error::{Error, Part, Problem, Result, positive};
 use crate::integrate::{Buffer, Integrator, Scheme};
 use crate::model::Model;
-use crate::simulate::system::{ControlledSystem, EvalError, RattleFailure, System};
+use crate::simulate::generalized_alpha::GeneralizedAlpha;
+use crate::simulate::system::{AlphaFailure, ControlledSystem, EvalError, RattleFailure, System};
 
 /// How to simulate: [`Settings::new`] and the `with_*` setters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +35,8 @@ pub struct Settings {
     /// Whether a dependent constraint row stops the run (the default) or
     /// is solved around (redundant constraints, singular positions).
     pub dependent_rows: DependentRows,
+    /// `ρ∞` and the Newton iteration of [`Scheme::GeneralizedAlpha`] (unused by the other schemes).
+    pub generalized_alpha: GeneralizedAlpha,
 }
 
 crate::setters!(Settings {
@@ -51,6 +54,8 @@ crate::setters!(Settings {
     with_solver => solver: LinearSolver,
     /// With dependent constraint rows an error or solved around.
     with_dependent_rows => dependent_rows: DependentRows,
+    /// With this `ρ∞` and Newton iteration for generalized-α.
+    with_generalized_alpha => generalized_alpha: GeneralizedAlpha,
 });
 
 impl Settings {
@@ -65,6 +70,7 @@ impl Settings {
             violation_limit: f64::INFINITY,
             solver: LinearSolver::Auto,
             dependent_rows: DependentRows::Error,
+            generalized_alpha: GeneralizedAlpha::new(),
         }
     }
 
@@ -72,6 +78,7 @@ impl Settings {
     pub fn validate(&self) -> Result<()> {
         positive("h", self.h)?;
         self.control.validate()?;
+        self.generalized_alpha.validate()?;
         if let Some(tol) = self.consistency_tolerance {
             positive("consistency tolerance", tol)?;
         }
@@ -102,6 +109,9 @@ pub struct Stepper<S: System> {
     rank_loss: Option<RankLoss>,
     /// Iterations of RATTLE's position step so far.
     rattle_iterations: u64,
+    /// Generalized-α's Newton corrections so far, and the largest one it left.
+    newton_iterations: u64,
+    newton_correction: f64,
 }
 
 /// When the constraints lost rank during a run with
@@ -157,17 +167,24 @@ pub(crate) fn check_initial_state(n: usize, q0: &[f64], v0: &[f64]) -> Result<()
 impl<S: System> Stepper<S> {
     /// Starts `system` at `t = 0` from a checked `(q0, v0)` with valid `settings`.
     pub(crate) fn start(mut system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
-        if settings.scheme == Scheme::Rattle {
-            if !system.offers_rattle() {
+        match settings.scheme {
+            Scheme::Rattle | Scheme::GeneralizedAlpha if !system.offers_model_schemes() => {
                 return Err(Error::Unsupported(
-                    "scheme rattle steps a general model (Simulation), not a SmallSimulation",
+                    "schemes rattle and generalized_alpha step a general model (Simulation), not a SmallSimulation",
                 ));
             }
-            if settings.control.is_active() {
+            Scheme::Rattle if settings.control.is_active() => {
                 return Err(Error::Unsupported(
                     "scheme rattle holds Φ = 0 and Φ̇ = 0 itself: use no control law (method none), or projection to hold the energy as well",
                 ));
             }
+            Scheme::GeneralizedAlpha if settings.control.is_active() => {
+                return Err(Error::Unsupported(
+                    "scheme generalized_alpha holds Φ = 0 itself: use no control law (method none), or projection to hold Φ̇ and the energy as well",
+                ));
+            }
+            Scheme::GeneralizedAlpha => system.prepare_generalized_alpha(settings.generalized_alpha),
+            _ => {}
         }
         let n = q0.len();
         let mut x = system.zero_state();
@@ -205,6 +222,8 @@ impl<S: System> Stepper<S> {
             projection_failures: 0,
             rank_loss: None,
             rattle_iterations: 0,
+            newton_iterations: 0,
+            newton_correction: 0.0,
         })
     }
 
@@ -224,6 +243,16 @@ impl<S: System> Stepper<S> {
     /// Iterations of RATTLE's position step so far ([`Scheme::Rattle`]).
     pub fn rattle_iterations(&self) -> u64 {
         self.rattle_iterations
+    }
+    /// Generalized-α's Newton corrections so far ([`Scheme::GeneralizedAlpha`]).
+    pub fn newton_iterations(&self) -> u64 {
+        self.newton_iterations
+    }
+    /// The largest `|Δq|∞` a generalized-α step left uncorrected so far:
+    /// below the tolerance when Newton converges, what a fixed number of
+    /// corrections reached otherwise.
+    pub fn newton_correction(&self) -> f64 {
+        self.newton_correction
     }
     /// Steps in which the constraints lost rank so far; `None` if none did.
     pub fn rank_loss(&self) -> Option<&RankLoss> {
@@ -293,6 +322,23 @@ impl<S: System> Stepper<S> {
                 Err(RattleFailure::Eval(e)) => return Err(eval_error(e, step, t + h)),
                 Err(RattleFailure::Positions { row, residual, iterations }) => {
                     return Err(Error::RattleFailed { step: step + 1, t: t + h, residual, row, iterations });
+                }
+            }
+        } else if self.settings.scheme == Scheme::GeneralizedAlpha {
+            let (step, t) = (step + 1, t + h);
+            match self.system.generalized_alpha(self.x.as_mut_slice(), t - h, h) {
+                Ok(r) => {
+                    self.newton_iterations += u64::from(r.iterations);
+                    self.newton_correction = self.newton_correction.max(r.correction);
+                }
+                Err(AlphaFailure::Eval(e)) => return Err(eval_error(e, step - 1, t)),
+                Err(AlphaFailure::Singular) => {
+                    let (cause, correction, iterations) = ("met a singular matrix", f64::NAN, 0);
+                    return Err(Error::NewtonFailed { step, t, cause, correction, iterations });
+                }
+                Err(AlphaFailure::NotConverged { correction, iterations }) => {
+                    let cause = "did not converge";
+                    return Err(Error::NewtonFailed { step, t, cause, correction, iterations });
                 }
             }
         } else {

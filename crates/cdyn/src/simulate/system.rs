@@ -13,6 +13,7 @@ use crate::dynamics::{Breakdown, DependentRows, Dynamics, LinearSolver};
 use crate::integrate::{Buffer, Rhs};
 use crate::linalg::mass::{MassAt, MassMatrix};
 use crate::model::Model;
+use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
 
 /// A failed evaluation of the right-hand side.
@@ -79,16 +80,32 @@ pub trait System: Rhs<Error = EvalError> {
     /// Projects the state `x` at time `t` onto the invariants (the
     /// `projection` method); returns the Newton iterations taken.
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure>;
-    /// Whether it can be stepped by [`Scheme::Rattle`](crate::Scheme::Rattle).
-    fn offers_rattle(&self) -> bool {
+    /// Whether it can be stepped by the schemes that step a model itself,
+    /// [`Scheme::Rattle`](crate::Scheme::Rattle) and
+    /// [`Scheme::GeneralizedAlpha`](crate::Scheme::GeneralizedAlpha) ([`Scheme::steps_model`](crate::Scheme::steps_model)).
+    fn offers_model_schemes(&self) -> bool {
         false
     }
     /// One RATTLE step of the state `x` from `t` to `t + h`
     /// ([`crate::simulate::rattle`]); returns the iterations of its position
-    /// step. Called only where [`offers_rattle`](Self::offers_rattle).
+    /// step. Called only where [`offers_model_schemes`](Self::offers_model_schemes).
     fn rattle(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<u32, RattleFailure> {
         let _ = (x, t, h);
         unreachable!("a system that does not offer RATTLE")
+    }
+    /// Makes generalized-α's buffers and Newton matrix pattern, before the
+    /// first [`generalized_alpha`](Self::generalized_alpha) step.
+    fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha) {
+        let _ = settings;
+        unreachable!("a system that does not offer generalized-α")
+    }
+    /// One generalized-α step of the state `x` from `t` to `t + h`
+    /// ([`crate::simulate::generalized_alpha`]). Called only where
+    /// [`offers_model_schemes`](Self::offers_model_schemes), after
+    /// [`prepare_generalized_alpha`](Self::prepare_generalized_alpha).
+    fn generalized_alpha(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<StepReport, AlphaFailure> {
+        let _ = (x, t, h);
+        unreachable!("a system that does not offer generalized-α")
     }
     /// The momenta the system keeps ([`crate::dynamics::momentum`]); none unless it finds them.
     fn symmetries(&self) -> &Symmetries {
@@ -115,6 +132,23 @@ pub enum RattleFailure {
         /// Its `|Φ|`.
         residual: f64,
         /// Iterations taken.
+        iterations: u32,
+    },
+}
+
+/// Why a generalized-α step failed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum AlphaFailure {
+    /// The dynamics could not be evaluated at an iterate.
+    Eval(EvalError),
+    /// The Newton matrix is singular (or its solution not finite).
+    Singular,
+    /// Newton did not converge within its allowed corrections.
+    NotConverged {
+        /// `|Δq|∞` of the correction that would come next.
+        correction: f64,
+        /// Corrections taken.
         iterations: u32,
     },
 }
@@ -155,6 +189,8 @@ pub struct ControlledSystem<'m> {
     turned: Vec<f64>,
     /// RATTLE's buffers (allocated here, so that no step allocates).
     rattle: rattle::Work,
+    /// Generalized-α's state and buffers, made before its first step.
+    alpha: Option<generalized_alpha::Work>,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -183,6 +219,7 @@ impl<'m> ControlledSystem<'m> {
             held: Held::default(),
             turned: vec![0.0; model.n()],
             rattle: rattle::Work::new(model),
+            alpha: None,
         }
     }
 
@@ -342,8 +379,27 @@ impl System for ControlledSystem<'_> {
         };
         momentum::value(self.model, q, v, direction, &mut self.work)
     }
-    fn offers_rattle(&self) -> bool {
+    fn offers_model_schemes(&self) -> bool {
         true
+    }
+    fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha) {
+        self.alpha = Some(generalized_alpha::Work::new(self.model, &self.dynamics, settings));
+    }
+    fn generalized_alpha(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<StepReport, AlphaFailure> {
+        let n = self.model.n();
+        let (q, rest) = x.split_at_mut(n);
+        let (v, e) = rest.split_at_mut(n);
+        let work = self.alpha.as_mut().expect("prepare_generalized_alpha before the first step");
+        let d = &mut self.dynamics;
+        let taken = generalized_alpha::step(self.model, d, q, v, &mut e[0], t, h, work, &mut self.evaluations);
+        self.dependent = self.dependent.max(self.dynamics.dependent_rows());
+        taken.map_err(|f| match f {
+            generalized_alpha::Failure::Breakdown(b, t) => AlphaFailure::Eval(EvalError::at(b, t)),
+            generalized_alpha::Failure::Singular => AlphaFailure::Singular,
+            generalized_alpha::Failure::NotConverged { correction, iterations } => {
+                AlphaFailure::NotConverged { correction, iterations }
+            }
+        })
     }
     fn rattle(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<u32, RattleFailure> {
         let n = self.model.n();

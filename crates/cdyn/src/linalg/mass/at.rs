@@ -60,3 +60,36 @@ impl MassMatrix for MassAt<'_> {
         either!(self, m => m.add_inverse_psi_v(v, scale, out))
     }
 }
+
+impl MassAt<'_> {
+    /// The `(row, column)` of each entry of `M` that can be non-zero, in
+    /// the order [`entry_values`](Self::entry_values) writes them: the
+    /// diagonal, then a block-diagonal `M(q)`'s blocks, or every entry of a dense one.
+    pub(crate) fn entries(&self, out: &mut Vec<(u32, u32)>) {
+        let n = self.n() as u32;
+        match self {
+            MassAt::Diagonal(_) => out.extend((0..n).map(|i| (i, i))),
+            MassAt::Dense(_) => out.extend((0..n).flat_map(|i| (0..n).map(move |j| (i, j)))),
+            MassAt::Blocks(m) => {
+                out.extend((0..n).map(|i| (i, i)));
+                for b in 0..m.blocks() {
+                    let c = m.coordinates(b);
+                    out.extend(c.iter().flat_map(|&i| c.iter().map(move |&j| (i, j))));
+                }
+            }
+        }
+    }
+
+    /// The values of [`entries`](Self::entries), into `out`.
+    pub(crate) fn entry_values(&self, out: &mut [f64]) {
+        match self {
+            MassAt::Diagonal(m) => out.copy_from_slice(m.diagonal()),
+            MassAt::Dense(m) => out.copy_from_slice(m.matrix()),
+            MassAt::Blocks(m) => {
+                let (diagonal, blocks) = out.split_at_mut(m.n());
+                diagonal.copy_from_slice(m.plain_diagonal());
+                blocks.copy_from_slice(m.matrices());
+            }
+        }
+    }
+}

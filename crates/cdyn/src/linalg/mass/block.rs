@@ -85,6 +85,16 @@ impl BlockMass {
         &self.inverse
     }
 
+    /// `M_cc` of the coordinates outside every block (0 inside one).
+    pub(crate) fn plain_diagonal(&self) -> &[f64] {
+        &self.diagonal
+    }
+
+    /// All blocks' matrices, one after another (each `k × k`, row-major).
+    pub(crate) fn matrices(&self) -> &[f64] {
+        &self.matrix
+    }
+
     /// All blocks' matrices, one after another (each `k × k`, row-major),
     /// to be filled before [`factor`](Self::factor).
     pub(crate) fn matrices_mut(&mut self) -> &mut [f64] {

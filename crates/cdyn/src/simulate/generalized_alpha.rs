@@ -1,0 +1,345 @@
+//! Generalized-α (Chung & Hulbert 1993) for the index-3 equations of
+//! motion, in the form Arnold & Brüls (2007) analyse for multibody
+//! systems: `Φ(q, t) = 0` holds at every step to the Newton tolerance.
+//!
+//! From `(q_n, v_n)`, the accelerations `q̈_n` and the auxiliary
+//! accelerations `a_n` (`a_0 = q̈_0`):
+//!
+//! ```text
+//! q_{n+1} = q_n + h v_n + h² (½ − β) a_n + h² β a_{n+1}
+//! v_{n+1} = v_n + h (1 − γ) a_n + h γ a_{n+1}
+//! (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) q̈_{n+1} + α_f q̈_n
+//! M q̈_{n+1} + Φ_qᵀ λ_{n+1} = G(q_{n+1}, v_{n+1}, t_{n+1})
+//! Φ(q_{n+1}, t_{n+1}) = 0        (nonholonomic rows: A v_{n+1} + b = 0)
+//! ```
+//!
+//! with `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`,
+//! `γ = ½ + α_f − α_m`, `β = ¼ (γ + ½)²`: second order, unconditionally
+//! stable on linear problems, and damping the modes far above `1/h` to
+//! the spectral radius `ρ∞` per step (1: none, 0: at once) while those
+//! well below it keep their amplitude to `O(h³)` per step.
+//!
+//! Newton iterates on `q̈_{n+1}` and `λ_{n+1}`. Its unknowns are the
+//! position change `Δq = Δq̈ / β′` and `Δμ = Δλ / β′`, `β′ = (1 − α_m) /
+//! (h² β (1 − α_f))`, which make every block of the matrix of order one:
+//!
+//! ```text
+//! [ M + c_v C + c_q K   Φ_qᵀ ] [Δq]   [ −c_q (M q̈ + Φ_qᵀ λ − G) ]
+//! [ Φ_q                 0    ] [Δμ] = [ −Φ   (−(A v + b)/γ′)     ]
+//! ```
+//!
+//! `c_q = 1/β′`, `c_v = γ′/β′`, `γ′ = γ/(h β)`; `K = −∂G/∂q` and
+//! `C = −∂G/∂v` are the potentials' Hessians and the forces' Jacobians
+//! (springs, dampers), each element's by dual numbers. Left out, so that
+//! the matrix keeps the sparsity of `M` and the elements: the derivatives
+//! of `M(q) q̈` and `Φ_qᵀ λ` in `q` and of Lagrange's velocity terms,
+//! which are `O(h²)` against `M` — the Newton iteration is then
+//! quasi-Newton, with the matrix factored once per step (sparse LU, its
+//! ordering analysed once per model).
+
+use crate::dynamics::{Breakdown, Dynamics};
+use crate::error::{Error, Result};
+use crate::linalg::mass::MassMatrix;
+use crate::linalg::sparse_lu::SparseLu;
+use crate::model::Model;
+
+/// How generalized-α iterates its implicit equations
+/// ([`Scheme::GeneralizedAlpha`](crate::Scheme::GeneralizedAlpha)):
+/// [`GeneralizedAlpha::new`] and the `with_*` setters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct GeneralizedAlpha {
+    /// The spectral radius at infinite frequency, `ρ∞ ∈ [0, 1]`.
+    pub rho_inf: f64,
+    /// When the Newton iteration stops.
+    pub newton: Newton,
+}
+
+/// When the Newton iteration of an implicit step stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Newton {
+    /// When the next correction is below `tolerance` × the largest
+    /// coordinate (at least 1); more than `max_iterations` stop the run.
+    Converge {
+        /// The correction's bound, relative to the largest coordinate.
+        tolerance: f64,
+        /// Corrections allowed per step.
+        max_iterations: u32,
+    },
+    /// After exactly this many corrections, whatever they reach: every
+    /// step costs the same (`iterations + 1` evaluations and one
+    /// factorization), for real-time runs. The run reports the largest
+    /// correction left ([`StepReport::correction`]).
+    Fixed {
+        /// Corrections per step (at least 1).
+        iterations: u32,
+    },
+}
+
+impl Newton {
+    /// Converging to `tolerance`, within `max_iterations`.
+    pub fn converge(tolerance: f64, max_iterations: u32) -> Self {
+        Self::Converge { tolerance, max_iterations }
+    }
+    /// Exactly `iterations` corrections a step.
+    pub fn fixed(iterations: u32) -> Self {
+        Self::Fixed { iterations }
+    }
+}
+
+crate::setters!(GeneralizedAlpha {
+    /// With this `ρ∞`.
+    with_rho_inf => rho_inf: f64,
+    /// With this Newton iteration.
+    with_newton => newton: Newton,
+});
+
+impl Default for GeneralizedAlpha {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl GeneralizedAlpha {
+    /// `ρ∞ = 0.9`, Newton to 1e-10 within 20 corrections.
+    pub fn new() -> Self {
+        Self { rho_inf: 0.9, newton: Newton::converge(1e-10, 20) }
+    }
+
+    /// Checks `ρ∞` and the iteration's bounds.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name, value, reason| Err(Error::InvalidParameter { name, value, reason });
+        if !(0.0..=1.0).contains(&self.rho_inf) {
+            return bad("rho_inf", self.rho_inf, "must lie in [0, 1]");
+        }
+        match self.newton {
+            Newton::Converge { tolerance, .. } if !(tolerance > 0.0 && tolerance.is_finite()) => {
+                bad("newton tolerance", tolerance, "must be positive")
+            }
+            Newton::Converge { max_iterations: 0, .. } => bad("newton max_iterations", 0.0, "must be at least 1"),
+            Newton::Fixed { iterations: 0 } => bad("newton iterations", 0.0, "must be at least 1"),
+            _ => Ok(()),
+        }
+    }
+
+    /// `(α_m, α_f, γ, β)` of `ρ∞`.
+    pub fn coefficients(&self) -> [f64; 4] {
+        let rho = self.rho_inf;
+        let alpha_m = (2.0 * rho - 1.0) / (rho + 1.0);
+        let alpha_f = rho / (rho + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        [alpha_m, alpha_f, gamma, 0.25 * (gamma + 0.5) * (gamma + 0.5)]
+    }
+}
+
+/// What one step's Newton iteration did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    /// Corrections applied.
+    pub iterations: u32,
+    /// `|Δq|∞` of the next correction, not applied: the error left in the positions.
+    pub correction: f64,
+}
+
+/// Why a generalized-α step failed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Failure {
+    /// The dynamics could not be evaluated at an iterate (at time `t`).
+    Breakdown(Breakdown, f64),
+    /// The Newton matrix is singular, or its solution not finite.
+    Singular,
+    /// No convergence within the allowed corrections.
+    NotConverged { correction: f64, iterations: u32 },
+}
+
+/// The scheme's state between steps and its buffers, allocated once per model.
+pub(crate) struct Work {
+    settings: GeneralizedAlpha,
+    /// Per constraint row: holonomic (its value is `Φ`) or not (`A v + b`).
+    holonomic: Vec<bool>,
+    /// Entries of the Newton matrix: `M`, then the elements', `Φ_q`, `Φ_qᵀ`.
+    mass_entries: usize,
+    element_entries: usize,
+    values: Vec<f64>,
+    lu: SparseLu,
+    /// `q̈_n`, `a_n`, `λ_n`, and whether they are known (after the first step).
+    acc: Vec<f64>,
+    aux: Vec<f64>,
+    lambda: Vec<f64>,
+    started: bool,
+    /// `Ė` at the end of the last step.
+    power: f64,
+    /// The iterate: `q̈`, `a`, `λ`; the step's start `(q_n, v_n)`.
+    acc_new: Vec<f64>,
+    aux_new: Vec<f64>,
+    lambda_new: Vec<f64>,
+    q0: Vec<f64>,
+    v0: Vec<f64>,
+    /// The Newton right-hand side and solution, `n + m`.
+    rhs: Vec<f64>,
+}
+
+impl Work {
+    /// For `model`, with the mass matrix as `d` holds it.
+    pub(crate) fn new(model: &Model, d: &Dynamics, settings: GeneralizedAlpha) -> Self {
+        let (n, m) = (model.n(), model.m());
+        let mut entries = Vec::new();
+        d.mass(model).entries(&mut entries);
+        let mass_entries = entries.len();
+        model.iteration_entries(&mut entries);
+        let element_entries = entries.len() - mass_entries;
+        let pattern = model.pattern();
+        for r in 0..m {
+            for j in pattern.row(r) {
+                entries.push(((n + r) as u32, pattern.cols[j]));
+            }
+        }
+        for r in 0..m {
+            for j in pattern.row(r) {
+                entries.push((pattern.cols[j], (n + r) as u32));
+            }
+        }
+        // The zero block's diagonal, listed for the pivoting's sake.
+        entries.extend((n..n + m).map(|i| (i as u32, i as u32)));
+        Self {
+            settings,
+            holonomic: model.holonomic_rows(),
+            mass_entries,
+            element_entries,
+            values: vec![0.0; entries.len()],
+            lu: SparseLu::new(n + m, &entries),
+            acc: vec![0.0; n],
+            aux: vec![0.0; n],
+            lambda: vec![0.0; m],
+            started: false,
+            power: 0.0,
+            acc_new: vec![0.0; n],
+            aux_new: vec![0.0; n],
+            lambda_new: vec![0.0; m],
+            q0: vec![0.0; n],
+            v0: vec![0.0; n],
+            rhs: vec![0.0; n + m],
+        }
+    }
+}
+
+/// One step of `(q, v, e)` from `t` to `t + h`, counting the evaluations
+/// of the dynamics in `evaluations`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn step(
+    model: &Model,
+    d: &mut Dynamics,
+    q: &mut [f64],
+    v: &mut [f64],
+    e: &mut f64,
+    t: f64,
+    h: f64,
+    w: &mut Work,
+    evaluations: &mut u64,
+) -> std::result::Result<StepReport, Failure> {
+    let n = model.n();
+    if !w.started {
+        // Consistent accelerations and multipliers at the start, a_0 = q̈_0.
+        *evaluations += 1;
+        d.evaluate(model, q, v, t).map_err(|b| Failure::Breakdown(b, t))?;
+        w.acc.copy_from_slice(d.acc());
+        w.aux.copy_from_slice(d.acc());
+        w.lambda.copy_from_slice(d.lambda());
+        w.power = d.energy_input();
+        w.started = true;
+    }
+    let [alpha_m, alpha_f, gamma, beta] = w.settings.coefficients();
+    let beta_prime = (1.0 - alpha_m) / (h * h * beta * (1.0 - alpha_f));
+    let gamma_prime = gamma / (h * beta);
+    let (c_q, c_v) = (1.0 / beta_prime, gamma_prime / beta_prime);
+    w.q0.copy_from_slice(q);
+    w.v0.copy_from_slice(v);
+    // The predictor: the accelerations and multipliers of the last step.
+    w.acc_new.copy_from_slice(&w.acc);
+    w.lambda_new.copy_from_slice(&w.lambda);
+    let states = |w: &mut Work, q: &mut [f64], v: &mut [f64]| {
+        for i in 0..n {
+            let aux = ((1.0 - alpha_f) * w.acc_new[i] + alpha_f * w.acc[i] - alpha_m * w.aux[i]) / (1.0 - alpha_m);
+            w.aux_new[i] = aux;
+            q[i] = w.q0[i] + h * w.v0[i] + h * h * ((0.5 - beta) * w.aux[i] + beta * aux);
+            v[i] = w.v0[i] + h * ((1.0 - gamma) * w.aux[i] + gamma * aux);
+        }
+    };
+    states(w, q, v);
+    let scale = w.q0.iter().fold(1.0_f64, |a, q| a.max(q.abs()));
+    let t1 = t + h;
+    let mut iterations = 0;
+    let correction = loop {
+        *evaluations += 1;
+        d.evaluate_forces(model, q, v, t1).map_err(|b| Failure::Breakdown(b, t1))?;
+        residual(model, d, w, c_q, gamma_prime);
+        if iterations == 0 {
+            newton_matrix(model, d, q, v, t1, c_q, c_v, w);
+            w.lu.factor(&w.values).map_err(|_| Failure::Singular)?;
+        }
+        w.lu.solve(&mut w.rhs);
+        let correction = w.rhs[..n].iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        if !correction.is_finite() || w.rhs[n..].iter().any(|x| !x.is_finite()) {
+            return Err(Failure::Singular);
+        }
+        match w.settings.newton {
+            Newton::Converge { tolerance, .. } if correction <= tolerance * scale => break correction,
+            Newton::Converge { max_iterations, .. } if iterations == max_iterations => {
+                return Err(Failure::NotConverged { correction, iterations });
+            }
+            Newton::Fixed { iterations: fixed } if iterations == fixed => break correction,
+            _ => {}
+        }
+        for (a, dq) in w.acc_new.iter_mut().zip(&w.rhs[..n]) {
+            *a += beta_prime * dq;
+        }
+        for (l, dmu) in w.lambda_new.iter_mut().zip(&w.rhs[n..]) {
+            *l += beta_prime * dmu;
+        }
+        states(w, q, v);
+        iterations += 1;
+    };
+    std::mem::swap(&mut w.acc, &mut w.acc_new);
+    std::mem::swap(&mut w.aux, &mut w.aux_new);
+    std::mem::swap(&mut w.lambda, &mut w.lambda_new);
+    // Ė = F·v + λᵀΦ_t at the last evaluated iterate (its λ, not the dynamics').
+    let power = crate::dynamics::energy::power(d.force_power(), &w.lambda, d.phi_t());
+    *e += 0.5 * h * (w.power + power);
+    w.power = power;
+    Ok(StepReport { iterations, correction })
+}
+
+/// The Newton right-hand side at the iterate, into `w.rhs`.
+fn residual(model: &Model, d: &Dynamics, w: &mut Work, c_q: f64, gamma_prime: f64) {
+    let n = model.n();
+    let (top, rows) = w.rhs.split_at_mut(n);
+    d.mass(model).mul(&w.acc_new, top);
+    let pattern = model.pattern();
+    for (r, lambda) in w.lambda_new.iter().enumerate() {
+        for j in pattern.row(r) {
+            top[pattern.cols[j] as usize] += d.jac()[j] * lambda;
+        }
+    }
+    for (x, g) in top.iter_mut().zip(d.force()) {
+        *x = -c_q * (*x - g);
+    }
+    for (r, x) in rows.iter_mut().enumerate() {
+        *x = if w.holonomic[r] { -d.phi()[r] } else { -d.phi_dot()[r] / gamma_prime };
+    }
+}
+
+/// The Newton matrix's values at the iterate, into `w.values`.
+#[allow(clippy::too_many_arguments)]
+fn newton_matrix(model: &Model, d: &Dynamics, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, w: &mut Work) {
+    let (mass, rest) = w.values.split_at_mut(w.mass_entries);
+    d.mass(model).entry_values(mass);
+    let (elements, rest) = rest.split_at_mut(w.element_entries);
+    model.iteration_values(q, v, t, c_q, c_v, elements);
+    let nnz = model.pattern().nnz();
+    let (jac, rest) = rest.split_at_mut(nnz);
+    let (jac_t, zeros) = rest.split_at_mut(nnz);
+    jac.copy_from_slice(d.jac());
+    jac_t.copy_from_slice(d.jac());
+    zeros.fill(0.0);
+}
