@@ -268,6 +268,17 @@ impl Dynamics {
         }
     }
 
+    /// `out += Φ_qᵀ y` with the Jacobian of the last evaluation: the
+    /// constraint forces of multipliers `y`, unweighted by `M⁻¹`.
+    pub fn add_jt(&self, model: &Model, y: &[f64], out: &mut [f64]) {
+        let (pattern, jac) = (model.pattern(), &self.constraints.jac);
+        for (r, y) in y.iter().enumerate() {
+            for j in pattern.row(r) {
+                out[pattern.cols[j] as usize] += jac[j] * y;
+            }
+        }
+    }
+
     /// `out = Φ_q x` with the Jacobian of the last [`evaluate`](Self::evaluate),
     /// without bounds checks (see [`add_weighted_jt`](Self::add_weighted_jt)).
     pub fn jac_mul(&self, model: &Model, x: &[f64], out: &mut [f64]) {

@@ -313,7 +313,7 @@ impl Model {
         self.forces.iter().for_each(|b| b.add_damping(q, v, w, t, out));
     }
 
-    /// The `(row, column)` of the entries [`add_iteration_values`](Self::add_iteration_values)
+    /// The `(row, column)` of the entries [`iteration_values`](Self::iteration_values)
     /// writes: each potential's Hessian block, then each force's Jacobian block.
     pub(crate) fn iteration_entries(&self, out: &mut Vec<(u32, u32)>) {
         self.potentials.iter().for_each(|p| p.hessian_entries(out));

@@ -28,7 +28,7 @@ pub(crate) trait PotentialBlock: Send + Sync {
     /// Returns `V` and adds `∇V` into `grad`.
     fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64;
     fn energy(&self, q: &[f64]) -> f64;
-    /// The `(row, column)` of each entry of [`add_hessians`](Self::add_hessians), element after element.
+    /// The `(row, column)` of each entry of [`hessians`](Self::hessians), element after element.
     fn hessian_entries(&self, out: &mut Vec<(u32, u32)>);
     /// Writes `scale · ∇²V` of each element (`K × K`, row-major) into `out`; returns the entries written.
     fn hessians(&self, q: &[f64], scale: f64, out: &mut [f64]) -> usize;
@@ -89,11 +89,10 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     }
 
     fn hessians(&self, q: &[f64], scale: f64, out: &mut [f64]) -> usize {
+        // ∂²V/∂xᵢ∂xⱼ: V along x + ε₁eᵢ + ε₂eⱼ, its ε₁ε₂ part.
+        let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
         let hyper = |x: &[f64; K], i: usize, j: usize, p: &P| {
-            let x = std::array::from_fn(|k| {
-                HyperDual64::new(x[k], f64::from(u8::from(k == i)), f64::from(u8::from(k == j)), 0.0)
-            });
-            p.energy(x).eps1eps2
+            p.energy(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0))).eps1eps2
         };
         for ((p, idx), block) in self.items.iter().zip(out.chunks_exact_mut(K * K)) {
             let x = std::array::from_fn(|j| q[idx[j]]);

@@ -315,12 +315,7 @@ fn residual(model: &Model, d: &Dynamics, w: &mut Work, c_q: f64, gamma_prime: f6
     let n = model.n();
     let (top, rows) = w.rhs.split_at_mut(n);
     d.mass(model).mul(&w.acc_new, top);
-    let pattern = model.pattern();
-    for (r, lambda) in w.lambda_new.iter().enumerate() {
-        for j in pattern.row(r) {
-            top[pattern.cols[j] as usize] += d.jac()[j] * lambda;
-        }
-    }
+    d.add_jt(model, &w.lambda_new, top);
     for (x, g) in top.iter_mut().zip(d.force()) {
         *x = -c_q * (*x - g);
     }

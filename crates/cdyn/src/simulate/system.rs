@@ -160,6 +160,13 @@ pub fn split_state(x: &[f64], n: usize) -> (&[f64], &[f64], f64) {
     (&x[..n], &x[n..2 * n], x[2 * n])
 }
 
+/// Splits a state into `(q, v, e)`, each to be written.
+fn split_state_mut(x: &mut [f64], n: usize) -> (&mut [f64], &mut [f64], &mut f64) {
+    let (q, rest) = x.split_at_mut(n);
+    let (v, e) = rest.split_at_mut(n);
+    (q, v, &mut e[0])
+}
+
 /// A model with a control law: the right-hand side an [`Integrator`](crate::integrate::Integrator) steps.
 pub struct ControlledSystem<'m> {
     model: &'m Model,
@@ -285,9 +292,8 @@ impl Rhs for ControlledSystem<'_> {
         f[2 * n] = e_dot;
         if let Some(u) = u {
             let psi = energy::psi(&self.dynamics.mass(self.model), v, self.dynamics.potential(), e, self.e0);
-            let (u_q, rest) = u.split_at_mut(n);
-            let (u_v, u_e) = rest.split_at_mut(n);
-            u_e[0] = 0.0;
+            let (u_q, u_v, u_e) = split_state_mut(u, n);
+            *u_e = 0.0;
             let [r0, r1, r2, r3, r4] = &mut self.rows;
             if self.momenta.stale() {
                 self.momenta.update(&self.dynamics.mass(self.model));
@@ -387,11 +393,10 @@ impl System for ControlledSystem<'_> {
     }
     fn generalized_alpha(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<StepReport, AlphaFailure> {
         let n = self.model.n();
-        let (q, rest) = x.split_at_mut(n);
-        let (v, e) = rest.split_at_mut(n);
+        let (q, v, e) = split_state_mut(x, n);
         let work = self.alpha.as_mut().expect("prepare_generalized_alpha before the first step");
         let d = &mut self.dynamics;
-        let taken = generalized_alpha::step(self.model, d, q, v, &mut e[0], t, h, work, &mut self.evaluations);
+        let taken = generalized_alpha::step(self.model, d, q, v, e, t, h, work, &mut self.evaluations);
         self.dependent = self.dependent.max(self.dynamics.dependent_rows());
         taken.map_err(|f| match f {
             generalized_alpha::Failure::Breakdown(b, t) => AlphaFailure::Eval(EvalError::at(b, t)),
@@ -403,10 +408,9 @@ impl System for ControlledSystem<'_> {
     }
     fn rattle(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<u32, RattleFailure> {
         let n = self.model.n();
-        let (q, rest) = x.split_at_mut(n);
-        let (v, e) = rest.split_at_mut(n);
+        let (q, v, e) = split_state_mut(x, n);
         let work = &mut self.rattle;
-        let taken = rattle::step(self.model, &mut self.dynamics, q, v, &mut e[0], t, h, work, &mut self.evaluations);
+        let taken = rattle::step(self.model, &mut self.dynamics, q, v, e, t, h, work, &mut self.evaluations);
         self.dependent = self.dependent.max(self.dynamics.dependent_rows());
         taken.map_err(|f| match f {
             rattle::Failure::Breakdown(b, t) => RattleFailure::Eval(EvalError::at(b, t)),
@@ -418,9 +422,8 @@ impl System for ControlledSystem<'_> {
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
         self.rattle.forget();
         let n = self.model.n();
-        let (q, rest) = x.split_at_mut(n);
-        let (v, e) = rest.split_at_mut(n);
-        let target = self.e0 + e[0];
+        let (q, v, e) = split_state_mut(x, n);
+        let target = self.e0 + *e;
         let (model, d) = (self.model, &mut self.dynamics);
         let (momenta, held) = (&mut self.momenta, &mut self.held);
         projection::invariants(model, d, momenta, held, q, v, t, target, h, settings, &mut self.projection)
