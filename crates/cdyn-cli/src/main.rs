@@ -98,6 +98,15 @@ enum Command {
         #[arg(long)]
         light: bool,
     },
+    /// Work-precision diagrams: a scenario at a range of steps for every scheme × method, its error
+    /// against a reference and its cost; writes precision.json, precision.csv and precision.png.
+    #[command(
+        after_help = "Example: cdyn precision examples/suite/example1.toml --out out/precision --schemes ab3,rk4,abm4"
+    )]
+    Precision {
+        #[command(flatten)]
+        args: commands::precision::PrecisionArgs,
+    },
     /// Run a scenario file.
     #[command(after_help = "Example: cdyn run examples/four_bar.toml --out out/four_bar --html")]
     Run {
@@ -142,6 +151,7 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Paper { out } => commands::paper::paper(&out),
         Command::Run { case } => commands::run::run(case),
         Command::Compare { case } => commands::compare::compare(case),
+        Command::Precision { args } => commands::precision::precision(args).map(done),
         Command::Bench { out, light } => commands::bench::bench(&out, light).map(done),
         Command::Sweep { scenario, out, shard, threads, listing } => {
             commands::sweep::sweep(&scenario, &out, shard.as_deref(), threads, &listing).map(done)

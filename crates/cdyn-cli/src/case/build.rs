@@ -86,6 +86,7 @@ impl Scenario {
         for (k, spec) in self.invariants.iter().enumerate() {
             spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
         }
+        let mut changed = false;
         for (key, given, default) in [("q", &init.q, &mut example.q0), ("v", &init.v, &mut example.v0)] {
             if let Some(given) = given {
                 if given.len() != default.len() {
@@ -98,8 +99,15 @@ impl Scenario {
                 if let Some(x) = given.iter().find(|x| !x.is_finite()) {
                     bail!("{file}: [initial] {key} contains {x}: must be finite");
                 }
+                if given != default {
+                    // The model's reference solves its own initial state, not this one.
+                    changed = true;
+                }
                 default.clone_from(given);
             }
+        }
+        if changed {
+            example.reference = None;
         }
         let assembly = if init.assemble.unwrap_or(self.model.kind.is_described()) {
             let tolerance = settings.consistency_tolerance.unwrap_or(1e-9).min(1e-10);

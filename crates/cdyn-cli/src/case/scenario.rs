@@ -184,7 +184,7 @@ pub struct IntegratorSpec {
     pub dependent_rows: DependentRows,
     /// Generalized-α's spectral radius at infinite frequency, in [0, 1] (default 0.9).
     pub rho_inf: Option<f64>,
-    /// Generalized-α's Newton tolerance, relative to the largest coordinate (default 1e-10).
+    /// Generalized-α's Newton tolerance on the accelerations' correction, relative to the largest acceleration (default 1e-10).
     pub newton_tolerance: Option<f64>,
     /// Generalized-α's Newton corrections allowed per step (default 20).
     pub newton_max_iterations: Option<u32>,

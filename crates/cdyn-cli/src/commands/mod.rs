@@ -6,6 +6,7 @@ pub mod bench;
 pub mod compare;
 pub mod manual;
 pub mod paper;
+pub mod precision;
 pub mod run;
 pub mod suite;
 pub mod sweep;

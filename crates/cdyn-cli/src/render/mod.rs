@@ -1,6 +1,7 @@
 //! What the commands write for people to look at: the summary and figures
 //! of a set of runs ([`report`]), plots ([`plot`]), heat maps
-//! ([`heatmap`]), the suite's figure ([`suite_plot`]), animated GIFs
+//! ([`heatmap`]), the suite's figure ([`suite_plot`]), work-precision
+//! diagrams ([`precision_plot`]), animated GIFs
 //! ([`gif`]), the HTML viewer ([`viewer`]) and the spatial views
 //! ([`view3d`]).
 //!
@@ -9,6 +10,7 @@
 pub mod gif;
 pub mod heatmap;
 pub mod plot;
+pub mod precision_plot;
 pub mod report;
 pub mod suite_plot;
 pub mod view3d;

@@ -238,7 +238,7 @@ fn log_tick(v: f64, shift: i32, (lo, hi): (f64, f64)) -> String {
 }
 
 /// Line style of series `i`: the ten hues first, then the hues again dashed, then dotted.
-fn style(i: usize) -> (ShapeStyle, Option<(u32, u32)>) {
+pub(crate) fn style(i: usize) -> (ShapeStyle, Option<(u32, u32)>) {
     let c = PALETTE[i % 10];
     let color = RGBColor((c >> 16) as u8, (c >> 8) as u8, c as u8);
     (color.stroke_width(2), [None, Some((12, 6)), Some((2, 5))][(i / 10) % 3])
@@ -275,7 +275,7 @@ fn widest<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, texts: impl Iterato
     Ok(w)
 }
 
-fn de<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
+pub(crate) fn de<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
     anyhow!("{e}")
 }
 

@@ -136,7 +136,7 @@ pub enum Error {
     },
     /// Generalized-α's Newton iteration failed.
     #[error(
-        "generalized-α's Newton iteration {cause} at step {step}, t = {}: |Δq| = {correction:.3e} after {iterations} corrections (take a smaller h, or allow more newton iterations)",
+        "generalized-α's Newton iteration {cause} at step {step}, t = {}: relative |Δq̈| = {correction:.3e} after {iterations} corrections (take a smaller h, or allow more newton iterations)",
         Time(*t)
     )]
     NewtonFailed {
@@ -146,7 +146,8 @@ pub enum Error {
         t: f64,
         /// `did not converge`, or `met a singular matrix`.
         cause: &'static str,
-        /// `|Δq|∞` of the correction that would come next (NaN where singular).
+        /// `|Δq̈|∞` of the correction that would come next, over the largest
+        /// acceleration (NaN where singular).
         correction: f64,
         /// Corrections taken.
         iterations: u32,

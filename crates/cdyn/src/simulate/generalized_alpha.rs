@@ -59,10 +59,17 @@ pub struct GeneralizedAlpha {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Newton {
-    /// When the next correction is below `tolerance` × the largest
-    /// coordinate (at least 1); more than `max_iterations` stop the run.
+    /// When the next correction of the accelerations is below
+    /// `tolerance` × the largest acceleration of the last step (at least
+    /// 1), or the position correction it makes is at the round-off of
+    /// the positions (100 ε × the largest coordinate, at least 1; at
+    /// small steps that is the accelerations' own round-off); more than
+    /// `max_iterations` stop the run. The accelerations, not the
+    /// positions, are judged: an error `δ` left in `q̈` at every step
+    /// moves the positions by about `δ t²/2` over a run, while the same
+    /// iterate's position correction is only `h² β δ`.
     Converge {
-        /// The correction's bound, relative to the largest coordinate.
+        /// The correction's bound, relative to the largest acceleration.
         tolerance: f64,
         /// Corrections allowed per step.
         max_iterations: u32,
@@ -138,7 +145,8 @@ impl GeneralizedAlpha {
 pub struct StepReport {
     /// Corrections applied.
     pub iterations: u32,
-    /// `|Δq|∞` of the next correction, not applied: the error left in the positions.
+    /// `|Δq̈|∞` of the next correction, not applied, over the largest
+    /// acceleration of the last step (at least 1): the error left in the accelerations.
     pub correction: f64,
 }
 
@@ -224,6 +232,10 @@ impl Work {
     }
 }
 
+/// A position correction this small (relative to the largest coordinate)
+/// is round-off: Newton stops there whatever its tolerance.
+const POSITION_ROUND_OFF: f64 = 100.0 * f64::EPSILON;
+
 /// One step of `(q, v, e)` from `t` to `t + h`, counting the evaluations
 /// of the dynamics in `evaluations`.
 #[allow(clippy::too_many_arguments)]
@@ -267,7 +279,9 @@ pub(crate) fn step(
         }
     };
     states(w, q, v);
-    let scale = w.q0.iter().fold(1.0_f64, |a, q| a.max(q.abs()));
+    let scale = w.acc.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+    // The accelerations' round-off: that of the positions, over h² β.
+    let round_off = POSITION_ROUND_OFF * beta_prime * w.q0.iter().fold(1.0_f64, |a, x| a.max(x.abs())) / scale;
     let t1 = t + h;
     let mut iterations = 0;
     let correction = loop {
@@ -279,12 +293,12 @@ pub(crate) fn step(
             w.lu.factor(&w.values).map_err(|_| Failure::Singular)?;
         }
         w.lu.solve(&mut w.rhs);
-        let correction = w.rhs[..n].iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        let correction = beta_prime * w.rhs[..n].iter().fold(0.0_f64, |a, x| a.max(x.abs())) / scale;
         if !correction.is_finite() || w.rhs[n..].iter().any(|x| !x.is_finite()) {
             return Err(Failure::Singular);
         }
         match w.settings.newton {
-            Newton::Converge { tolerance, .. } if correction <= tolerance * scale => break correction,
+            Newton::Converge { tolerance, .. } if correction <= tolerance + round_off => break correction,
             Newton::Converge { max_iterations, .. } if iterations == max_iterations => {
                 return Err(Failure::NotConverged { correction, iterations });
             }
