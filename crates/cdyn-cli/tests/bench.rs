@@ -30,6 +30,21 @@ fn light_bench_writes_a_complete_report() {
         assert!(c["max_abs_phi"].as_f64().unwrap() < 1e-8, "{c}");
         assert_eq!(c["allocations_per_step"].as_f64(), Some(0.0), "{c}");
     }
+    let alpha = r["generalized_alpha_chain"].as_array().unwrap();
+    assert_eq!(alpha.iter().map(|c| c["n"].as_u64().unwrap()).collect::<Vec<_>>(), [10, 100, 1000]);
+    for c in alpha {
+        // Newton's tolerance on the positions' round-off, 100 ε × up to 1 000 m.
+        assert!(c["max_abs_phi"].as_f64().unwrap() < 1e-9, "{c}");
+        assert_eq!(c["allocations_per_step"].as_f64(), Some(0.0), "{c}");
+    }
+    assert!(r["generalized_alpha_chain_cost_exponent"].as_f64().is_some());
+    let flyball = r["flyball"].as_array().unwrap();
+    let runs: Vec<_> = flyball.iter().map(|f| (f["scheme"].as_str().unwrap(), f["h"].as_f64().unwrap())).collect();
+    assert_eq!(runs, [("rk4", 5e-5), ("rk4", 2.5e-4), ("generalized_alpha", 1e-3)]);
+    for f in flyball {
+        assert!(f["ms_per_simulated_second"].as_f64().unwrap() > 0.0, "{f}");
+        assert_eq!(f["allocations_per_step"].as_f64(), Some(0.0), "{f}");
+    }
     let against_hand = r["spatial_handwritten"].as_array().unwrap();
     assert_eq!(against_hand.iter().map(|c| c["n"].as_u64().unwrap()).collect::<Vec<_>>(), [10, 100]);
     for c in against_hand {
@@ -43,7 +58,7 @@ fn light_bench_writes_a_complete_report() {
 
 /// The methods' comparison: every model and method, ratios to
 /// `cvsgf_energy` taken within a trial (so its own is exactly 1), the
-/// projection's and RATTLE's iterations counted and their violations
+/// projection's, RATTLE's and generalized-α's iterations counted and their violations
 /// within their tolerances.
 #[test]
 fn light_bench_compares_robust_projection_and_rattle_with_cvsgf_energy() {
@@ -58,7 +73,7 @@ fn light_bench_compares_robust_projection_and_rattle_with_cvsgf_energy() {
     for m in comparisons {
         let methods = m["methods"].as_array().unwrap();
         let names: Vec<_> = methods.iter().map(|c| c["method"].as_str().unwrap()).collect();
-        assert_eq!(names, ["cvsgf_energy", "robust", "projection", "rattle"], "{m}");
+        assert_eq!(names, ["cvsgf_energy", "robust", "projection", "rattle", "generalized_alpha"], "{m}");
         assert_eq!(methods[0]["ratio_to_cvsgf_energy"].as_f64(), Some(1.0), "{m}");
         for c in methods {
             assert!(c["us_per_step"].as_f64().unwrap() > 0.0, "{c}");
@@ -75,6 +90,10 @@ fn light_bench_compares_robust_projection_and_rattle_with_cvsgf_energy() {
                 assert!(iterations.unwrap() >= 0.0, "{c}");
                 // 256 ε × the largest coordinate (up to 1 000 on the chain).
                 assert!(c["max_abs_phi"].as_f64().unwrap() <= 6e-11, "{c}");
+            } else if c["method"] == "generalized_alpha" {
+                // At least one Newton correction a step.
+                assert!(iterations.unwrap() >= 1.0, "{c}");
+                assert!(c["max_abs_phi"].as_f64().unwrap() < 1e-9, "{c}");
             } else {
                 assert_eq!(iterations, None, "{c}");
             }
@@ -85,5 +104,6 @@ fn light_bench_compares_robust_projection_and_rattle_with_cvsgf_energy() {
     }
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("robust") && table.contains("projection") && table.contains("rattle"), "{table}");
+    assert!(table.contains("generalized_alpha") && table.contains("flyball"), "{table}");
     assert!(table.contains("iter/step"), "{table}");
 }

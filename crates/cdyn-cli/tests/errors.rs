@@ -189,3 +189,24 @@ fn shipped_examples_run() {
         }
     }
 }
+
+#[test]
+fn a_run_stopped_by_stiff_damping_names_generalized_alpha_and_a_stable_step() {
+    // The flyball governor at 1 kHz: RK-4 stops within a few steps.
+    let flyball = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/flyball_governor.toml"))
+        .unwrap()
+        .replace("h = 5e-5", "h = 1e-3");
+    let (line, _) = error_of(&flyball);
+    assert!(line.contains("at step 4"), "{line}");
+    assert!(line.contains("scheme = \"generalized_alpha\" has no such limit"), "{line}");
+    // h λ_d = 8.1 at 1e-3 and RK-4's limit 2.785: half of it at h ≤ 1.7e-4.
+    assert!(line.contains("rk4 needs h ≤ 1.71e-4"), "{line}");
+    // And generalized-α does run there (`tests/generalized_alpha` checks its accuracy).
+    let alpha =
+        flyball.replace("scheme = \"rk4\"", "scheme = \"generalized_alpha\"").replace("t_end = 2.0", "t_end = 0.05");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("alpha.toml");
+    std::fs::write(&path, alpha).unwrap();
+    let out = cdyn(&["run"], Some(&path), &dir.path().join("out"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}

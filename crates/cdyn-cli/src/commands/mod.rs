@@ -79,9 +79,16 @@ pub fn ended(results: &[CaseResult], out: &Path) -> Result<Ended> {
                 out.display()
             ),
         }),
-        _ => match results.iter().find_map(|r| r.error.as_ref()) {
+        _ => match results.iter().find(|r| r.error.is_some()) {
             // A run that failed part-way still wrote its output; say where, and fail.
-            Some(e) => bail!("{e} (output up to that point is in {})", out.display()),
+            Some(r) => {
+                let hint = cdyn_cli::render::report::stiff_hint(r).map_or(String::new(), |h| format!("; {h}"));
+                bail!(
+                    "{}{hint} (output up to that point is in {})",
+                    r.error.as_deref().unwrap_or_default(),
+                    out.display()
+                )
+            }
             None => Ok(Ended::Done),
         },
     }

@@ -121,6 +121,7 @@ pub fn table(cases: &[CaseResult]) -> String {
         );
     }
     out += &momenta_lines(cases);
+    out += &stiff_lines(cases);
     for c in cases {
         if let Some(t) = c.tuning.filter(|t| t.energy_left_out) {
             let projected = c.control.is_some_and(|c| c.projection.is_some());
@@ -134,6 +135,34 @@ pub fn table(cases: &[CaseResult]) -> String {
         }
     }
     out
+}
+
+/// Damping this close to an explicit scheme's stability limit (as a
+/// fraction of its real interval) is named with the way out.
+const NEAR_STABILITY_LIMIT: f64 = 0.5;
+
+/// For a case of an explicit scheme whose damping is stiff against its
+/// step (`h λ_d` beyond half the scheme's real stability interval), what
+/// to do: generalized-α, which has no such limit, or the explicit step
+/// that would be stable.
+pub fn stiff_hint(c: &CaseResult) -> Option<String> {
+    let (t, scheme) = (c.tuning?, cdyn::Scheme::from_name(c.scheme)?);
+    let limit = cdyn::control::gains::real_stability_interval(scheme);
+    if scheme.steps_model() || t.dissipation_h <= NEAR_STABILITY_LIMIT * limit {
+        return None;
+    }
+    Some(format!(
+        "the damping is stiff against the step (h λ_d = {:.3}; {}'s stability limit is {limit:.3}): scheme = \"generalized_alpha\" has no such limit and damps it at this h, or {} needs h ≤ {:.2e}",
+        t.dissipation_h,
+        c.scheme,
+        c.scheme,
+        NEAR_STABILITY_LIMIT * limit * c.h / t.dissipation_h
+    ))
+}
+
+/// A note for each case with a [`stiff_hint`].
+fn stiff_lines(cases: &[CaseResult]) -> String {
+    cases.iter().filter_map(|c| stiff_hint(c).map(|hint| format!("note: {}: {hint}\n", c.name))).collect()
 }
 
 /// What the momenta did: the ones the system keeps (from the first case

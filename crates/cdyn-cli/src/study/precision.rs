@@ -145,7 +145,8 @@ pub struct Precision {
     pub reference: Reference,
     /// One per scheme × method.
     pub lines: Vec<Line>,
-    /// For each of [`TARGETS`] some line reaches, the cheapest there.
+    /// For each of [`TARGETS`] some line reaches (and ten times above the
+    /// reference's error bound), the cheapest there.
     pub cheapest: Vec<Cheapest>,
 }
 
@@ -209,7 +210,9 @@ pub fn run(path: &Path, options: &Options) -> Result<Precision> {
         })
         .collect();
     bar.finish_and_clear();
-    let cheapest = TARGETS.iter().filter_map(|&target| cheapest(&lines, target)).collect();
+    // A target within ten times the reference's own error is not told apart from it.
+    let told_apart = |target: f64| target > 10.0 * reference.error_bound;
+    let cheapest = TARGETS.iter().filter(|&&t| told_apart(t)).filter_map(|&target| cheapest(&lines, target)).collect();
     Ok(Precision { scenario: file, t_end, sample_interval: coarsest, reference, lines, cheapest })
 }
 

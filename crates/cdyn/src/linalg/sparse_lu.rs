@@ -2,9 +2,9 @@
 //! partial pivoting and solved many times: the Newton matrix
 //! `[M + c_v C + c_q K, Φ_qᵀ; Φ_q, 0]` of an implicit step, which is
 //! indefinite (no Cholesky) and whose pattern never changes. The pattern
-//! and its fill-reducing ordering are analysed once; every factorization
-//! after the first reuses the storage of the one before, so steps do not
-//! allocate.
+//! and its fill-reducing ordering are analysed once, and the factors'
+//! storage is sized when the system is made ([`SparseLu::reserve`]), so
+//! steps do not allocate.
 
 use faer::Par;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -61,7 +61,7 @@ impl SparseLu {
             symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         );
-        Self {
+        let mut lu = Self {
             dim,
             values: vec![0.0; row_idx.len()],
             col_ptr,
@@ -71,7 +71,24 @@ impl SparseLu {
             numeric: NumericLu::new(),
             factored: false,
             memory: MemBuffer::new(scratch),
-        }
+        };
+        // A first factorization, of a diagonally dominant matrix with the
+        // pattern (ones off the diagonal), sizes the factors' storage for
+        // the pattern's fill, so that the first step does not allocate it.
+        // A real matrix's pivoting may need more, once.
+        let warm: Vec<f64> =
+            entries.iter().map(|&(r, c)| if r == c { 2.0 * entries.len() as f64 } else { 1.0 }).collect();
+        lu.reserve(&warm);
+        lu
+    }
+
+    /// Factors `values` to size the factors' storage, and forgets the
+    /// factorization: a matrix with the pivoting of the real ones leaves
+    /// room for their fill. A singular one does nothing (the real
+    /// factorization says so, if it is).
+    pub(crate) fn reserve(&mut self, values: &[f64]) {
+        let _ = self.factor(values);
+        self.factored = false;
     }
 
     /// Factors the matrix whose listed entries have `values` (in the order of [`new`](Self::new)'s).

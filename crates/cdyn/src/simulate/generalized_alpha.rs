@@ -210,13 +210,25 @@ impl Work {
         }
         // The zero block's diagonal, listed for the pivoting's sake.
         entries.extend((n..n + m).map(|i| (i as u32, i as u32)));
+        let mut lu = SparseLu::new(n + m, &entries);
+        // A saddle point like the real matrices (the zero block zero), so
+        // that the first step's pivoting finds the storage it needs.
+        let saddle: Vec<f64> = entries
+            .iter()
+            .map(|&(r, c)| match (r == c, (r as usize) < n) {
+                (true, true) => 4.0,
+                (true, false) => 0.0,
+                (false, _) => 1.0,
+            })
+            .collect();
+        lu.reserve(&saddle);
         Self {
             settings,
             holonomic: model.holonomic_rows(),
             mass_entries,
             element_entries,
             values: vec![0.0; entries.len()],
-            lu: SparseLu::new(n + m, &entries),
+            lu,
             acc: vec![0.0; n],
             aux: vec![0.0; n],
             lambda: vec![0.0; m],

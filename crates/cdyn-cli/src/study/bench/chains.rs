@@ -8,7 +8,7 @@ use cdyn::{Scheme, Settings, Simulation};
 use serde::Serialize;
 use std::time::Instant;
 
-/// One size of the planar chain (`cvsgf_energy`, AB-3, h = 1e-3).
+/// One size of a chain at h = 1e-3: AB-3 with `cvsgf_energy`, or generalized-α.
 #[derive(Debug, Serialize)]
 pub struct ChainRun {
     /// Bodies.
@@ -42,14 +42,14 @@ pub struct SpatialBaseline {
     pub overhead_ratio: f64,
 }
 
-pub(super) fn chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
+pub(super) fn chain_run(n: usize, t_end: f64, scheme: Scheme) -> Result<ChainRun> {
     let ex = chain_example(n)?;
-    timed_chain(n, &ex.model, &ex.q0, &ex.v0, t_end)
+    timed_chain(n, &ex.model, &ex.q0, &ex.v0, t_end, scheme)
 }
 
 pub(super) fn spatial_chain_run(n: usize, t_end: f64) -> Result<ChainRun> {
     let built = cdyn::spatial::chain(n, 0.3, 1.0).build()?;
-    timed_chain(n, &built.model, &built.q0, &built.v0, t_end)
+    timed_chain(n, &built.model, &built.q0, &built.v0, t_end, Scheme::AdamsBashforth3)
 }
 
 /// The spatial chain of `n` rods in cdyn and hand-written, in interleaved
@@ -81,10 +81,19 @@ pub(super) fn spatial_baseline(n: usize, steps: u64, trials: usize) -> Result<Sp
     })
 }
 
-/// A chain's run at h = 1e-3, AB-3, with [`chain_control`].
-pub(super) fn timed_chain(n: usize, model: &cdyn::Model, q0: &[f64], v0: &[f64], t_end: f64) -> Result<ChainRun> {
+/// A chain's run at h = 1e-3: AB-3 with [`chain_control`], or a scheme
+/// that steps the model (RATTLE, generalized-α) without control.
+pub(super) fn timed_chain(
+    n: usize,
+    model: &cdyn::Model,
+    q0: &[f64],
+    v0: &[f64],
+    t_end: f64,
+    scheme: Scheme,
+) -> Result<ChainRun> {
     let h = 1e-3;
-    let settings = Settings::new(Scheme::AdamsBashforth3, h, chain_control(h));
+    let control = if scheme.steps_model() { Control::none() } else { chain_control(h) };
+    let settings = Settings::new(scheme, h, control);
     let mut sim = Simulation::new(model, settings, q0, v0)?;
     let steps = cdyn::simulate::steps_to(t_end, h)?;
     let mut phi = vec![0.0; model.m()];

@@ -12,14 +12,15 @@ use std::time::Instant;
 /// One method's cost on one model, over the interleaved trials of a [`MethodComparison`].
 #[derive(Debug, Serialize)]
 pub struct MethodCost {
-    /// `cvsgf_energy`, `robust` or `projection` (AB-3), or `rattle` (RATTLE, no control).
+    /// `cvsgf_energy`, `robust` or `projection` (AB-3), or `rattle` /
+    /// `generalized_alpha` (those schemes, no control).
     pub method: &'static str,
     /// Median over the trials.
     pub us_per_step: f64,
     /// Median over the trials of this method's time over `cvsgf_energy`'s in the same trial.
     pub ratio_to_cvsgf_energy: f64,
-    /// Newton iterations of the projection per step (`projection`), or of
-    /// RATTLE's position step (`rattle`).
+    /// Newton iterations per step of the projection (`projection`), of
+    /// RATTLE's position step (`rattle`), or generalized-α's corrections.
     pub projection_iterations_per_step: Option<f64>,
     /// Largest `|Φ|` seen, sampled (outside the clock) every [`PHI_EVERY`] steps and at the end.
     pub max_abs_phi: f64,
@@ -47,9 +48,9 @@ pub struct MethodComparison {
 }
 
 /// The methods compared, by name; the first is the one ratios are taken
-/// to. The first three step with AB-3; `rattle` is RATTLE with no control,
-/// which holds the constraints itself.
-pub const METHODS: [&str; 4] = ["cvsgf_energy", "robust", "projection", "rattle"];
+/// to. The first three step with AB-3; `rattle` and `generalized_alpha`
+/// are those schemes with no control, which hold the constraints themselves.
+pub const METHODS: [&str; 5] = ["cvsgf_energy", "robust", "projection", "rattle", "generalized_alpha"];
 
 /// Steps between samples of `|Φ|` in a [`MethodComparison`]: the clock is
 /// read this often, which costs well under 1 % even of Example 1's step.
@@ -67,7 +68,7 @@ pub(super) struct MethodRun {
     seconds: f64,
     allocations: u64,
     max_abs_phi: f64,
-    /// Of the projection, or of RATTLE's position step.
+    /// Of the projection, of RATTLE's position step, or generalized-α's corrections.
     iterations: u64,
 }
 
@@ -91,7 +92,7 @@ pub(super) fn method_run(ex: &Example, settings: Settings, steps: u64, phi: &mut
         seconds,
         allocations: allocs,
         max_abs_phi: worst,
-        iterations: sim.projection_iterations() + sim.rattle_iterations(),
+        iterations: sim.projection_iterations() + sim.rattle_iterations() + sim.newton_iterations(),
     })
 }
 
@@ -114,6 +115,7 @@ pub(super) fn compare_methods(
         ab3(methods::robust()),
         ab3(methods::projection()),
         Settings::new(Scheme::Rattle, h, Control::none()),
+        Settings::new(Scheme::GeneralizedAlpha, h, Control::none()),
     ];
     let controls = settings.map(|s| s.control);
     let k = controls.len();
@@ -141,7 +143,7 @@ pub(super) fn compare_methods(
             method: METHODS[c],
             us_per_step: median(seconds[c].clone()) / total_steps * 1e6,
             ratio_to_cvsgf_energy: median(ratios[c].clone()),
-            projection_iterations_per_step: (controls[c].projection.is_some() || settings[c].scheme == Scheme::Rattle)
+            projection_iterations_per_step: (controls[c].projection.is_some() || settings[c].scheme.steps_model())
                 .then(|| iterations[c] as f64 / (total_steps * trials as f64)),
             max_abs_phi: worst[c],
             allocations_per_step: allocs[c] as f64 / steps as f64,

@@ -24,18 +24,26 @@
 //!   their order; each figure is the median over the trials, and each
 //!   ratio the median of the ratios within a trial, so that a slow spell
 //!   of the machine, which hits the methods of one trial alike, cancels.
+//!   `rattle` and `generalized_alpha` (no control) beside them.
+//! - Generalized-α on the planar chain by N (h = 1e-3, no control) and
+//!   its cost exponent.
+//! - The stiff flyball governor (IFToMM A05) over 1 s: RK-4 at h = 5e-5
+//!   (its step in the IFToMM files), RK-4 at 2.5e-4 (about its largest
+//!   stable step; 5e-4 stops), generalized-α at 1e-3: microseconds per
+//!   step and milliseconds per simulated second.
 //! - Allocations per step, counted by the binary's global allocator.
 
 use crate::io::alloc_count::allocations;
 use anyhow::Result;
 use cdyn::models::{ChainParams, Example, chain};
-use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric};
+use cdyn::{Application, Control, Energy, EnergyGain, Gain, Geometric, Scheme};
 use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
 
 mod chains;
 mod example1;
+mod flyball;
 mod method_costs;
 mod table;
 
@@ -43,6 +51,8 @@ pub use chains::{ChainRun, SpatialBaseline};
 use chains::{chain_run, spatial_baseline, spatial_chain_run};
 pub use example1::Example1;
 use example1::example1;
+pub use flyball::FlyballRun;
+use flyball::flyball_runs;
 use method_costs::method_comparisons;
 pub use method_costs::{METHODS, MethodComparison, MethodCost, PHI_EVERY};
 pub use table::table;
@@ -66,6 +76,12 @@ pub struct Report {
     pub spatial_handwritten: Vec<SpatialBaseline>,
     /// `cvsgf_energy`, `robust` and `projection` on Example 1, then on the chain by N.
     pub methods: Vec<MethodComparison>,
+    /// Generalized-α on the planar chain, by N.
+    pub generalized_alpha_chain: Vec<ChainRun>,
+    /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
+    pub generalized_alpha_chain_cost_exponent: Option<f64>,
+    /// The flyball governor at each scheme and step.
+    pub flyball: Vec<FlyballRun>,
     /// Over every run above, the methods' included.
     pub max_allocations_per_step: f64,
 }
@@ -122,7 +138,11 @@ pub fn run(light: bool) -> Result<Report> {
     let example1 = example1(light)?;
     let (sizes, t_end): (&[usize], f64) =
         if light { (&[10, 100, 1000], 0.05) } else { (&[10, 100, 1000, 10_000], 10.0) };
-    let chain = sizes.iter().map(|&n| chain_run(n, t_end)).collect::<Result<Vec<_>>>()?;
+    let chain = sizes.iter().map(|&n| chain_run(n, t_end, Scheme::AdamsBashforth3)).collect::<Result<Vec<_>>>()?;
+    // Generalized-α's step costs several of AB-3's: a tenth of the run.
+    let generalized_alpha_chain =
+        sizes.iter().map(|&n| chain_run(n, t_end / 10.0, Scheme::GeneralizedAlpha)).collect::<Result<Vec<_>>>()?;
+    let flyball = flyball_runs(light)?;
     // The spatial chain's step costs about 20 times the planar one's: its
     // light run stops at N = 100 (the full one takes minutes at N = 10 000).
     let (spatial_sizes, spatial_t_end): (&[usize], f64) =
@@ -142,7 +162,9 @@ pub fn run(light: bool) -> Result<Report> {
     let max_allocations_per_step = chain
         .iter()
         .chain(&spatial_chain)
+        .chain(&generalized_alpha_chain)
         .map(|c| c.allocations_per_step)
+        .chain(flyball.iter().map(|f| f.allocations_per_step))
         .chain(methods.iter().flat_map(|m| m.methods.iter().map(|c| c.allocations_per_step)))
         .fold(example1.allocations_per_step, f64::max);
     Ok(Report {
@@ -154,6 +176,9 @@ pub fn run(light: bool) -> Result<Report> {
         spatial_chain,
         spatial_handwritten,
         methods,
+        generalized_alpha_chain_cost_exponent: fit(&generalized_alpha_chain),
+        generalized_alpha_chain,
+        flyball,
         max_allocations_per_step,
     })
 }

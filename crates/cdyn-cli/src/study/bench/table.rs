@@ -46,7 +46,7 @@ pub fn table(r: &Report) -> String {
     }
     if let Some(m) = r.methods.first() {
         out += &format!(
-            "Methods, AB-3, and RATTLE without control (median of {} interleaved trials; ratio to cvsgf_energy within a trial, median):\n",
+            "Methods, AB-3, and RATTLE and generalized-α without control (median of {} interleaved trials; ratio to cvsgf_energy within a trial, median):\n",
             m.trials
         );
     }
@@ -70,6 +70,14 @@ pub fn table(r: &Report) -> String {
                 c.max_abs_phi
             );
         }
+    }
+    out += "flyball governor (IFToMM A05), no control, best of the trials:\n";
+    out += &format!("  {:>18} {:>8} {:>8} {:>12} {:>16}\n", "scheme", "h", "steps", "µs/step", "ms/simulated s");
+    for f in &r.flyball {
+        out += &format!(
+            "  {:>18} {:>8} {:>8} {:>12.2} {:>16.1}\n",
+            f.scheme, f.h, f.steps, f.us_per_step, f.ms_per_simulated_second
+        );
     }
     out += &format!("allocations per step (max): {}\n", r.max_allocations_per_step);
     out
