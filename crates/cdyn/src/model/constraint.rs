@@ -8,7 +8,7 @@
 
 use crate::ad::jet::JetN;
 use crate::ad::scalar::Scalar;
-use num_dual::{Dual2_64, Dual64};
+use num_dual::{Dual2_64, Dual64, HyperDual64};
 use std::any::Any;
 
 /// `R` holonomic constraints `Φ(x, t) = 0` on `K` coordinates `x`.
@@ -103,6 +103,15 @@ pub(crate) trait ConstraintBlock: Send + Sync {
     fn holonomic(&self) -> bool {
         true
     }
+    /// The `(row, column)` of each entry of [`curvatures`](Self::curvatures),
+    /// element after element (none for velocity-level rows).
+    fn curvature_entries(&self, _out: &mut Vec<(u32, u32)>) {}
+    /// Writes `scale · Σ_r λ_r ∇²Φ_r` of each element (`K × K`, row-major;
+    /// `lambda` the block's rows) into `out` — the derivative of `Φ_qᵀ λ`
+    /// in `q` — and returns the entries written.
+    fn curvatures(&self, _q: &[f64], _t: f64, _lambda: &[f64], _scale: f64, _out: &mut [f64]) -> usize {
+        0
+    }
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
@@ -152,6 +161,29 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
             let rows = c.eval(std::array::from_fn(|j| q[idx[j]]), t);
             phi[e * R..(e + 1) * R].copy_from_slice(&rows);
         }
+    }
+
+    fn curvature_entries(&self, out: &mut Vec<(u32, u32)>) {
+        crate::model::force::block_entries(&self.items, out);
+    }
+
+    fn curvatures(&self, q: &[f64], t: f64, lambda: &[f64], scale: f64, out: &mut [f64]) -> usize {
+        // ∂²Φ_r/∂xᵢ∂xⱼ: Φ along x + ε₁eᵢ + ε₂eⱼ, its ε₁ε₂ parts, weighted by λ_r.
+        let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
+        for (e, ((c, idx), block)) in self.items.iter().zip(out.chunks_exact_mut(K * K)).enumerate() {
+            let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
+            let weights = &lambda[e * R..(e + 1) * R];
+            for i in 0..K {
+                for j in i..K {
+                    let rows =
+                        c.eval(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0)), t.into());
+                    let h = scale * rows.iter().zip(weights).map(|(r, l)| r.eps1eps2 * l).sum::<f64>();
+                    block[i * K + j] = h;
+                    block[j * K + i] = h;
+                }
+            }
+        }
+        self.items.len() * K * K
     }
 }
 

@@ -333,6 +333,22 @@ impl Model {
         }
     }
 
+    /// The `(row, column)` of the entries [`curvature_values`](Self::curvature_values)
+    /// writes: each holonomic constraint element's block.
+    pub(crate) fn curvature_entries(&self, out: &mut Vec<(u32, u32)>) {
+        self.constraints.iter().for_each(|b| b.curvature_entries(out));
+    }
+
+    /// `scale · Σ_r λ_r ∇²Φ_r`, the derivative of `Φ_qᵀ λ` in `q` (the
+    /// constraints' geometric stiffness), entry by entry in the order of
+    /// [`curvature_entries`](Self::curvature_entries).
+    pub(crate) fn curvature_values(&self, q: &[f64], t: f64, lambda: &[f64], scale: f64, out: &mut [f64]) {
+        let mut at = 0;
+        for (b, &(r0, _)) in self.constraints.iter().zip(&self.offsets) {
+            at += b.curvatures(q, t, &lambda[r0..r0 + b.rows()], scale, &mut out[at..]);
+        }
+    }
+
     /// For each constraint row, whether it is holonomic (a position-level
     /// `Φ`) rather than nonholonomic (velocity-level only).
     pub(crate) fn holonomic_rows(&self) -> Vec<bool> {

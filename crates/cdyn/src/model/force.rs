@@ -51,7 +51,7 @@ pub(crate) trait ForceBlock: Send + Sync {
 }
 
 /// The `(row, column)` of every entry of each element's `K × K` block, row-major.
-fn block_entries<T, const K: usize>(items: &[(T, [usize; K])], out: &mut Vec<(u32, u32)>) {
+pub(crate) fn block_entries<T, const K: usize>(items: &[(T, [usize; K])], out: &mut Vec<(u32, u32)>) {
     for (_, idx) in items {
         for i in idx {
             out.extend(idx.iter().map(|j| (*i as u32, *j as u32)));
