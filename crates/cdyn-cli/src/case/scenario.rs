@@ -168,11 +168,23 @@ pub struct InitialSpec {
     pub tolerance: Option<f64>,
 }
 
+/// The scheme of a scenario that names none: ABM-4, the cheapest to a
+/// given error on most of the work-precision diagrams of `docs/precision.md`
+/// (Example 1 at every error from 1e-3 to 1e-9, the chain to 1e-3). Stiff
+/// damping is where it is not: a run it stops says so and names
+/// generalized-α.
+pub const DEFAULT_SCHEME: Scheme = Scheme::AdamsBashforthMoulton4;
+
+fn default_scheme() -> Scheme {
+    DEFAULT_SCHEME
+}
+
 /// `[integrator]`.
 #[derive(Debug, Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
-    /// The fixed-step scheme.
+    /// The fixed-step scheme (default [`DEFAULT_SCHEME`]).
+    #[serde(default = "default_scheme")]
     pub scheme: Scheme,
     /// The step size.
     pub h: f64,
