@@ -244,6 +244,21 @@ pub(crate) fn style(i: usize) -> (ShapeStyle, Option<(u32, u32)>) {
     (color.stroke_width(2), [None, Some((12, 6)), Some((2, 5))][(i / 10) % 3])
 }
 
+/// Series `i`'s line style, 40 pixels of it from `(x, y)`, in a legend.
+pub(crate) fn legend_sample<DB: DrawingBackend>(
+    legend: &DrawingArea<DB, Shift>,
+    i: usize,
+    (x, y): (i32, i32),
+) -> Result<()> {
+    let (st, dash) = style(i);
+    let sample = [(x, y), (x + 40, y)];
+    match dash {
+        None => legend.draw(&PathElement::new(sample, st)),
+        Some((a, b)) => legend.draw(&DashedPathElement::new(sample, a, b, st)),
+    }
+    .map_err(de)
+}
+
 /// Markers along each line.
 const MARKERS: usize = 12;
 
@@ -326,13 +341,7 @@ fn render<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure, d: &Da
     let font = TextStyle::from((FONT, (row - 6).clamp(6, 18))).pos(Pos::new(HPos::Left, VPos::Center));
     for (i, l) in labels.iter().enumerate() {
         let y = 26 + row * i as i32 + row / 2;
-        let (st, dash) = style(i);
-        let sample = [(12, y), (52, y)];
-        match dash {
-            None => legend.draw(&PathElement::new(sample, st)),
-            Some((a, b)) => legend.draw(&DashedPathElement::new(sample, a, b, st)),
-        }
-        .map_err(de)?;
+        legend_sample(&legend, i, (12, y))?;
         draw_marker!(i, (32, y), |e| legend.draw(&e))?;
         legend.draw(&Text::new(l.as_str(), (62, y), font.clone())).map_err(de)?;
     }

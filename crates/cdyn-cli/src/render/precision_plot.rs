@@ -5,7 +5,7 @@
 //! a run that stopped leaves its point out. The reference's own error bound
 //! is a grey dashed line: errors below it are not told apart.
 
-use crate::render::plot::{FONT, de, style, write_drawing};
+use crate::render::plot::{FONT, de, legend_sample, style, write_drawing};
 use crate::study::precision::{Point, Precision};
 use anyhow::Result;
 use plotters::coord::Shift;
@@ -104,13 +104,7 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, p: &Precision, x_label
     let row = 22;
     for (i, l) in p.lines.iter().enumerate() {
         let at = 40 + row * i as i32;
-        let (st, dash) = style(i);
-        let sample = [(10, at), (50, at)];
-        match dash {
-            None => legend.draw(&PathElement::new(sample, st)),
-            Some((a, b)) => legend.draw(&DashedPathElement::new(sample, a, b, st)),
-        }
-        .map_err(de)?;
+        legend_sample(&legend, i, (10, at))?;
         let stopped = l.points.iter().filter(|pt| !pt.max_error.is_finite()).count();
         let note = if stopped > 0 { format!(" ({stopped} stopped)") } else { String::new() };
         legend.draw(&Text::new(format!("{} {}{note}", l.scheme, l.method), (58, at), font.clone())).map_err(de)?;

@@ -14,6 +14,7 @@
 use crate::case::runner::Case;
 use crate::case::scenario::{self, Scenario};
 use crate::study::compare;
+use crate::study::suite::{distance, rk4_samples};
 use anyhow::{Result, anyhow, bail};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
 use cdyn::{Control, Scheme, Simulation};
@@ -77,7 +78,7 @@ pub struct Point {
     /// Largest `|q_i − q_ref,i|` over the samples; infinite if the run stopped.
     #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub max_error: f64,
-    /// Largest `|Φ|` over the steps.
+    /// Largest `|Φ|` over the samples (read outside the clock).
     #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub max_abs_phi: f64,
     /// Why it stopped, if it did.
@@ -286,25 +287,6 @@ fn reference(case: &Case, interval: f64, finest: f64, t_end: f64) -> cdyn::Resul
     Ok((Reference { kind: "rk4", h: Some(h), error_bound }, fine))
 }
 
-/// Positions of the model without control, RK-4 at `h`, at `t = k·interval`.
-fn rk4_samples(case: &Case, h: f64, interval: f64, t_end: f64) -> cdyn::Result<Vec<Vec<f64>>> {
-    let every = (interval / h).round() as u64;
-    let settings = case.settings.with_scheme(Scheme::RungeKutta4).with_h(h).with_control(Control::none());
-    let ex = &case.example;
-    let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
-    let mut samples = Vec::new();
-    sim.run(t_end, every, |s| {
-        samples.push(s.q().to_vec());
-        Ok::<_, cdyn::Error>(())
-    })?;
-    Ok(samples)
-}
-
-/// Largest `|a_i − b_i|`.
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
-}
-
 /// Runs `case` to `t_end`, its error against `samples` at the multiples of
 /// `interval`, and its cost.
 fn run_case(case: &Case, t_end: f64, interval: f64, samples: &[Vec<f64>]) -> Point {
@@ -336,20 +318,22 @@ fn run_case(case: &Case, t_end: f64, interval: f64, samples: &[Vec<f64>]) -> Poi
                 return point;
             }
         };
-        let (mut error, mut phi) = (distance(sim.q(), &samples[0]), 0.0_f64);
-        let start = Instant::now();
+        let (mut error, mut phi, mut seconds) = (distance(sim.q(), &samples[0]), 0.0_f64, 0.0);
+        let mut values = vec![0.0; ex.model.m()];
         while sim.steps() < steps {
-            if let Err(e) = sim.step() {
-                point.error = Some(e.to_string());
-                point.steps = sim.steps();
-                return point;
+            let start = Instant::now();
+            for _ in 0..every {
+                if let Err(e) = sim.step() {
+                    point.error = Some(e.to_string());
+                    point.steps = sim.steps();
+                    return point;
+                }
             }
-            phi = phi.max(sim.measure().phi.abs());
-            if sim.steps().is_multiple_of(every) {
-                error = error.max(distance(sim.q(), &samples[(sim.steps() / every) as usize]));
-            }
+            seconds += start.elapsed().as_secs_f64();
+            ex.model.constraint_values(sim.q(), sim.t(), &mut values);
+            phi = values.iter().fold(phi, |a, x| a.max(x.abs()));
+            error = error.max(distance(sim.q(), &samples[(sim.steps() / every) as usize]));
         }
-        let seconds = start.elapsed().as_secs_f64();
         fastest = fastest.min(seconds);
         (point.max_error, point.max_abs_phi, point.steps) = (error, phi, sim.steps());
         point.evaluations_per_second = sim.evaluations() as f64 / t_end;

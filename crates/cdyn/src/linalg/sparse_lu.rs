@@ -3,8 +3,8 @@
 //! `[M + c_v C + c_q K, Φ_qᵀ; Φ_q, 0]` of an implicit step, which is
 //! indefinite (no Cholesky) and whose pattern never changes. The pattern
 //! and its fill-reducing ordering are analysed once, and the factors'
-//! storage is sized when the system is made ([`SparseLu::reserve`]), so
-//! steps do not allocate.
+//! storage is sized by a first factorization of a matrix like the ones
+//! to come ([`SparseLu::reserve`]), so steps do not allocate.
 
 use faer::Par;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -61,7 +61,7 @@ impl SparseLu {
             symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         );
-        let mut lu = Self {
+        Self {
             dim,
             values: vec![0.0; row_idx.len()],
             col_ptr,
@@ -71,15 +71,7 @@ impl SparseLu {
             numeric: NumericLu::new(),
             factored: false,
             memory: MemBuffer::new(scratch),
-        };
-        // A first factorization, of a diagonally dominant matrix with the
-        // pattern (ones off the diagonal), sizes the factors' storage for
-        // the pattern's fill, so that the first step does not allocate it.
-        // A real matrix's pivoting may need more, once.
-        let warm: Vec<f64> =
-            entries.iter().map(|&(r, c)| if r == c { 2.0 * entries.len() as f64 } else { 1.0 }).collect();
-        lu.reserve(&warm);
-        lu
+        }
     }
 
     /// Factors `values` to size the factors' storage, and forgets the

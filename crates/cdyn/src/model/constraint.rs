@@ -164,7 +164,7 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
     }
 
     fn curvature_entries(&self, out: &mut Vec<(u32, u32)>) {
-        crate::model::force::block_entries(&self.items, out);
+        block_entries(&self.items, out);
     }
 
     fn curvatures(&self, q: &[f64], t: f64, lambda: &[f64], scale: f64, out: &mut [f64]) -> usize {
@@ -184,6 +184,15 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
             }
         }
         self.items.len() * K * K
+    }
+}
+
+/// The `(row, column)` of every entry of each element's `K × K` block, row-major.
+pub(crate) fn block_entries<T, const K: usize>(items: &[(T, [usize; K])], out: &mut Vec<(u32, u32)>) {
+    for (_, idx) in items {
+        for i in idx {
+            out.extend(idx.iter().map(|j| (*i as u32, *j as u32)));
+        }
     }
 }
 

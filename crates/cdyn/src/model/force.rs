@@ -6,7 +6,7 @@
 //! energy constraint integrates.
 
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::seeded;
+use crate::model::constraint::{block_entries, seeded};
 use num_dual::{Dual64, HyperDual64};
 use std::any::Any;
 
@@ -48,15 +48,6 @@ pub(crate) trait ForceBlock: Send + Sync {
     /// both — and returns the entries written.
     fn jacobians(&self, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, out: &mut [f64]) -> usize;
     fn as_any_mut(&mut self) -> &mut dyn Any;
-}
-
-/// The `(row, column)` of every entry of each element's `K × K` block, row-major.
-pub(crate) fn block_entries<T, const K: usize>(items: &[(T, [usize; K])], out: &mut Vec<(u32, u32)>) {
-    for (_, idx) in items {
-        for i in idx {
-            out.extend(idx.iter().map(|j| (*i as u32, *j as u32)));
-        }
-    }
 }
 
 pub(crate) struct PotentialGroup<P, const K: usize> {

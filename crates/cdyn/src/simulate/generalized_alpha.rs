@@ -220,18 +220,6 @@ impl Work {
         }
         // The zero block's diagonal, listed for the pivoting's sake.
         entries.extend((n..n + m).map(|i| (i as u32, i as u32)));
-        let mut lu = SparseLu::new(n + m, &entries);
-        // A saddle point like the real matrices (the zero block zero), so
-        // that the first step's pivoting finds the storage it needs.
-        let saddle: Vec<f64> = entries
-            .iter()
-            .map(|&(r, c)| match (r == c, (r as usize) < n) {
-                (true, true) => 4.0,
-                (true, false) => 0.0,
-                (false, _) => 1.0,
-            })
-            .collect();
-        lu.reserve(&saddle);
         Self {
             settings,
             holonomic: model.holonomic_rows(),
@@ -239,7 +227,7 @@ impl Work {
             force_entries,
             element_entries,
             values: vec![0.0; entries.len()],
-            lu,
+            lu: SparseLu::new(n + m, &entries),
             acc: vec![0.0; n],
             aux: vec![0.0; n],
             lambda: vec![0.0; m],
@@ -263,6 +251,51 @@ const SLOW_CONTRACTION: f64 = 0.5;
 /// is round-off: Newton stops there whatever its tolerance.
 const POSITION_ROUND_OFF: f64 = 100.0 * f64::EPSILON;
 
+/// The Newton system's scaling at step `h` (see the module's notes).
+struct Scaling {
+    beta_prime: f64,
+    gamma_prime: f64,
+    c_q: f64,
+    c_v: f64,
+}
+
+impl Work {
+    fn scaling(&self, h: f64) -> Scaling {
+        let [alpha_m, alpha_f, gamma, beta] = self.settings.coefficients();
+        let beta_prime = (1.0 - alpha_m) / (h * h * beta * (1.0 - alpha_f));
+        let gamma_prime = gamma / (h * beta);
+        Scaling { beta_prime, gamma_prime, c_q: 1.0 / beta_prime, c_v: gamma_prime / beta_prime }
+    }
+
+    /// Consistent accelerations and multipliers at `(q, v, t)`, `a_0 =
+    /// q̈_0`; and one factorization of the Newton matrix there, which sizes
+    /// the factors' storage for the pivoting of the steps to come.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn start(
+        &mut self,
+        model: &Model,
+        d: &mut Dynamics,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        h: f64,
+        evaluations: &mut u64,
+    ) -> std::result::Result<(), Failure> {
+        *evaluations += 1;
+        d.evaluate(model, q, v, t).map_err(|b| Failure::Breakdown(b, t))?;
+        self.acc.copy_from_slice(d.acc());
+        self.aux.copy_from_slice(d.acc());
+        self.lambda.copy_from_slice(d.lambda());
+        self.lambda_new.copy_from_slice(d.lambda());
+        self.power = d.energy_input();
+        self.started = true;
+        let Scaling { c_q, c_v, .. } = self.scaling(h);
+        newton_matrix(model, d, q, v, t, c_q, c_v, self);
+        self.lu.reserve(&self.values);
+        Ok(())
+    }
+}
+
 /// One step of `(q, v, e)` from `t` to `t + h`, counting the evaluations
 /// of the dynamics in `evaluations`.
 #[allow(clippy::too_many_arguments)]
@@ -279,19 +312,10 @@ pub(crate) fn step(
 ) -> std::result::Result<StepReport, Failure> {
     let n = model.n();
     if !w.started {
-        // Consistent accelerations and multipliers at the start, a_0 = q̈_0.
-        *evaluations += 1;
-        d.evaluate(model, q, v, t).map_err(|b| Failure::Breakdown(b, t))?;
-        w.acc.copy_from_slice(d.acc());
-        w.aux.copy_from_slice(d.acc());
-        w.lambda.copy_from_slice(d.lambda());
-        w.power = d.energy_input();
-        w.started = true;
+        w.start(model, d, q, v, t, h, evaluations)?;
     }
+    let Scaling { beta_prime, gamma_prime, c_q, c_v } = w.scaling(h);
     let [alpha_m, alpha_f, gamma, beta] = w.settings.coefficients();
-    let beta_prime = (1.0 - alpha_m) / (h * h * beta * (1.0 - alpha_f));
-    let gamma_prime = gamma / (h * beta);
-    let (c_q, c_v) = (1.0 / beta_prime, gamma_prime / beta_prime);
     w.q0.copy_from_slice(q);
     w.v0.copy_from_slice(v);
     // The predictor: the accelerations and multipliers of the last step.

@@ -183,7 +183,9 @@ impl<S: System> Stepper<S> {
                     "scheme generalized_alpha holds Φ = 0 itself: use no control law (method none), or projection to hold Φ̇ and the energy as well",
                 ));
             }
-            Scheme::GeneralizedAlpha => system.prepare_generalized_alpha(settings.generalized_alpha),
+            Scheme::GeneralizedAlpha => {
+                system.prepare_generalized_alpha(settings.generalized_alpha, q0, v0, settings.h)
+            }
             _ => {}
         }
         let n = q0.len();

@@ -93,10 +93,11 @@ pub trait System: Rhs<Error = EvalError> {
         let _ = (x, t, h);
         unreachable!("a system that does not offer RATTLE")
     }
-    /// Makes generalized-α's buffers and Newton matrix pattern, before the
-    /// first [`generalized_alpha`](Self::generalized_alpha) step.
-    fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha) {
-        let _ = settings;
+    /// Makes generalized-α's buffers and Newton matrix pattern, and starts
+    /// it at `(q0, v0)` with step `h`, before the first
+    /// [`generalized_alpha`](Self::generalized_alpha) step.
+    fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha, q0: &[f64], v0: &[f64], h: f64) {
+        let _ = (settings, q0, v0, h);
         unreachable!("a system that does not offer generalized-α")
     }
     /// One generalized-α step of the state `x` from `t` to `t + h`
@@ -388,8 +389,11 @@ impl System for ControlledSystem<'_> {
     fn offers_model_schemes(&self) -> bool {
         true
     }
-    fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha) {
-        self.alpha = Some(generalized_alpha::Work::new(self.model, &self.dynamics, settings));
+    fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha, q0: &[f64], v0: &[f64], h: f64) {
+        let mut work = generalized_alpha::Work::new(self.model, &self.dynamics, settings);
+        // A state the dynamics cannot evaluate leaves it unstarted: the first step says why.
+        let _ = work.start(self.model, &mut self.dynamics, q0, v0, 0.0, h, &mut self.evaluations);
+        self.alpha = Some(work);
     }
     fn generalized_alpha(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<StepReport, AlphaFailure> {
         let n = self.model.n();

@@ -279,12 +279,18 @@ fn run_model(model: &Model) -> Result<(Vec<Group>, f64)> {
 
 /// Positions of the model without control, RK-4 at `interval / 20`, at `t = k·interval`.
 fn reference(case: &Case, interval: f64, t_end: f64) -> cdyn::Result<Vec<Vec<f64>>> {
-    let h = interval / REFERENCE_DIVISOR as f64;
+    rk4_samples(case, interval / REFERENCE_DIVISOR as f64, interval, t_end)
+}
+
+/// Positions of `case`'s model without control, RK-4 at `h`, at `t = k·interval`
+/// (`interval` a whole number of steps).
+pub(crate) fn rk4_samples(case: &Case, h: f64, interval: f64, t_end: f64) -> cdyn::Result<Vec<Vec<f64>>> {
+    let every = (interval / h).round() as u64;
     let settings = case.settings.with_scheme(Scheme::RungeKutta4).with_h(h).with_control(Control::none());
     let ex = &case.example;
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
     let mut samples = Vec::new();
-    sim.run(t_end, REFERENCE_DIVISOR, |s| {
+    sim.run(t_end, every, |s| {
         samples.push(s.q().to_vec());
         Ok::<_, cdyn::Error>(())
     })?;
@@ -292,7 +298,7 @@ fn reference(case: &Case, interval: f64, t_end: f64) -> cdyn::Result<Vec<Vec<f64
 }
 
 /// Largest `|a_i − b_i|`.
-fn distance(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
 }
 
