@@ -47,7 +47,7 @@ impl Scenario {
     pub fn method(&self) -> MethodKeys {
         let default = match self.integrator.scheme {
             s if s.steps_model() => MethodKeys::default(),
-            _ => MethodKeys { preset: Some(Preset::Robust), ..MethodKeys::default() },
+            _ => MethodKeys::default().with_preset(Preset::Robust),
         };
         self.method.clone().unwrap_or(default)
     }
@@ -263,21 +263,8 @@ impl Scenario {
         // The robot's joints by name, then the scenario's: one list, so that
         // errors name joints[k] counting the scenario's own from 0 after the robot's.
         let name = |i: usize| robot.bodies[i].name.clone();
-        let mut joints: Vec<cdyn::spatial::Joint<String>> = robot
-            .joints
-            .iter()
-            .map(|j| cdyn::spatial::Joint {
-                kind: j.kind,
-                a: name(j.a),
-                b: Some(j.b.map_or(cdyn::planar::GROUND.to_string(), name)),
-                point: j.point,
-                axis: j.axis,
-                axis_b: j.axis_b,
-                point_b: j.point_b,
-                angle: j.angle.clone(),
-                displacement: j.displacement.clone(),
-            })
-            .collect();
+        let mut joints: Vec<cdyn::spatial::Joint<String>> =
+            robot.joints.iter().map(|j| j.clone().map_bodies(name)).collect();
         let robot_loads: Vec<cdyn::spatial::Load<String>> = robot
             .loads
             .iter()

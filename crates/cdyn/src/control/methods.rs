@@ -14,6 +14,7 @@ use crate::integrate::Application;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Preset {
     /// [`robust`]: the combination the method suite shows best, with automatic gains.
     Robust,
@@ -23,6 +24,7 @@ pub enum Preset {
 
 /// A rate as scenario files write it: a number (1/s), or `"auto"`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum RateKey {
     /// This rate.
     Value(f64),
@@ -82,6 +84,7 @@ impl RateKey {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum GeometricKind {
     /// No geometric control.
     #[default]
@@ -99,6 +102,7 @@ pub enum GeometricKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum VelocityKind {
     /// None.
     #[default]
@@ -111,6 +115,7 @@ pub enum VelocityKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum EnergyKind {
     /// No energy control.
     #[default]
@@ -131,6 +136,7 @@ pub enum EnergyKind {
 #[derive(Debug, Clone, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct MethodKeys {
     /// A whole method by name: `robust` or `projection`; then only the
     /// projection's settings may be given besides.
@@ -179,6 +185,51 @@ pub struct MethodKeys {
     /// `free`: the laws as written (the paper's, as published).
     pub invariants: Option<Invariants>,
 }
+
+crate::setters!(MethodKeys {
+    /// With a whole method by name.
+    with_preset => preset(Some): Preset,
+    /// With this geometric control.
+    with_geometric => geometric: GeometricKind,
+    /// With this velocity-level feedback.
+    with_velocity => velocity: VelocityKind,
+    /// With this energy control.
+    with_energy => energy: EnergyKind,
+    /// With the control term integrated here.
+    with_apply => apply(Some): Application,
+    /// With CVSGF's fixed gain `ζ`.
+    with_zeta => zeta(Some): f64,
+    /// With CVSGF's or Newton's rate `α_g`.
+    with_alpha_g => alpha_g(Some): RateKey,
+    /// With the velocity feedback's rate `α_v`.
+    with_alpha_v => alpha_v(Some): RateKey,
+    /// With Baumgarte's `α`.
+    with_alpha => alpha(Some): f64,
+    /// With Baumgarte's `β`.
+    with_beta => beta(Some): f64,
+    /// With Baumgarte's natural frequency `ω`.
+    with_omega => omega(Some): f64,
+    /// With Baumgarte's damping ratio.
+    with_damping_ratio => damping_ratio(Some): f64,
+    /// With the energy control's rate `α_e`.
+    with_alpha_e => alpha_e(Some): RateKey,
+    /// With the projected energy control's `c α_e²`.
+    with_position_weight => position_weight(Some): f64,
+    /// With the gradient energy control's fixed `ρ_q`.
+    with_rho_q => rho_q(Some): f64,
+    /// With the gradient energy control's fixed `ρ_v`.
+    with_rho_v => rho_v(Some): f64,
+    /// With the Baumgarte-type energy control's `η`.
+    with_eta => eta(Some): f64,
+    /// With the projection's tolerance.
+    with_tolerance => tolerance(Some): f64,
+    /// With the projection's Newton iterations allowed per step.
+    with_max_iterations => max_iterations(Some): u32,
+    /// With the projection stopping or continuing when it does not converge.
+    with_on_failure => on_failure(Some): OnFailure,
+    /// With the corrections keeping the momenta, or free of them.
+    with_invariants => invariants(Some): Invariants,
+});
 
 const CVSGF: &str = "geometric = \"cvsgf\"";
 const VELOCITY: &str = "velocity = \"gradient\"";
@@ -372,6 +423,7 @@ const TAKES_ENERGY: &str = "alpha_e, or rho_v (and rho_q, default 0)";
 
 /// The gains every case draws from.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct MethodGains {
     /// CVSGF gain: fixed `ζ` or target rate `α_g`.
     pub cvsgf: Gain,
@@ -382,6 +434,17 @@ pub struct MethodGains {
     /// Baumgarte `β`.
     pub baumgarte_beta: f64,
 }
+
+crate::setters!(MethodGains {
+    /// With this CVSGF gain.
+    with_cvsgf => cvsgf: Gain,
+    /// With these gradient energy control gains.
+    with_energy => energy: EnergyGain,
+    /// With Baumgarte's `α`.
+    with_baumgarte_alpha => baumgarte_alpha: f64,
+    /// With Baumgarte's `β`.
+    with_baumgarte_beta => baumgarte_beta: f64,
+});
 
 impl MethodGains {
     /// The paper's test: `α_g = α_e = 40` (`ζ = 20`, `ρ_v` set every step so

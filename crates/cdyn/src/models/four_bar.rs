@@ -15,7 +15,8 @@ use crate::{Constraint, Model, Potential, Scalar};
 
 /// Which of the two assemblies of a four-bar linkage: joint C lies to the
 /// left or to the right of the directed line from B (crank tip) to D
-/// (rocker pivot).
+/// (rocker pivot). Exhaustive on purpose (not `#[non_exhaustive]`): the
+/// two circles meet in at most two points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
@@ -39,6 +40,7 @@ pub enum FourBarBranch {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct FourBarParams {
     /// Crank length `a` (AB).
     pub crank_length: f64,
@@ -74,6 +76,39 @@ pub struct FourBarParams {
     /// [`LoadPendulum`]).
     pub load: Option<LoadPendulum>,
 }
+
+crate::setters!(FourBarParams {
+    /// With `crank_length`: crank length `a` (AB).
+    with_crank_length => crank_length: f64,
+    /// With `coupler_length`: coupler length `b` (BC).
+    with_coupler_length => coupler_length: f64,
+    /// With `rocker_length`: rocker length `c` (DC).
+    with_rocker_length => rocker_length: f64,
+    /// With `ground_length`: ground length `d` (AD).
+    with_ground_length => ground_length: f64,
+    /// With `crank_mass`: mass of the crank.
+    with_crank_mass => crank_mass: f64,
+    /// With `crank_inertia`: moment of inertia of the crank about its centre.
+    with_crank_inertia => crank_inertia: f64,
+    /// With `coupler_mass`: mass of the coupler.
+    with_coupler_mass => coupler_mass: f64,
+    /// With `coupler_inertia`: moment of inertia of the coupler about its centre.
+    with_coupler_inertia => coupler_inertia: f64,
+    /// With `rocker_mass`: mass of the rocker.
+    with_rocker_mass => rocker_mass: f64,
+    /// With `rocker_inertia`: moment of inertia of the rocker about its centre.
+    with_rocker_inertia => rocker_inertia: f64,
+    /// With `omega`: constant crank speed `ω`.
+    with_omega => omega: f64,
+    /// With `theta0`: initial crank angle from +X.
+    with_theta0 => theta0: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `branch`: which of the two assemblies the linkage starts in (and keeps); in
+    with_branch => branch: FourBarBranch,
+    /// With `load`: pendulum hanging from joint C; none by default. In scenario files a
+    with_load => load: Option<LoadPendulum>,
+});
 
 impl Default for FourBarParams {
     /// A Grashof crank-rocker `a = 1, b = 3, c = 2.5, d = 3` (s + l = 4 <

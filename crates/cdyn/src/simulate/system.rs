@@ -18,6 +18,7 @@ use crate::simulate::rattle;
 
 /// A failed evaluation of the right-hand side.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum EvalError {
     /// `Φ_q M⁻¹ Φ_qᵀ` is singular at a finite state.
     Singular {

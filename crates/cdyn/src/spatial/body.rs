@@ -11,6 +11,7 @@ use crate::model::kinetic::{Kinetic, VelocityMap};
 /// `velocity` and `angular_velocity` may be omitted).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
+#[non_exhaustive]
 pub struct Body {
     /// Its name, for joints, error messages and output; unique, not `ground`.
     pub name: String,
@@ -36,6 +37,21 @@ pub struct Body {
     #[cfg_attr(feature = "serde", serde(default))]
     pub angular_velocity: [f64; 3],
 }
+
+crate::setters!(Body {
+    /// With `mass`: mass.
+    with_mass => mass: f64,
+    /// With `inertia`: inertia tensor about the centre of mass, in body axes (symmetric
+    with_inertia => inertia: [[f64; 3]; 3],
+    /// With `position`: centre of mass in space.
+    with_position => position: [f64; 3],
+    /// With `orientation`: euler parameters of the body axes (scalar first). A unit quaternion
+    with_orientation => orientation: [f64; 4],
+    /// With `velocity`: velocity of the centre of mass.
+    with_velocity => velocity: [f64; 3],
+    /// With `angular_velocity`: angular velocity, in body axes.
+    with_angular_velocity => angular_velocity: [f64; 3],
+});
 
 #[cfg(feature = "serde")]
 fn identity() -> [f64; 4] {

@@ -28,6 +28,7 @@ use crate::model::timefn::TimeFn;
 /// What a joint allows (its `kind` in scenario files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum JointKind {
     /// Rotation about the point.
     Spherical,
@@ -88,6 +89,7 @@ impl JointKind {
 /// or `"ground"` for the ground).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
+#[non_exhaustive]
 pub struct Joint<B = usize> {
     /// What it allows.
     pub kind: JointKind,
@@ -125,32 +127,31 @@ impl Joint {
     pub fn new(kind: JointKind, a: usize, b: Option<usize>, point: [f64; 3]) -> Self {
         Self { kind, a, b, point, axis: None, axis_b: None, point_b: None, angle: None, displacement: None }
     }
-    /// With its axis.
-    pub fn axis(self, axis: [f64; 3]) -> Self {
-        Self { axis: Some(axis), ..self }
-    }
-    /// With a universal joint's second axis.
-    pub fn axis_b(self, axis_b: [f64; 3]) -> Self {
-        Self { axis_b: Some(axis_b), ..self }
-    }
-    /// With a distance joint's second point.
-    pub fn point_b(self, point_b: [f64; 3]) -> Self {
-        Self { point_b: Some(point_b), ..self }
-    }
-    /// Driven in angle.
-    pub fn angle(self, angle: TimeFn) -> Self {
-        Self { angle: Some(angle), ..self }
-    }
-    /// Driven in displacement.
-    pub fn displacement(self, displacement: TimeFn) -> Self {
-        Self { displacement: Some(displacement), ..self }
-    }
 }
+
+crate::setters!(impl<B> Joint<B> {
+    /// With its axis.
+    with_axis => axis(Some): [f64; 3],
+    /// With a universal joint's second axis.
+    with_axis_b => axis_b(Some): [f64; 3],
+    /// With a distance joint's second point.
+    with_point_b => point_b(Some): [f64; 3],
+    /// Driven in angle.
+    with_angle => angle(Some): TimeFn,
+    /// Driven in displacement.
+    with_displacement => displacement(Some): TimeFn,
+});
 
 impl<B> Joint<B> {
     /// Its constraint rows: the kind's and one per drive.
     pub fn rows(&self) -> usize {
         self.kind.rows() + self.angle.is_some() as usize + self.displacement.is_some() as usize
+    }
+
+    /// The same joint with its bodies passed through `f` (indices to names, say).
+    pub fn map_bodies<C>(self, mut f: impl FnMut(B) -> C) -> Joint<C> {
+        let Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement } = self;
+        Joint { kind, a: f(a), b: b.map(f), point, axis, axis_b, point_b, angle, displacement }
     }
 }
 

@@ -14,6 +14,7 @@ use std::collections::HashMap;
 
 /// Bodies, joints and uniform gravity.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Mechanism {
     /// The bodies; body `i` has coordinates `7i .. 7i + 7` (see [`SpatialBody`]).
     pub bodies: Vec<Body>,
@@ -43,10 +44,22 @@ pub struct Built {
 /// Where a body's coordinates are: `r` at `first .. first + 3`, `p` at
 /// `first + 3 .. first + 7`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SpatialBody {
     /// Its first coordinate.
     pub first: usize,
 }
+
+crate::setters!(Mechanism {
+    /// With these bodies.
+    with_bodies => bodies: Vec<Body>,
+    /// With these joints.
+    with_joints => joints: Vec<Joint>,
+    /// With this gravitational acceleration.
+    with_gravity => gravity: [f64; 3],
+    /// With these springs, dampers, forces and torques.
+    with_loads => loads: Vec<Load>,
+});
 
 impl SpatialBody {
     /// Body `index` of a [`Mechanism`].
@@ -111,6 +124,13 @@ fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
 }
 
 impl Mechanism {
+    /// An empty mechanism under `gravity`; bodies, joints and loads are
+    /// added with [`Mechanism::with_bodies`], [`Mechanism::with_joints`],
+    /// [`Mechanism::with_loads`].
+    pub fn new(gravity: [f64; 3]) -> Self {
+        Self { gravity, ..Self::default() }
+    }
+
     /// A mechanism whose joints name their bodies (`"ground"`, or `b`
     /// omitted, for the ground), as scenario files do.
     pub fn named(
