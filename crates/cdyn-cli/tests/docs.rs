@@ -43,11 +43,44 @@ fn blocks<'a>(text: &'a str, lang: &str) -> Vec<&'a str> {
     out
 }
 
+/// `block` with its commented-out keys and tables (`# zeta = 20.0`,
+/// `# [[invariants]]`) written in, or `None` when it has none: the book's
+/// alternatives, which must be real keys of the tables they sit in.
+fn uncommented(block: &str) -> Option<String> {
+    let mut changed = false;
+    let lines: Vec<String> = block
+        .lines()
+        .map(|line| {
+            let Some(rest) = line.strip_prefix("# ") else { return line.to_string() };
+            let key: String = rest.chars().take_while(|c| c.is_ascii_lowercase() || *c == '_').collect();
+            let table = rest.split(" #").next().unwrap_or_default().trim_end();
+            let header = table.trim_start_matches('[').trim_end_matches(']');
+            let is_header = table.starts_with('[')
+                && table.ends_with(']')
+                && header.chars().all(|c| c.is_ascii_lowercase() || c == '_' || c == '.');
+            if is_header || (!key.is_empty() && rest[key.len()..].starts_with(" = ")) {
+                changed = true;
+                rest.to_string()
+            } else {
+                line.to_string()
+            }
+        })
+        .collect();
+    changed.then(|| lines.join("\n"))
+}
+
 #[test]
 fn every_scenario_in_the_readme_and_the_book_runs() {
     let mut count = 0;
+    let mut alternatives = 0;
     for (page, text) in pages() {
         for (i, block) in blocks(&text, "toml").into_iter().enumerate() {
+            if let Some(all) = uncommented(block) {
+                // Read, not run: the alternatives exclude each other.
+                let read = cdyn_cli::case::scenario::parse(&all, "<book>");
+                assert!(read.is_ok(), "{page}, TOML block {} with its commented keys: {:?}", i + 1, read.err());
+                alternatives += 1;
+            }
             // A snippet that shows only the model's keys runs for ten steps.
             let mut text = block.to_string();
             if !text.contains("[integrator]") {
@@ -61,6 +94,138 @@ fn every_scenario_in_the_readme_and_the_book_runs() {
         }
     }
     assert!(count >= 4, "only {count} scenario blocks found");
+    assert!(alternatives >= 1, "no block with commented keys found");
+}
+
+/// The names a serde type expected where it refused `zzz_not_a_key`
+/// (`unknown field …, expected one of \`a\`, \`b\``): its keys, or
+/// its variants for an unknown variant.
+fn expected(error: impl std::fmt::Display) -> Vec<String> {
+    let error = error.to_string();
+    if error.contains("there are no fields") {
+        return Vec::new();
+    }
+    let list = error.split("expected").nth(1).unwrap_or_else(|| panic!("not a list of expected names: {error}"));
+    let names: Vec<String> = list.split('`').skip(1).step_by(2).map(str::to_string).collect();
+    assert!(!names.is_empty(), "no names in: {error}");
+    names
+}
+
+/// The keys (and names of kinds) `T` accepts from `text`, which holds an
+/// unknown key or value that `T` refuses with the list it expected.
+fn probe<T: serde::de::DeserializeOwned + std::fmt::Debug>(text: &str) -> Vec<String> {
+    expected(toml::from_str::<T>(text).expect_err(text))
+}
+
+/// The identifiers a page shows as code: in inline code and in TOML
+/// blocks, comments included.
+fn code_words(text: &str) -> std::collections::BTreeSet<String> {
+    let mut code = blocks(text, "toml").concat();
+    let prose: String = text.split("```").step_by(2).collect::<Vec<_>>().concat();
+    code.extend(prose.split('`').skip(1).step_by(2).flat_map(|span| [span, " "]));
+    code.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|w| !w.is_empty())
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn every_key_the_scenario_accepts_is_in_the_reference() {
+    use cdyn::models::Kind;
+    use cdyn_cli::case::scenario::{InitialSpec, IntegratorSpec, InvariantSpec, OutputSpec, Scenario};
+    const UNKNOWN: &str = "zzz_not_a_key = 0";
+    let tagged = |kind: &str| format!("kind = \"{kind}\"\n{UNKNOWN}");
+    let value = |key: &str| format!("{key} = \"zzz_not_a_value\"");
+    #[derive(Debug, serde::Deserialize)]
+    struct Value<T> {
+        #[allow(dead_code)]
+        v: T,
+    }
+
+    // (what, the names it accepts), read from the types themselves.
+    let mut planar: Vec<(String, Vec<String>)> = vec![
+        ("the scenario's tables".into(), probe::<Scenario>(UNKNOWN)),
+        // `[model]` takes every other key (the pendulum's parameters), so it
+        // cannot be probed: its own keys are these.
+        ("[model]".into(), ["kind", "gravity", "parameters"].map(String::from).to_vec()),
+        ("[initial]".into(), probe::<InitialSpec>(UNKNOWN)),
+        ("[integrator]".into(), probe::<IntegratorSpec>(UNKNOWN)),
+        ("[output]".into(), probe::<OutputSpec>(UNKNOWN)),
+        ("[method]".into(), probe::<cdyn::control::methods::MethodKeys>(UNKNOWN)),
+        ("model kinds".into(), probe::<Value<Kind>>("v = \"zzz\"")),
+        ("schemes".into(), cdyn::Scheme::ALL.iter().map(|s| s.info().name.to_string()).collect()),
+        ("a function of time".into(), probe::<Value<cdyn::model::timefn::TimeFn>>(&format!("v = {{ {UNKNOWN} }}"))),
+        ("[[bodies]]".into(), probe::<cdyn::planar::Body>(UNKNOWN)),
+        ("element kinds".into(), probe::<cdyn::planar::Element<String>>(&tagged("zzz"))),
+        ("[[invariants]] kinds".into(), probe::<InvariantSpec>(&tagged("zzz"))),
+    ];
+    for kind in planar.iter().find(|(what, _)| what == "element kinds").unwrap().1.clone() {
+        planar.push((format!("{kind} elements"), probe::<cdyn::planar::Element<String>>(&tagged(&kind))));
+    }
+    for kind in planar.iter().find(|(what, _)| what == "[[invariants]] kinds").unwrap().1.clone() {
+        planar.push((format!("{kind} invariants"), probe::<InvariantSpec>(&tagged(&kind))));
+    }
+    for (what, key) in [
+        ("geometric", "geometric"),
+        ("velocity", "velocity"),
+        ("energy", "energy"),
+        ("preset", "preset"),
+        ("apply", "apply"),
+        ("on_failure", "on_failure"),
+        ("invariants", "invariants"),
+    ] {
+        let names = probe::<cdyn::control::methods::MethodKeys>(&value(key));
+        planar.push((format!("{what} values"), names));
+    }
+    planar.push((
+        "dependent_rows values".into(),
+        probe::<IntegratorSpec>(&format!("h = 0.1\nt_end = 1.0\n{}", value("dependent_rows"))),
+    ));
+    for kind in Kind::ALL.into_iter().filter(|k| !k.is_described()) {
+        let table: toml::Table = toml::from_str(UNKNOWN).unwrap();
+        if let Err(e) = kind.example(toml::Value::Table(table)) {
+            planar.push((format!("{kind:?}'s parameters"), expected(e)));
+        }
+    }
+    for kind in [Kind::SliderCrank, Kind::FourBar] {
+        let table: toml::Table = toml::from_str(&format!("load = {{ {UNKNOWN} }}")).unwrap();
+        let error = kind.example(toml::Value::Table(table)).err().expect("a load with an unknown key");
+        planar.push((format!("{kind:?}'s load"), expected(error)));
+    }
+    let table: toml::Table = toml::from_str(&value("branch")).unwrap();
+    planar
+        .push(("four-bar branches".into(), expected(Kind::FourBar.example(toml::Value::Table(table)).err().unwrap())));
+    planar.push((
+        "drive coordinates".into(),
+        probe::<cdyn::planar::Element<String>>(
+            "kind = \"coordinate\"\nbody = \"b\"\nfunction = 1.0\ncoordinate = \"zzz\"",
+        ),
+    ));
+
+    let mut spatial: Vec<(String, Vec<String>)> = vec![
+        ("[model] of a spatial mechanism".into(), vec!["urdf".to_string()]),
+        ("spatial [[bodies]]".into(), probe::<cdyn::spatial::Body>(UNKNOWN)),
+        ("spatial [[joints]]".into(), probe::<cdyn::spatial::Joint<String>>(UNKNOWN)),
+        ("spatial joint kinds".into(), probe::<Value<cdyn::spatial::JointKind>>("v = \"zzz\"")),
+        ("spatial load kinds".into(), probe::<cdyn::spatial::Load<String>>(&tagged("zzz"))),
+    ];
+    for kind in spatial[4].1.clone() {
+        spatial.push((format!("spatial {kind} loads"), probe::<cdyn::spatial::Load<String>>(&tagged(&kind))));
+    }
+
+    let (mut checked, mut missing) = (0, Vec::new());
+    for (page, groups) in [("docs/scenarios.md", planar), ("docs/spatial.md", spatial)] {
+        let words = code_words(&std::fs::read_to_string(root().join(page)).unwrap());
+        for (what, names) in groups {
+            let absent: Vec<_> = names.iter().filter(|n| !words.contains(*n)).collect();
+            if !absent.is_empty() {
+                missing.push(format!("{page} does not show {what}: {absent:?}"));
+            }
+            checked += names.len();
+        }
+    }
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
+    assert!(checked > 200, "only {checked} names checked");
 }
 
 #[test]
