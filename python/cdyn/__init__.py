@@ -3,7 +3,8 @@ constraint and energy violations pushed back (CVSGF), from Python.
 
 A thin layer over the Rust library and the ``cdyn`` command line: scenarios
 are read, cases run and errors worded exactly as ``cdyn run``, ``cdyn
-compare``, ``cdyn sweep``, ``cdyn suite`` and ``cdyn paper`` do. Runs release the GIL.
+compare``, ``cdyn sweep``, ``cdyn suite``, ``cdyn precision`` and ``cdyn paper`` do.
+Runs release the GIL.
 
 >>> import cdyn
 >>> s = cdyn.model("pendulum", scheme="rk4", h=0.01, t_end=1.0)
@@ -35,6 +36,7 @@ __all__ = [
     "Result",
     "Sweep",
     "Suite",
+    "Precision",
     "load",
     "loads",
     "from_dict",
@@ -44,6 +46,7 @@ __all__ = [
     "compare",
     "sweep",
     "suite",
+    "precision",
     "example1",
 ]
 
@@ -229,6 +232,42 @@ class Suite:
         return f"<cdyn.Suite {len(self.summary['cases'])} groups, {len(self.misses)} misses>"
 
 
+class Precision:
+    """A work-precision diagram, as ``cdyn precision`` computes it:
+    ``summary`` is ``precision.json`` as a dict, ``csv`` the text of
+    ``precision.csv``, ``table`` the table it prints. The errors, steps and
+    evaluations equal the CLI's; the wall-clock times are this run's own."""
+
+    __slots__ = {
+        "summary": "precision.json as a dict: scenario, t_end, sample_interval, reference, lines, cheapest.",
+        "csv": "precision.csv as text: one row per scheme, method and step.",
+        "table": "The table cdyn precision prints.",
+    }
+
+    def __init__(self, text: str, csv: str, table: str) -> None:
+        self.summary: Dict[str, Any] = json.loads(text)
+        self.csv: str = csv
+        self.table: str = table
+
+    @property
+    def lines(self) -> List[Dict[str, Any]]:
+        """One per scheme and method: its points (coarsest step first) and observed order."""
+        return list(self.summary["lines"])
+
+    @property
+    def reference(self) -> Dict[str, Any]:
+        """What the errors are measured against: a closed form, or a fine RK-4 and its error bound."""
+        return dict(self.summary["reference"])
+
+    @property
+    def cheapest(self) -> List[Dict[str, Any]]:
+        """For each target error some line reaches, the line that gets there in the least wall time."""
+        return list(self.summary["cheapest"])
+
+    def __repr__(self) -> str:
+        return f"<cdyn.Precision {len(self.lines)} lines of {self.summary['scenario']}>"
+
+
 def load(path: Union[str, "os.PathLike[str]"]) -> Scenario:
     """Reads and checks the scenario file at ``path`` (as ``cdyn run`` does)."""
     return _cdyn.load(os.fspath(path))
@@ -319,10 +358,34 @@ def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:
 
 def suite(scenarios: Sequence[Union[str, "os.PathLike[str]"]] = (), *, light: bool = False) -> Suite:
     """Judges every method of ``cdyn compare`` on the shipped models (a few,
-    shorter, with ``light``) and the scenario files ``scenarios``, at AB-3
-    and RK-4, h and h/2, against a fine reference, as ``cdyn suite`` does;
-    the result's ``summary`` equals the CLI's ``suite.json``."""
+    shorter, with ``light``) and the scenario files ``scenarios``, at AB-3,
+    RK-4 and ABM-4, h and h/2, against a fine reference, as ``cdyn suite``
+    does; the result's ``summary`` equals the CLI's ``suite.json``."""
     return Suite(*_cdyn.run_suite([os.fspath(p) for p in scenarios], light))
+
+
+def precision(
+    path: Union[str, "os.PathLike[str]"],
+    *,
+    schemes: Sequence[str] = (),
+    methods: Union[str, Sequence[str], None] = None,
+    h: Sequence[float] = (),
+    t_end: Optional[float] = None,
+    light: bool = False,
+) -> Precision:
+    """The work-precision diagram of the scenario file at ``path``, as
+    ``cdyn precision`` draws it: each scheme of ``schemes`` (by name; all by
+    default) and method of ``methods`` (names of ``cdyn compare``; no
+    control, robust and projection by default; ``"all"`` every one) at each
+    step of ``h`` (default: the scenario's h × 4, 2, 1, 1/2, 1/4), run to
+    ``t_end`` (default the scenario's), the error against the model's closed
+    form or a fine RK-4, the evaluations and wall time per simulated
+    second, the observed order and the cheapest line per error. ``light``
+    takes three steps over a quarter of the time. Writes no files."""
+    names = [methods] if isinstance(methods, str) else list(methods or [])
+    return Precision(
+        *_cdyn.run_precision(os.fspath(path), list(schemes), names, [float(x) for x in h], t_end, light)
+    )
 
 
 def example1(*, multipliers: bool = False) -> Dict[str, Result]:

@@ -170,6 +170,36 @@ def test_numpy_numbers_in_a_dict_and_the_toml_round_trip():
     assert s.file == "<dict>" and not s.has_sweep and "<dict>" in repr(s)
 
 
+def without_timings(summary):
+    """precision.json without what the clock measured (wall time per
+    second, and the cheapest line, which is chosen by it)."""
+    summary = json.loads(json.dumps(summary))
+    summary.pop("cheapest")
+    for line in summary["lines"]:
+        for point in line["points"]:
+            point.pop("wall_per_second")
+    return summary
+
+
+def test_precision_is_the_clis_precision_json(cli, tmp_path):
+    scenario = EXAMPLES / "cvsgf_energy.toml"
+    args = ["--schemes", "rk4", "--methods", "none,robust", "--h", "0.02,0.01", "--t-end", "1"]
+    out = cli("precision", scenario, "--out", tmp_path, *args)
+    assert out.returncode == 0, out.stderr
+    result = cdyn.precision(scenario, schemes=["rk4"], methods=["none", "robust"], h=[0.02, 0.01], t_end=1.0)
+    written = json.loads((tmp_path / "precision.json").read_text())
+    assert without_timings(result.summary) == without_timings(written)
+    # The same lines and points as the CLI's CSV, each value but the time.
+    assert [line["method"] for line in result.lines] == ["none", "robust"]
+    assert all(len(line["points"]) == 2 and line["scheme"] == "rk4" for line in result.lines)
+    assert result.reference["kind"] == "closed form"
+    csv_cli = (tmp_path / "precision.csv").read_text().splitlines()
+    assert result.csv.splitlines()[0] == csv_cli[0] and len(result.csv.splitlines()) == len(csv_cli)
+    assert result.table.splitlines()[0] in out.stdout
+    with pytest.raises(cdyn.ScenarioError, match="unknown scheme `rk5`"):
+        cdyn.precision(scenario, schemes=["rk5"])
+
+
 def test_suite_is_the_clis_suite_json_and_table(cli, tmp_path):
     extra = EXAMPLES / "suite" / "satellite_planar.toml"
     out = cli("suite", "--light", extra, "--out", tmp_path)

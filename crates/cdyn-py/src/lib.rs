@@ -1,7 +1,7 @@
 //! `cdyn._cdyn`, the native part of the Python package `cdyn`: thin over the
 //! CLI's library (crates/cdyn-cli), so scenarios are read, cases built and
-//! run, and errors worded exactly as `cdyn run`, `compare`, `sweep` and
-//! `paper` do. The Python layer (python/cdyn) wraps what these functions
+//! run, and errors worded exactly as `cdyn run`, `compare`, `sweep`,
+//! `suite`, `precision` and `paper` do. The Python layer (python/cdyn) wraps what these functions
 //! return in result classes.
 //!
 //! Every run happens with the GIL released; failures become `cdyn.Error`
@@ -11,6 +11,7 @@ use cdyn_cli::case::runner::{
     Case, CaseResult, Estimate, OUTPUT_LIMIT, Rows, columns, every_to_fit, run_case_in_memory,
 };
 use cdyn_cli::case::scenario;
+use cdyn_cli::study::precision::{self, Methods, Options};
 use cdyn_cli::study::{paper, suite, sweep};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
@@ -307,6 +308,39 @@ fn run_suite(py: Python<'_>, scenarios: Vec<PathBuf>, light: bool) -> PyResult<(
     Ok((json, suite::table(&result) + &suite::summary(&result)))
 }
 
+/// Runs `cdyn precision` on the scenario file `scenario`: every scheme of
+/// `schemes` (all when empty) × method of `methods` (`cdyn compare`'s names;
+/// none, robust and projection when empty; `["all"]` every one) at each
+/// step of `h` (the scenario's h × 4, 2, 1, 1/2, 1/4 when empty); returns
+/// `precision.json` as text, `precision.csv` and the table the CLI prints.
+#[pyfunction]
+#[pyo3(signature = (scenario, schemes = Vec::new(), methods = Vec::new(), h = Vec::new(), t_end = None, light = false))]
+fn run_precision(
+    py: Python<'_>,
+    scenario: PathBuf,
+    schemes: Vec<String>,
+    methods: Vec<String>,
+    h: Vec<f64>,
+    t_end: Option<f64>,
+    light: bool,
+) -> PyResult<(String, String, String)> {
+    let schemes = schemes
+        .into_iter()
+        .map(cdyn::Scheme::try_from)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(ScenarioError::new_err)?;
+    // As `cdyn precision --methods` reads its list.
+    let methods = match &methods[..] {
+        [] => Methods::Default,
+        [all] if all == "all" => Methods::All,
+        named => Methods::Named(named.to_vec()),
+    };
+    let options = Options { schemes, methods, steps: h, t_end, light };
+    let result = py.detach(|| precision::run(&scenario, &options)).map_err(scenario_error)?;
+    let json = serde_json::to_string_pretty(&result).map_err(|e| Error::new_err(e.to_string()))? + "\n";
+    Ok((json, precision::csv(&result), precision::table(&result)))
+}
+
 /// The native module.
 #[pymodule]
 fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -323,6 +357,7 @@ fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(paper_cases, m)?)?;
     m.add_function(wrap_pyfunction!(run_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(run_suite, m)?)?;
+    m.add_function(wrap_pyfunction!(run_precision, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
