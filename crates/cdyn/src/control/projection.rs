@@ -40,6 +40,37 @@ pub enum OnFailure {
 }
 
 /// Settings of the exact projection (the `projection` method).
+///
+/// After every step of a pendulum by forward Euler, which alone would leave
+/// the circle at once, the projection brings `|Φ|` back under its tolerance:
+///
+/// ```
+/// use cdyn::control::projection::Projection;
+/// use cdyn::{Constraint, Control, Model, Potential, Scalar, Scheme, Settings, Simulation};
+///
+/// struct Rod;
+/// impl Constraint<2, 1> for Rod {
+///     fn eval<D: Scalar>(&self, [x, y]: [D; 2], _t: D) -> [D; 1] {
+///         [(x * x + y * y - 1.0) * 0.5]
+///     }
+/// }
+/// struct Weight;
+/// impl Potential<1> for Weight {
+///     fn energy<D: Scalar>(&self, [y]: [D; 1]) -> D {
+///         y
+///     }
+/// }
+///
+/// let model = Model::builder(vec![1.0, 1.0]).constrain(Rod, [0, 1]).potential(Weight, [1]).build()?;
+/// let projection = Projection::new().with_tolerance(1e-12);
+/// let control = Control::none().with_projection(Some(projection));
+/// let mut sim = Simulation::new(&model, Settings::new(Scheme::Euler, 0.01, control), &[1.0, 0.0], &[0.0, 2.0])?;
+/// sim.run::<cdyn::Error>(1.0, 1, |s| {
+///     assert!(s.measure().phi.abs() <= 1e-12);
+///     Ok(())
+/// })?;
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]

@@ -132,7 +132,7 @@ impl Scheme {
     ];
 
     /// The schemes that step any right-hand side `ẋ = f + U` with an
-    /// [`Integrator`], under every control law: all but RATTLE and generalized-α.
+    /// [`Integrator`](super::Integrator), under every control law: all but RATTLE and generalized-α.
     pub const GENERAL: [Scheme; 5] = [
         Scheme::Euler,
         Scheme::AdamsBashforth2,

@@ -37,6 +37,30 @@ impl Model {
 }
 
 /// Builds a [`Model`] element by element.
+///
+/// Each element names the coordinates it reads; its derivatives come by
+/// automatic differentiation. A spring `V = ½ k x²` on the first of two
+/// coordinates:
+///
+/// ```
+/// use cdyn::{Model, Potential, Scalar};
+///
+/// struct Spring(f64);
+/// impl Potential<1> for Spring {
+///     fn energy<D: Scalar>(&self, [x]: [D; 1]) -> D {
+///         x * x * (0.5 * self.0)
+///     }
+/// }
+///
+/// let model = Model::builder(vec![1.0, 1.0])
+///     .potential(Spring(4.0), [0])
+///     .coordinate_names(vec!["x".into(), "y".into()])
+///     .build()?;
+/// let mut grad = [0.0; 2];
+/// assert_eq!(model.potential(&[0.5, 3.0], Some(&mut grad)), 0.5);
+/// assert_eq!(grad, [2.0, 0.0]); // ∇V = (k x, 0)
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 pub struct ModelBuilder {
     mass: Vec<f64>,
     kinetic: Vec<Box<dyn KineticBlock>>,

@@ -16,6 +16,28 @@ use crate::model::unit_vector::UnitVector;
 pub use crate::linalg::sparse::Pattern;
 
 /// A constrained mechanical system, ready to simulate.
+///
+/// Built with [`Model::builder`] from the coordinates' masses and elements
+/// written once for any scalar, as here a point on the unit circle:
+///
+/// ```
+/// use cdyn::{Constraint, Model, Scalar};
+///
+/// /// `Φ = x² + y² − 1`
+/// struct Circle;
+/// impl Constraint<2, 1> for Circle {
+///     fn eval<D: Scalar>(&self, [x, y]: [D; 2], _t: D) -> [D; 1] {
+///         [x * x + y * y - 1.0]
+///     }
+/// }
+///
+/// let model = Model::builder(vec![2.0, 2.0]).constrain(Circle, [0, 1]).build()?;
+/// assert_eq!((model.n(), model.m()), (2, 1));
+/// let mut phi = [0.0];
+/// model.constraint_values(&[0.6, 0.8], 0.0, &mut phi);
+/// assert!(phi[0].abs() < 1e-15);
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 pub struct Model {
     pub(super) inertia: Inertia,
     pub(super) constraints: Vec<Box<dyn ConstraintBlock>>,

@@ -7,6 +7,24 @@ use super::element::Element;
 use crate::error::{Part, Problem, Result};
 
 /// A planar mechanism under construction; [`Mechanism::build`] turns it into a model.
+///
+/// A pendulum: a point mass on a rod from the ground, held by `robust`:
+///
+/// ```
+/// use cdyn::planar::{BodyId, Element, Mechanism};
+/// use cdyn::{Control, Scheme, Settings, Simulation};
+///
+/// let mut m = Mechanism::new([0.0, -9.81]);
+/// let bob = m.point("bob", 1.0, [1.0, 0.0]);
+/// m.add(Element::Distance { a: BodyId::Ground, pa: [0.0, 0.0], b: bob, pb: [0.0, 0.0], length: 1.0 });
+/// let built = m.build()?;
+/// assert_eq!(built.names, ["bob.x", "bob.y"]);
+/// let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+/// let mut sim = Simulation::new(&built.model, settings, &built.q0, &built.v0)?;
+/// sim.run::<cdyn::Error>(0.1, 10, |_| Ok(()))?;
+/// assert!(sim.measure().phi.abs() < 1e-9 && sim.q()[1] < 0.0); // on the rod, falling
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 #[derive(Debug, Clone, Default)]
 #[non_exhaustive]
 pub struct Mechanism {

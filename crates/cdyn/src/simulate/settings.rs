@@ -9,6 +9,17 @@ use crate::integrate::Scheme;
 use crate::simulate::generalized_alpha::GeneralizedAlpha;
 
 /// How to simulate: [`Settings::new`] and the `with_*` setters.
+///
+/// ```
+/// use cdyn::dynamics::LinearSolver;
+/// use cdyn::{Control, Scheme, Settings};
+///
+/// let settings = Settings::new(Scheme::AdamsBashforthMoulton4, 1e-3, Control::robust())
+///     .with_violation_limit(1e-3) // stop the run if max |Φ| exceeds it
+///     .with_solver(LinearSolver::Sparse);
+/// assert!(settings.validate().is_ok());
+/// assert!(Settings::new(Scheme::RungeKutta4, 0.0, Control::none()).validate().is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct Settings {

@@ -53,6 +53,27 @@ pub struct RankLoss {
 }
 
 /// A running simulation of a [`Model`].
+///
+/// A harmonic oscillator `ẍ = −x` by RK-4, against `cos t`:
+///
+/// ```
+/// use cdyn::{Control, Model, Potential, Scalar, Scheme, Settings, Simulation};
+///
+/// struct Spring;
+/// impl Potential<1> for Spring {
+///     fn energy<D: Scalar>(&self, [x]: [D; 1]) -> D {
+///         x * x * 0.5
+///     }
+/// }
+///
+/// let model = Model::builder(vec![1.0]).potential(Spring, [0]).build()?;
+/// let settings = Settings::new(Scheme::RungeKutta4, 0.01, Control::none());
+/// let mut sim = Simulation::new(&model, settings, &[1.0], &[0.0])?;
+/// sim.run::<cdyn::Error>(1.0, 10, |_| Ok(()))?;
+/// assert_eq!(sim.steps(), 100);
+/// assert!((sim.q()[0] - 1f64.cos()).abs() < 1e-9);
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 pub type Simulation<'m> = Stepper<ControlledSystem<'m>>;
 
 impl<'m> Simulation<'m> {

@@ -139,7 +139,7 @@ pub struct SpatialBody {
 }
 
 impl SpatialBody {
-    /// Body `index` of a [`Mechanism`].
+    /// Body `index` of a [`Mechanism`](super::Mechanism).
     pub fn of(index: usize) -> Self {
         Self { first: 7 * index }
     }

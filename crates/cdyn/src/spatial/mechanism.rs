@@ -13,6 +13,25 @@ use crate::model::angular::Generator;
 use crate::model::force::Potential;
 
 /// Bodies, joints and uniform gravity.
+///
+/// A rod hanging from a spherical joint at the origin, started off the
+/// vertical: seven coordinates, the joint's three rows and the Euler
+/// parameters' normalization:
+///
+/// ```
+/// use cdyn::spatial::{Body, Joint, JointKind, Mechanism};
+/// use cdyn::{Control, Scheme, Settings, Simulation};
+///
+/// let rod = Body::new("rod", 1.0, [0.08, 0.08, 0.01]).with_position([0.3, 0.0, -0.4]);
+/// let pivot = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
+/// let built = Mechanism::new([0.0, 0.0, -9.81]).with_bodies(vec![rod]).with_joints(vec![pivot]).build()?;
+/// assert_eq!((built.model.n(), built.model.m()), (7, 4));
+/// let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+/// let mut sim = Simulation::new(&built.model, settings, &built.q0, &built.v0)?;
+/// sim.run::<cdyn::Error>(0.05, 10, |_| Ok(()))?;
+/// assert!(sim.measure().phi.abs() < 1e-9 && sim.q()[0] < 0.3); // swinging back towards the vertical
+/// # Ok::<(), cdyn::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 #[non_exhaustive]
 pub struct Mechanism {

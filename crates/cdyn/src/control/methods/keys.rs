@@ -13,9 +13,9 @@ use crate::integrate::Application;
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 #[non_exhaustive]
 pub enum Preset {
-    /// [`robust`]: the combination the method suite shows best, with automatic gains.
+    /// [`robust`](super::robust): the combination the method suite shows best, with automatic gains.
     Robust,
-    /// [`projection`]: exact projection onto the invariants after every step.
+    /// [`projection`](super::projection): exact projection onto the invariants after every step.
     Projection,
 }
 
@@ -91,7 +91,7 @@ pub enum GeometricKind {
     /// CVSGF: `zeta` or `alpha_g` (a number or `"auto"`).
     Cvsgf,
     /// CVSGF with the coupled gain in the kinetic-energy metric
-    /// ([`Geometric::Newton`]): `alpha_g`, automatic when not given.
+    /// ([`Geometric::Newton`](crate::Geometric::Newton)): `alpha_g`, automatic when not given.
     Newton,
 }
 
@@ -104,7 +104,7 @@ pub enum VelocityKind {
     /// None.
     #[default]
     None,
-    /// Gradient feedback on `Φ̇` ([`Velocity::Gradient`]): `alpha_v`, automatic when not given.
+    /// Gradient feedback on `Φ̇` ([`Velocity::Gradient`](crate::Velocity::Gradient)): `alpha_v`, automatic when not given.
     Gradient,
 }
 
@@ -121,14 +121,14 @@ pub enum EnergyKind {
     Gradient,
     /// Baumgarte-type: `eta`.
     Baumgarte,
-    /// Gradient feedback that respects the constraints ([`Energy::Projected`]):
+    /// Gradient feedback that respects the constraints ([`Energy::Projected`](crate::Energy::Projected)):
     /// `alpha_e` (automatic when not given) and `position_weight`.
     Projected,
 }
 
 /// A stabilization method as scenario files write it: one flat table whose
 /// gains are optional, so that `cdyn compare` can fill in the missing ones.
-/// [`MethodKeys::control`] turns it into a [`Control`], refusing gains the
+/// [`MethodKeys::control`] turns it into a [`Control`](crate::Control), refusing gains the
 /// named methods do not use. A sweep axis is one of the gain keys.
 #[derive(Debug, Clone, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
@@ -164,7 +164,7 @@ pub struct MethodKeys {
     /// Gradient energy control: target rate `α_e` (Eq. 27); projected: its
     /// rate, or `"auto"`.
     pub alpha_e: Option<RateKey>,
-    /// Projected energy control: `c α_e²` (default [`POSITION_WEIGHT`]).
+    /// Projected energy control: `c α_e²` (default [`POSITION_WEIGHT`](crate::control::POSITION_WEIGHT)).
     pub position_weight: Option<f64>,
     /// Gradient energy control: fixed `ρ_q` (default 0, with `rho_v`).
     pub rho_q: Option<f64>,

@@ -1,7 +1,7 @@
 //! Stabilization methods by name: the flat table of keys in which scenario
 //! files write a method (`geometric = "cvsgf"`, `zeta = 20.0`, …), and the
 //! named cases of the paper's comparison, for `cdyn paper`, `compare`,
-//! `bench` and benchmarks. A simulation itself needs only a [`Control`].
+//! `bench` and benchmarks. A simulation itself needs only a [`Control`](crate::Control).
 //!
 //! - `keys`: [`MethodKeys`], the scenario table, and the kinds it names;
 //! - `keys_to_control`: [`MethodKeys::control`] and [`MethodKeys::gains`];

@@ -90,14 +90,14 @@ impl Potential<4> for FourBarWeight {
 }
 
 /// The four-bar in its joint angles `q = (θ, β, ψ)` — crank, coupler and
-/// rocker angles from +X, as in [`four_bar`] — and, with a load, the load
+/// rocker angles from +X, as in [`four_bar`](super::four_bar) — and, with a load, the load
 /// pendulum's angle `φ` from the downward vertical. Constraints: the crank
 /// drive and the loop closure (two rows). The crank's and rocker's inertia
 /// about their pivots is constant (`m l²/4 + I` on the diagonal); the
 /// coupler's and the load's kinetic energies are elements, so `M(q)` is
 /// full where they couple the angles.
 ///
-/// Observables and reference as for [`four_bar`]: `rocker.angle`,
+/// Observables and reference as for [`four_bar`](super::four_bar): `rocker.angle`,
 /// `coupler.angle`, `rocker.rate`, `load.angle` (with a load), then the angles.
 pub fn four_bar_angles(p: FourBarParams) -> Result<Example> {
     p.validate()?;

@@ -35,7 +35,7 @@ pub enum FourBarBranch {
 }
 
 /// A four-bar linkage: ground pivots A = (0, 0) and D = (d, 0); crank AB
-/// (length a) driven at constant angular speed by a [`Element::DriveAngle`]
+/// (length a) driven at constant angular speed by a [`Element::DriveAngle`](crate::planar::Element::DriveAngle)
 /// relative to the ground; coupler BC (length b); rocker DC (length c);
 /// revolute joints at A, B, C, D. The crank must turn fully without
 /// reaching a toggle position: `|b − c| < d − a` and `d + a < b + c`
