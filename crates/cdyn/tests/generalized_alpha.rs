@@ -158,6 +158,19 @@ fn bad_settings_and_failed_iterations_are_errors_naming_the_cause() {
     let e = sim.step().unwrap_err();
     assert!(matches!(e, Error::NewtonFailed { step: 1, iterations: 1, .. }), "{e}");
     assert!(e.to_string().contains("did not converge at step 1"), "{e}");
+    // A Newton matrix singular with no constraint to blame: ρ∞ = 1 makes
+    // c_q = h²β(1 − α_f)/(1 − α_m) = h²/4, so at h = 0.5 a spring of
+    // k = −16 cancels a unit mass exactly: m + c_q k = 0.
+    let model = oscillator(1.0, -16.0, 0.0);
+    let mut sim = Simulation::new(&model, alpha(0.5, 1.0), &[0.1], &[0.0]).unwrap();
+    let e = sim.step().unwrap_err();
+    assert_eq!(e, Error::NewtonSingular { step: 1, t: 0.5, iterations: 0 });
+    let text = e.to_string();
+    assert!(text.contains("Newton matrix is singular at step 1, t = 0.5") && text.contains("take a smaller h"), "{e}");
+    // A step of 0.25 is fine (the motion grows, as it should).
+    let mut sim = Simulation::new(&model, alpha(0.25, 1.0), &[0.1], &[0.0]).unwrap();
+    sim.step().unwrap();
+    assert!(sim.q()[0] > 0.1);
     // Projection may follow it.
     let settings = alpha(2e-3, 0.9).with_control(methods::projection());
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();

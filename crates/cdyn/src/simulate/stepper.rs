@@ -327,20 +327,19 @@ impl<S: System> Stepper<S> {
                 }
             }
         } else if self.settings.scheme == Scheme::GeneralizedAlpha {
-            let (cause, correction, iterations) = match self.system.generalized_alpha(self.x.as_mut_slice(), t, h) {
+            let (step, t) = (step + 1, t + h);
+            match self.system.generalized_alpha(self.x.as_mut_slice(), t - h, h) {
                 Ok(r) => {
                     self.newton_iterations += u64::from(r.iterations);
                     self.newton_correction = self.newton_correction.max(r.correction);
-                    ("", 0.0, 0)
                 }
-                Err(AlphaFailure::Eval(e)) => return Err(eval_error(e, step, t + h)),
-                Err(AlphaFailure::Singular) => ("met a singular matrix", f64::NAN, 0),
+                Err(AlphaFailure::Eval(e)) => return Err(eval_error(e, step - 1, t)),
+                Err(AlphaFailure::Singular { iterations }) => {
+                    return Err(Error::NewtonSingular { step, t, iterations });
+                }
                 Err(AlphaFailure::NotConverged { correction, iterations }) => {
-                    ("did not converge", correction, iterations)
+                    return Err(Error::NewtonFailed { step, t, correction, iterations });
                 }
-            };
-            if !cause.is_empty() {
-                return Err(Error::NewtonFailed { step: step + 1, t: t + h, cause, correction, iterations });
             }
         } else {
             self.integrator
