@@ -398,7 +398,13 @@ impl System for ControlledSystem<'_> {
         true
     }
     fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha, q0: &[f64], v0: &[f64], h: f64) {
-        let mut work = generalized_alpha::Work::new(self.model, &self.dynamics, settings, self.dependent_rows);
+        let mut work = generalized_alpha::Work::new(
+            self.model,
+            &self.dynamics,
+            settings,
+            self.dependent_rows,
+            self.control.projection.is_some(),
+        );
         // A state the dynamics cannot evaluate leaves it unstarted: the first step says why.
         let _ = work.start(self.model, &mut self.dynamics, q0, v0, 0.0, h, &mut self.evaluations);
         self.alpha = Some(work);
