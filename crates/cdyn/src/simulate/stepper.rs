@@ -201,8 +201,10 @@ impl<S: System> Stepper<S> {
         // Automatic gains, and the rate × h every control term runs at.
         // A state the dynamics cannot evaluate fails the first step, which
         // reports it with the run's record; the gains are then moot.
-        // The projection reads the damping's rate (whether to project `Ψ`).
-        let operators = if settings.control.is_active() || settings.control.projection.is_some() {
+        // The projection reads the damping's rate (whether to project `Ψ`);
+        // an explicit scheme's run reports the damping's and the springs'
+        // rates against its step (a hint where they are stiff).
+        let operators = if settings.scheme != Scheme::GeneralizedAlpha || settings.control.projection.is_some() {
             system.operators(x.as_slice(), 0.0).unwrap_or(Operators { coupling: 1.0, ..Operators::default() })
         } else {
             Operators::default()

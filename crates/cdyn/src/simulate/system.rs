@@ -369,10 +369,26 @@ impl System for ControlledSystem<'_> {
             out.fill(0.0);
             model.add_damping(q, v, w, t, out);
         };
+        // K of generalized-α's Newton matrix: the potentials' and forces'
+        // stiffness, and the constraints' curvatures weighted by λ.
+        let mut entries = Vec::new();
+        model.iteration_entries(&mut entries);
+        let forces = entries.len();
+        model.curvature_entries(&mut entries);
+        let mut values = vec![0.0; entries.len()];
+        model.iteration_values(q, v, t, 1.0, 0.0, &mut values[..forces]);
+        model.curvature_values(q, t, self.dynamics.lambda(), 1.0, &mut values[forces..]);
+        let stiffness = |w: &[f64], out: &mut [f64]| {
+            out.fill(0.0);
+            for (&(r, c), k) in entries.iter().zip(&values) {
+                out[r as usize] += k * w[c as usize];
+            }
+        };
         Ok(Operators {
             coupling: crate::control::gains::coupling(&d, n),
             max_row_norm2: rows.fold(0.0, f64::max),
             dissipation: crate::control::gains::dissipation_rate(&d, n, damping),
+            frequency: crate::control::gains::oscillation_frequency(&d, n, stiffness),
         })
     }
     fn set_control(&mut self, control: Control) {
