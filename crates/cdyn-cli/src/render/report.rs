@@ -162,10 +162,11 @@ pub fn stiff_hint(c: &CaseResult) -> Option<String> {
             "stability limit on oscillations",
         ),
     ];
-    // Euler and AB-2 grow on any oscillation: no step to name.
+    // Euler and AB-2 grow on any oscillation, and an infinite h λ (a step
+    // of 1e308) has no step to name.
     let (what, figure, x, limit, kind) = candidates
         .into_iter()
-        .filter(|&(_, _, x, limit, _)| limit > 0.0 && x > NEAR_STABILITY_LIMIT * limit)
+        .filter(|&(_, _, x, limit, _)| limit > 0.0 && x > NEAR_STABILITY_LIMIT * limit && x.is_finite())
         .max_by(|a, b| (a.2 / a.3).total_cmp(&(b.2 / b.3)))?;
     Some(format!(
         "{what} stiff against the step ({figure} = {x:.3}; {}'s {kind} is {limit:.3}): scheme = \"generalized_alpha\" has no such limit, or {} needs h ≤ {:.2e}",
