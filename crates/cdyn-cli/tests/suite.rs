@@ -149,7 +149,7 @@ fn the_light_suite_has_every_case_and_its_checks_hold_but_the_known_misses() {
             assert_eq!(free_motion, model != "slider_crank", "{label}: the driven slider-crank has no free motion");
             // Check g: the uncontrolled run of a scheme that holds Φ holds it.
             let none = &runs[0];
-            let held = none["error"].is_null() && num(&none["max_abs_phi"]) <= 1e-9;
+            let held = none["error"].is_null() && num(&none["max_abs_phi"]) <= cdyn_cli::study::suite::HELD_PHI;
             assert_eq!(case["applies"]["g"], steps_model, "{label} (g)");
             assert_eq!(case["checks"]["g"], !steps_model || held, "{label} (g): {}", case["compared"]["g"]);
             if steps_model && !held {

@@ -42,6 +42,11 @@
 //! the curvatures and the refactoring, Andrews' squeezer (multipliers of
 //! 100 N on links of 2–4 cm) did not converge at h = 7.5e-4; with them it
 //! runs there, and stops at 1e-3.
+//!
+//! With [`DependentRows::Tolerate`] each new Newton matrix comes with a
+//! factorization of `Φ_q M⁻¹ Φ_qᵀ` at its iterate (a full evaluation), and
+//! the rows it drops get `Δμ_r = 0` and `λ_r = 0`: the explicit schemes'
+//! basic solution (Bricard's mechanism, the N four-bar's flat position).
 
 use crate::dynamics::{Breakdown, DependentRows, Dynamics};
 use crate::error::{Error, Result};
@@ -398,10 +403,10 @@ pub(crate) fn step(
         *evaluations += 1;
         // A fresh Newton matrix with tolerated dependent rows: the full
         // evaluation factors `Φ_q M⁻¹ Φ_qᵀ` at the iterate, which finds them.
-        let find_dropped = refactor && w.tolerate;
-        let evaluated = if find_dropped { d.evaluate(model, q, v, t1) } else { d.evaluate_forces(model, q, v, t1) };
+        let rank_revealed = refactor && w.tolerate;
+        let evaluated = if rank_revealed { d.evaluate(model, q, v, t1) } else { d.evaluate_forces(model, q, v, t1) };
         evaluated.map_err(|b| Failure::Breakdown(b, t1))?;
-        if find_dropped {
+        if rank_revealed {
             w.find_dropped(d);
         }
         residual(model, d, w, c_q, gamma_prime);

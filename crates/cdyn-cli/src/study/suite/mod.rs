@@ -287,7 +287,7 @@ fn run_model(model: &Model) -> Result<(Vec<Group>, f64)> {
             reference_h: model.h / REFERENCE_DIVISOR as f64,
             baseline: cases[none].name.clone(),
             free_motion,
-            verdicts: verdicts(&runs, none, robust, projection, free_motion, scheme.steps_model()),
+            verdicts: verdicts(&runs, none, robust, projection, free_motion),
             runs,
         });
     }

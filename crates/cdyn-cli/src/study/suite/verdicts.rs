@@ -2,17 +2,16 @@
 
 use super::*;
 
-/// The checks of [`CHECKS`] on one group: a–d and f judge `robust` (none
-/// in a group of a scheme that steps the model, where they do not apply),
-/// g the uncontrolled run of such a scheme. A run judged that stopped
-/// fails every check that applies to it.
+/// The checks of [`CHECKS`] on one group: a–d and f judge `robust`; a
+/// group without one is of a scheme that steps the model (RATTLE,
+/// generalized-α), where g judges its uncontrolled run instead. A run
+/// judged that stopped fails every check that applies to it.
 pub(super) fn verdicts(
     runs: &[Run],
     none: usize,
     robust: Option<usize>,
     projection: usize,
     free_motion: bool,
-    steps_model: bool,
 ) -> Vec<Verdict> {
     let (none, projection) = (&runs[none], &runs[projection]);
     let verdict = |applies: bool, ok: bool, pass: bool, numbers: String| Verdict {
@@ -21,7 +20,7 @@ pub(super) fn verdicts(
         numbers,
     };
     let held = verdict(
-        steps_model,
+        robust.is_none(),
         none.error.is_none(),
         none.max_abs_phi <= HELD_PHI,
         format!("max|phi| none {:.3e}", none.max_abs_phi),
