@@ -101,7 +101,18 @@ fn chains(c: &mut Criterion) {
         .with_application(Application::ForwardEuler);
     let examples: Vec<_> = sizes
         .iter()
-        .map(|&n| chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 }).unwrap())
+        .map(|&n| {
+            chain(
+                ChainParams::default()
+                    .with_n(n)
+                    .with_mass(1.0)
+                    .with_length(1.0)
+                    .with_gravity(1.0)
+                    .with_theta0(0.3)
+                    .with_omega0(0.0),
+            )
+            .unwrap()
+        })
         .collect();
     for (name, control) in
         [("cvsgf_energy", cvsgf_energy), ("robust", methods::robust()), ("projection", methods::projection())]
@@ -131,8 +142,8 @@ fn chains(c: &mut Criterion) {
 /// of the same mechanism in more coordinates.
 fn angles(c: &mut Criterion) {
     let mut group = c.benchmark_group("angles_vs_cartesian_rk4");
-    let loaded = FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() };
-    let dp = DoublePendulumParams { theta1: 1.0, theta2: 0.5, ..Default::default() };
+    let loaded = FourBarParams::default().with_load(Some(LoadPendulum::default()));
+    let dp = DoublePendulumParams::default().with_theta1(1.0).with_theta2(0.5);
     let cases: [(&str, Example); 4] = [
         ("double_pendulum_cartesian", double_pendulum(dp).unwrap()),
         ("double_pendulum_angles", double_pendulum_angles(dp).unwrap()),

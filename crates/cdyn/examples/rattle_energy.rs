@@ -30,7 +30,7 @@ fn bands(ex: &Example, settings: Settings, steps: u64) -> (Vec<f64>, f64) {
 fn main() {
     let steps: u64 = std::env::args().nth(1).map_or(1_000_000, |s| s.parse().expect("STEPS: a whole number"));
     let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
-    let chain_of = |n| chain(ChainParams { n, theta0: 0.8, ..ChainParams::default() }).unwrap();
+    let chain_of = |n| chain(ChainParams::default().with_n(n).with_theta0(0.8)).unwrap();
     let cases = [("Example 1", pendulum, 0.01, steps), ("chain 100", chain_of(100), 1e-3, steps)];
     let cases = cases.into_iter().chain([("chain 1000", chain_of(1000), 1e-3, steps / 10)]);
     for (name, ex, h, steps) in cases {

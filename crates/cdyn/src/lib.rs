@@ -35,19 +35,26 @@ pub(crate) use with_const;
 
 /// Builder-style setters, `with_<field>(value) -> Self`, for the fields of a
 /// configuration type that users build: with the type `#[non_exhaustive]`,
-/// a new field is then not a breaking change.
+/// a new field is then not a breaking change. `name => field(Some): T`
+/// sets an optional field from a plain `T`; `impl<B> Type<B> { … }` writes
+/// them for a generic type.
 macro_rules! setters {
-    ($ty:ty { $($(#[$doc:meta])* $name:ident => $field:ident: $t:ty),+ $(,)? }) => {
-        impl $ty {
+    (@wrap $value:ident) => { $value };
+    (@wrap $wrap:ident $value:ident) => { $wrap($value) };
+    (impl<$($g:ident),*> $ty:ty { $($(#[$doc:meta])* $name:ident => $field:ident $(($wrap:ident))?: $t:ty),+ $(,)? }) => {
+        impl<$($g),*> $ty {
             $(
                 $(#[$doc])*
                 #[must_use]
                 pub fn $name(mut self, value: $t) -> Self {
-                    self.$field = value;
+                    self.$field = $crate::setters!(@wrap $($wrap)? value);
                     self
                 }
             )+
         }
+    };
+    ($ty:ty { $($body:tt)+ }) => {
+        $crate::setters!(impl<> $ty { $($body)+ });
     };
 }
 pub(crate) use setters;

@@ -77,7 +77,7 @@ fn chain_mechanism(n: usize) -> Mechanism {
     m.add(Element::DriveCoordinate {
         body: support,
         coordinate: Coordinate::X,
-        f: TimeFn { polynomial: vec![], sines: vec![[0.1, 3.0, 0.0]] },
+        f: TimeFn::default().with_sines(vec![[0.1, 3.0, 0.0]]),
     });
     m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::Y, f: TimeFn::constant(0.0) });
     m.add(Element::DriveCoordinate { body: support, coordinate: Coordinate::Angle, f: TimeFn::constant(0.0) });
@@ -207,8 +207,7 @@ fn steps_do_not_allocate() {
     let trailer = tractor_trailer();
     let redundant = redundant_chain(64);
     let angles = double_pendulum_angles(DoublePendulumParams::default()).unwrap();
-    let four_bar =
-        four_bar_angles(FourBarParams { load: Some(LoadPendulum::default()), ..Default::default() }).unwrap();
+    let four_bar = four_bar_angles(FourBarParams::default().with_load(Some(LoadPendulum::default()))).unwrap();
     let cdyn::spatial::Built { model: spatial, q0: sq0, v0: sv0, .. } =
         cdyn::spatial::chain(40, 0.3, 1.0).build().unwrap();
     assert!(spatial.mass_blocks().is_some());

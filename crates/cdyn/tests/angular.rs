@@ -22,34 +22,30 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// A free asymmetric body with a full inertia tensor in its own axes,
 /// moving and tumbling, off the origin.
 fn free_body() -> Mechanism {
-    let body = Body {
+    let body = Body::new("body", 2.0, [1.0; 3])
         // Principal moments 1, 2, 3 kg m² about axes turned 0.7 rad about (1, 2, 3).
-        inertia: [
+        .with_inertia([
             [1.544859710076236, -0.45817463857111, 0.591356595893453],
             [-0.45817463857111, 1.702467921455299, 0.096314688900842],
             [0.591356595893453, 0.096314688900842, 2.752672368468465],
-        ],
-        position: [0.3, -0.2, 0.5],
-        velocity: [0.1, 0.25, -0.05],
-        orientation: compose(about([0.0, 0.0, 1.0], 0.4), about([0.6, 0.8, 0.0], 0.9)),
-        angular_velocity: [1.18, 0.48, 0.62],
-        ..Body::new("body", 2.0, [1.0; 3])
-    };
-    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3], loads: vec![] }
+        ])
+        .with_position([0.3, -0.2, 0.5])
+        .with_velocity([0.1, 0.25, -0.05])
+        .with_orientation(compose(about([0.0, 0.0, 1.0], 0.4), about([0.6, 0.8, 0.0], 0.9)))
+        .with_angular_velocity([1.18, 0.48, 0.62]);
+    Mechanism::new([0.0; 3]).with_bodies(vec![body])
 }
 
 /// The heavy top of Brüls & Cardona on a fixed point at `pivot`, under `gravity`.
 fn top(pivot: [f64; 3], gravity: [f64; 3]) -> Mechanism {
     let w0 = [0.0, 150.0, -4.61538];
     let arm = [0.0, 1.0, 0.0];
-    let top = Body {
-        position: std::array::from_fn(|i| pivot[i] + arm[i]),
-        velocity: cross(w0, arm),
-        angular_velocity: w0,
-        ..Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
-    };
+    let top = Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
+        .with_position(std::array::from_fn(|i| pivot[i] + arm[i]))
+        .with_velocity(cross(w0, arm))
+        .with_angular_velocity(w0);
     let fixed = Joint::new(JointKind::Spherical, 0, None, pivot);
-    Mechanism { bodies: vec![top], joints: vec![fixed], gravity, loads: vec![] }
+    Mechanism::new(gravity).with_bodies(vec![top]).with_joints(vec![fixed])
 }
 
 fn found(m: &Mechanism) -> Vec<String> {

@@ -63,7 +63,8 @@ fn rk4_converges_to_the_exact_solution_over_the_whole_paper_interval() {
 #[test]
 fn cartesian_and_angle_models_agree_for_other_parameters() {
     // A librating pendulum, L = 2, g = 9.81, m = 3: both descriptions and the exact solution.
-    let p = PendulumParams { mass: 3.0, length: 2.0, gravity: 9.81, theta0: -1.0, omega0: 0.4 };
+    let p =
+        PendulumParams::default().with_mass(3.0).with_length(2.0).with_gravity(9.81).with_theta0(-1.0).with_omega0(0.4);
     for ex in [cartesian_pendulum(p).unwrap(), theta_pendulum(p).unwrap()] {
         let e = max_error(&ex, Scheme::RungeKutta4, 1e-3, Control::none(), 5.0);
         assert!(e < 1e-9, "n = {}: max |X − X*| = {e:e}", ex.model.n());

@@ -102,7 +102,7 @@ fn a_mode_far_above_one_over_h_is_damped_by_rho_inf_per_step() {
 #[test]
 fn constraints_hold_to_the_newton_tolerance_after_every_step() {
     let cases = [
-        ("chain of 20", chain(ChainParams { n: 20, theta0: 0.6, ..ChainParams::default() }).unwrap(), 2e-3),
+        ("chain of 20", chain(ChainParams::default().with_n(20).with_theta0(0.6)).unwrap(), 2e-3),
         ("driven four-bar", four_bar(FourBarParams::default()).unwrap(), 1e-3),
     ];
     for (name, ex, h) in cases {
@@ -128,7 +128,7 @@ fn constraints_hold_to_the_newton_tolerance_after_every_step() {
 
 #[test]
 fn a_fixed_count_of_corrections_costs_the_same_every_step() {
-    let ex = chain(ChainParams { n: 10, theta0: 0.6, ..ChainParams::default() }).unwrap();
+    let ex = chain(ChainParams::default().with_n(10).with_theta0(0.6)).unwrap();
     let settings = alpha(2e-3, 0.9).with_generalized_alpha(GeneralizedAlpha::new().with_newton(Newton::fixed(2)));
     let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
     sim.step().unwrap();
@@ -144,7 +144,7 @@ fn a_fixed_count_of_corrections_costs_the_same_every_step() {
 
 #[test]
 fn bad_settings_and_failed_iterations_are_errors_naming_the_cause() {
-    let ex = chain(ChainParams { n: 5, theta0: 0.6, ..ChainParams::default() }).unwrap();
+    let ex = chain(ChainParams::default().with_n(5).with_theta0(0.6)).unwrap();
     for rho in [-0.1, 1.5, f64::NAN] {
         let e = Simulation::new(&ex.model, alpha(1e-3, rho), &ex.q0, &ex.v0).err().unwrap();
         assert!(e.to_string().contains("rho_inf"), "{e}");

@@ -17,17 +17,15 @@ use cdyn::{Error, Model, Scheme, Settings, Simulation};
 use proptest::prelude::*;
 
 fn params(theta1: f64, theta2: f64) -> DoublePendulumParams {
-    DoublePendulumParams {
-        m1: 1.3,
-        m2: 0.7,
-        l1: 1.1,
-        l2: 0.8,
-        theta1,
-        theta2,
-        omega1: 0.4,
-        omega2: -0.9,
-        ..Default::default()
-    }
+    DoublePendulumParams::default()
+        .with_m1(1.3)
+        .with_m2(0.7)
+        .with_l1(1.1)
+        .with_l2(0.8)
+        .with_theta1(theta1)
+        .with_theta2(theta2)
+        .with_omega1(0.4)
+        .with_omega2(-0.9)
 }
 
 fn element(p: &DoublePendulumParams) -> DoublePendulumKinetic {
@@ -146,7 +144,7 @@ fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
 #[test]
 fn angles_and_cartesian_coordinates_give_the_same_motion_at_order_four() {
     // A regular (not chaotic) motion: both rods released at moderate angles.
-    let p = DoublePendulumParams { theta1: 0.8, theta2: 0.3, omega1: 0.0, omega2: 1.0, ..Default::default() };
+    let p = DoublePendulumParams::default().with_theta1(0.8).with_theta2(0.3).with_omega1(0.0).with_omega2(1.0);
     let (angles, cartesian) = (double_pendulum_angles(p).unwrap(), double_pendulum(p).unwrap());
     let t_end = 4.0;
     let steps = [0.04, 0.02, 0.01, 0.00125];
@@ -188,7 +186,11 @@ fn the_energy_controls_set_the_same_decay_of_psi_in_both_coordinates() {
     let projected = Energy::Projected { alpha_e: Rate::Given(alpha), position_weight: POSITION_WEIGHT };
     for energy in [projected, Energy::Baumgarte { eta: alpha }] {
         for (theta1, theta2, omega1, omega2) in [(1.0, 0.5, 0.3, -1.2), (-0.4, 2.0, 1.5, 0.2)] {
-            let p = DoublePendulumParams { theta1, theta2, omega1, omega2, ..Default::default() };
+            let p = DoublePendulumParams::default()
+                .with_theta1(theta1)
+                .with_theta2(theta2)
+                .with_omega1(omega1)
+                .with_omega2(omega2);
             let mut rates = Vec::new();
             for ex in [double_pendulum_angles(p).unwrap(), double_pendulum(p).unwrap()] {
                 let model = &ex.model;
@@ -212,7 +214,7 @@ fn the_energy_controls_set_the_same_decay_of_psi_in_both_coordinates() {
 #[test]
 fn uncontrolled_energy_drift_is_the_integration_error_of_each() {
     // Ψ drifts only by the integration error: O(h⁴) with RK-4 in both.
-    let p = DoublePendulumParams { theta1: 1.0, theta2: 0.5, omega1: 0.0, omega2: 0.0, ..Default::default() };
+    let p = DoublePendulumParams::default().with_theta1(1.0).with_theta2(0.5).with_omega1(0.0).with_omega2(0.0);
     for ex in [double_pendulum_angles(p).unwrap(), double_pendulum(p).unwrap()] {
         let worst = |h: f64| run(&ex, h, Control::none(), 4.0).iter().map(|s| s.1).fold(0.0, f64::max);
         let (coarse, fine) = (worst(0.02), worst(0.01));
@@ -247,7 +249,7 @@ fn against_reference(ex: &Example, h: f64, t_end: f64, k: usize) -> (f64, Vec<Ve
 #[test]
 fn four_bar_in_angles_follows_the_exact_kinematics_and_the_cartesian_model() {
     for load in [None, Some(LoadPendulum::default())] {
-        let p = FourBarParams { load, ..Default::default() };
+        let p = FourBarParams::default().with_load(load);
         let (angles, cartesian) = (four_bar_angles(p).unwrap(), four_bar(p).unwrap());
         assert_eq!((angles.model.n(), angles.model.m()), (3 + load.is_some() as usize, 3));
         let t_end = 3.0;

@@ -94,7 +94,7 @@ fn frequency(samples: &[(f64, f64)]) -> f64 {
 /// fixed gain makes the Euler-applied control unstable at h = 0.01. The
 /// rate form sets `ζᵢ = α_g / (2|∇Φᵢ|²)` every step, as Eq. 40 intends.
 fn paper_gains() -> MethodGains {
-    MethodGains { cvsgf: Gain::Rate(40.0), ..MethodGains::paper() }
+    MethodGains::paper().with_cvsgf(Gain::Rate(40.0))
 }
 
 /// `(max |Φ|, |Φ| at the end, max |Ψ|)` of a run with the named control of
@@ -151,9 +151,8 @@ fn double_pendulum_normal_modes_have_the_linearized_frequencies() {
     // at h = 1e-3 (ωh ≤ 0.01) adds a phase error ~1e-10 and the crossing
     // interpolation ~1e-8. So 1e-5 is the a-priori bound, not a fit.
     let eps = 1e-3;
-    let equal = DoublePendulumParams { gravity: G, ..DoublePendulumParams::default() };
-    let unequal =
-        DoublePendulumParams { m1: 2.0, m2: 0.5, l1: 1.0, l2: 0.6, gravity: G, ..DoublePendulumParams::default() };
+    let equal = DoublePendulumParams::default().with_gravity(G);
+    let unequal = DoublePendulumParams::default().with_m1(2.0).with_m2(0.5).with_l1(1.0).with_l2(0.6).with_gravity(G);
     // For equal masses and lengths, ω² = (g/l)(2 ∓ √2).
     let closed = [G * (2.0 - 2f64.sqrt()), G * (2.0 + 2f64.sqrt())];
     let modes = double_modes(&equal);
@@ -162,14 +161,9 @@ fn double_pendulum_normal_modes_have_the_linearized_frequencies() {
     }
     for p in [equal, unequal] {
         for (w2, u) in double_modes(&p) {
-            let ex = double_pendulum(DoublePendulumParams {
-                theta1: eps * u[0],
-                theta2: eps * u[1],
-                omega1: 0.0,
-                omega2: 0.0,
-                ..p
-            })
-            .unwrap();
+            let ex =
+                double_pendulum(p.with_theta1(eps * u[0]).with_theta2(eps * u[1]).with_omega1(0.0).with_omega2(0.0))
+                    .unwrap();
             let omega = w2.sqrt();
             // About eight periods.
             let t_end = 16.0 * PI / omega;
@@ -198,17 +192,18 @@ fn double_pendulum_without_gravity_in_line_rotates_rigidly() {
     // Both masses on one line through the pivot, v_i = ω × r_i: tension
     // alone supplies the centripetal forces, so θ1 = θ2 = θ0 + ωt exactly.
     let (theta0, omega) = (0.7, 1.3);
-    let ex = double_pendulum(DoublePendulumParams {
-        m1: 1.5,
-        m2: 0.8,
-        l1: 1.0,
-        l2: 0.7,
-        gravity: 0.0,
-        theta1: theta0,
-        theta2: theta0,
-        omega1: omega,
-        omega2: omega,
-    })
+    let ex = double_pendulum(
+        DoublePendulumParams::default()
+            .with_m1(1.5)
+            .with_m2(0.8)
+            .with_l1(1.0)
+            .with_l2(0.7)
+            .with_gravity(0.0)
+            .with_theta1(theta0)
+            .with_theta2(theta0)
+            .with_omega1(omega)
+            .with_omega2(omega),
+    )
     .unwrap();
     let revolutions = 3.0;
     let mut sim = rk4(&ex, 1e-3);
@@ -263,17 +258,16 @@ fn rk4_step(f: impl Fn([f64; 4]) -> [f64; 4], y: [f64; 4], h: f64) -> [f64; 4] {
 
 #[test]
 fn double_pendulum_matches_the_generalized_coordinate_equations() {
-    let p = DoublePendulumParams {
-        m1: 1.2,
-        m2: 0.7,
-        l1: 1.0,
-        l2: 0.8,
-        gravity: G,
-        theta1: 0.6,
-        theta2: -0.4,
-        omega1: 0.5,
-        omega2: 0.0,
-    };
+    let p = DoublePendulumParams::default()
+        .with_m1(1.2)
+        .with_m2(0.7)
+        .with_l1(1.0)
+        .with_l2(0.8)
+        .with_gravity(G)
+        .with_theta1(0.6)
+        .with_theta2(-0.4)
+        .with_omega1(0.5)
+        .with_omega2(0.0);
     let ex = double_pendulum(p).unwrap();
     // Independent solution: RK-4 in (θ1, θ2) at a step 10× smaller (its
     // error is 1e4× smaller than cdyn's), recorded every 0.01 s.
@@ -311,7 +305,16 @@ fn double_pendulum_matches_the_generalized_coordinate_equations() {
 fn chain_without_gravity_rotates_rigidly() {
     for n in [5, 20] {
         let (theta0, omega) = (0.4, 1.1);
-        let ex = chain(ChainParams { n, mass: 0.3, length: 0.5, gravity: 0.0, theta0, omega0: omega }).unwrap();
+        let ex = chain(
+            ChainParams::default()
+                .with_n(n)
+                .with_mass(0.3)
+                .with_length(0.5)
+                .with_gravity(0.0)
+                .with_theta0(theta0)
+                .with_omega0(omega),
+        )
+        .unwrap();
         // The exact motion, written here independently of the model.
         let exact = |t: f64| {
             let (s, c) = (theta0 + omega * t).sin_cos();
@@ -345,7 +348,7 @@ fn chain_without_gravity_rotates_rigidly() {
 
 #[test]
 fn one_link_chain_is_the_exact_pendulum() {
-    let ex = chain(ChainParams { n: 1, length: 1.3, theta0: 2.0, omega0: -0.5, ..ChainParams::default() }).unwrap();
+    let ex = chain(ChainParams::default().with_n(1).with_length(1.3).with_theta0(2.0).with_omega0(-0.5)).unwrap();
     // A libration of 2.1 rad amplitude: h = 5e-4 for RK-4 to reach 1e-9.
     let (eq, ev) = reference_errors(&ex, 5e-4, 5.0, 10);
     assert!(eq < 1e-9 && ev < 1e-9, "{eq:e} {ev:e}");
@@ -357,7 +360,7 @@ fn cvsgf_keeps_a_swinging_chain_on_its_constraints() {
     // 10 s. Without control the drift of Φ is secular (it ends at its
     // largest); CVSGF (α_g = 40) holds it at the per-step level, so by the
     // end it must be at least 5× smaller, and below 1e-6 m² throughout.
-    let ex = chain(ChainParams { n: 10, theta0: 0.5, ..ChainParams::default() }).unwrap();
+    let ex = chain(ChainParams::default().with_n(10).with_theta0(0.5)).unwrap();
     let (none_max, none_end, _) = paper_case(&ex, "none", 2e-3, 10.0);
     let (cvsgf_max, cvsgf_end, _) = paper_case(&ex, "cvsgf", 2e-3, 10.0);
     println!(
@@ -390,7 +393,16 @@ fn chain_small_oscillations_have_the_linearized_frequencies() {
         let w2 = eig.eigenvalues[k];
         let u = linv.transpose() * eig.eigenvectors.column(k);
         let scale = u.amax();
-        let mut ex = chain(ChainParams { n, mass: m, length: l, gravity: G, theta0: 0.0, omega0: 0.0 }).unwrap();
+        let mut ex = chain(
+            ChainParams::default()
+                .with_n(n)
+                .with_mass(m)
+                .with_length(l)
+                .with_gravity(G)
+                .with_theta0(0.0)
+                .with_omega0(0.0),
+        )
+        .unwrap();
         // Start in the mode shape, at rest.
         let mut p = [0.0, 0.0];
         for i in 0..n {
@@ -456,22 +468,19 @@ fn slider_crank_follows_its_exact_kinematics() {
     .unwrap();
 
     // Other dimensions, a negative speed and a start at an odd angle.
-    let q = SliderCrankParams {
-        crank_radius: 0.3,
-        rod_length: 0.5,
-        omega: -3.0,
-        theta0: 2.5,
-        gravity: 0.0,
-        ..SliderCrankParams::default()
-    };
+    let q = SliderCrankParams::default()
+        .with_crank_radius(0.3)
+        .with_rod_length(0.5)
+        .with_omega(-3.0)
+        .with_theta0(2.5)
+        .with_gravity(0.0);
     let (eq, ev) = reference_errors(&slider_crank(q).unwrap(), 5e-4, 2.0 * 2.0 * PI / 3.0, 10);
     assert!(eq < 1e-9 && ev < 1e-9, "{eq:e} {ev:e}");
 }
 
 #[test]
 fn slider_crank_with_a_load_follows_kinematics_and_the_load_equation() {
-    let ex = slider_crank(SliderCrankParams { load: Some(LoadPendulum::default()), ..SliderCrankParams::default() })
-        .unwrap();
+    let ex = slider_crank(SliderCrankParams::default().with_load(Some(LoadPendulum::default()))).unwrap();
     assert_eq!(ex.model.n() - ex.model.m(), 1);
     let (eq, ev) = reference_errors(&ex, 1e-3, 3.0 * PI, 10);
     println!("slider-crank + load, 3 revolutions: max |Δq| = {eq:.2e}, |Δv| = {ev:.2e}");
@@ -484,7 +493,7 @@ fn slider_crank_energy_input_is_the_drive_power() {
     // as ∫Ė: Ψ stays at integration-error level (RK-4, h = 1e-3: ~1e-12
     // per unit energy) while T + V − E₀ swings by O(1) J.
     for load in [None, Some(LoadPendulum::default())] {
-        let ex = slider_crank(SliderCrankParams { load, ..SliderCrankParams::default() }).unwrap();
+        let ex = slider_crank(SliderCrankParams::default().with_load(load)).unwrap();
         let (psi, input, change) = energy_bookkeeping(&ex, 1e-3, 3.0 * PI);
         println!(
             "slider-crank (load {}): max |Ψ| = {psi:.2e}, max |∫Ė| = {input:.3}, max |T + V − E₀| = {change:.3}",
@@ -505,7 +514,7 @@ fn four_bar_follows_its_exact_kinematics() {
     assert!(sorted[0] == a && sorted[0] + sorted[3] < sorted[1] + sorted[2]);
     let revolutions = 3.0 * 2.0 * PI / p.omega;
     for (branch, theta0) in [(FourBarBranch::Left, 0.0), (FourBarBranch::Right, 1.0)] {
-        let ex = four_bar(FourBarParams { branch, theta0, ..p }).unwrap();
+        let ex = four_bar(p.with_branch(branch).with_theta0(theta0)).unwrap();
         assert_eq!(ex.observables[0], "rocker.angle");
         // The assembly: C = rocker's far end lies on the chosen side of B→D.
         let bp = [a * theta0.cos(), a * theta0.sin()];
@@ -517,14 +526,14 @@ fn four_bar_follows_its_exact_kinematics() {
         assert!(eq < 1e-9 && ev < 1e-9, "{branch:?}: {eq:e} {ev:e}");
     }
     // With a load on joint C.
-    let ex = four_bar(FourBarParams { load: Some(LoadPendulum::default()), ..p }).unwrap();
+    let ex = four_bar(p.with_load(Some(LoadPendulum::default()))).unwrap();
     converges_to_the_reference("four-bar + load, 3 revolutions", &ex, 1e-3, revolutions);
 }
 
 #[test]
 fn four_bar_energy_input_is_the_drive_power() {
     for load in [None, Some(LoadPendulum::default())] {
-        let ex = four_bar(FourBarParams { load, ..FourBarParams::default() }).unwrap();
+        let ex = four_bar(FourBarParams::default().with_load(load)).unwrap();
         let (psi, input, change) = energy_bookkeeping(&ex, 1e-3, 3.0 * PI);
         println!(
             "four-bar (load {}): max |Ψ| = {psi:.2e}, max |∫Ė| = {input:.3}, max |T + V − E₀| = {change:.3}",
@@ -540,13 +549,13 @@ fn four_bar_that_cannot_turn_is_refused() {
     // A toggle position (d + a = b + c), a crank as long as the ground, a
     // change-point linkage (s + l = p + q) and a non-Grashof one.
     for (a, b, c, d) in [(1.0, 1.5, 2.5, 3.0), (1.0, 3.0, 2.5, 1.0), (2.0, 3.0, 2.0, 3.0), (2.5, 2.0, 1.2, 3.0)] {
-        let err = four_bar(FourBarParams {
-            crank_length: a,
-            coupler_length: b,
-            rocker_length: c,
-            ground_length: d,
-            ..FourBarParams::default()
-        })
+        let err = four_bar(
+            FourBarParams::default()
+                .with_crank_length(a)
+                .with_coupler_length(b)
+                .with_rocker_length(c)
+                .with_ground_length(d),
+        )
         .err()
         .unwrap();
         assert!(err.to_string().contains("cannot turn fully"), "{err}");
@@ -558,7 +567,7 @@ fn four_bar_that_cannot_turn_is_refused() {
 // ---------------------------------------------------------------------------
 
 fn polynomial(c: &[f64]) -> TimeFn {
-    TimeFn { polynomial: c.to_vec(), sines: Vec::new() }
+    TimeFn::polynomial(c.to_vec())
 }
 
 /// Errors against the reference at `h` and `h/2`: the observed order must
@@ -582,23 +591,23 @@ fn pendulum_on_a_uniformly_accelerated_support_is_a_pendulum_in_tilted_gravity()
     assert!(eq < 1e-9 && ev < 1e-9, "{eq:e} {ev:e}");
     // Sideways acceleration larger than g and an initial support velocity,
     // fast enough to go over the top in the support frame.
-    let ex = moving_support_pendulum(MovingSupportParams {
-        support_x: polynomial(&[1.0, -0.5, -7.5]),
-        support_y: polynomial(&[0.5, 2.0, 1.5]),
-        theta0: 0.3,
-        omega0: 6.0,
-        length: 0.8,
-        ..MovingSupportParams::default()
-    })
+    let ex = moving_support_pendulum(
+        MovingSupportParams::default()
+            .with_support_x(polynomial(&[1.0, -0.5, -7.5]))
+            .with_support_y(polynomial(&[0.5, 2.0, 1.5]))
+            .with_theta0(0.3)
+            .with_omega0(6.0)
+            .with_length(0.8),
+    )
     .unwrap();
     converges_to_the_reference("moving support, rotating in tilted gravity", &ex, 5e-4, 5.0);
     // Falling with the support: a = (0, −g), weightless, uniform rotation.
-    let ex = moving_support_pendulum(MovingSupportParams {
-        support_x: polynomial(&[0.0, 1.0]),
-        support_y: polynomial(&[0.0, 0.0, -0.5 * G]),
-        omega0: 1.5,
-        ..MovingSupportParams::default()
-    })
+    let ex = moving_support_pendulum(
+        MovingSupportParams::default()
+            .with_support_x(polynomial(&[0.0, 1.0]))
+            .with_support_y(polynomial(&[0.0, 0.0, -0.5 * G]))
+            .with_omega0(1.5),
+    )
     .unwrap();
     let (eq, ev) = reference_errors(&ex, 1e-3, 5.0, 10);
     println!("moving support, free fall: max |Δq| = {eq:.2e}, |Δv| = {ev:.2e}");
@@ -661,13 +670,8 @@ fn damped_pendulum_matches_its_equation_and_loses_energy_to_the_damper() {
 fn undamped_pendulum_reference_is_the_exact_one() {
     // c = 0 switches the reference to the elliptic closed form; both the
     // rigid body on its pin and the reference must agree.
-    let ex = damped_pendulum(DampedPendulumParams {
-        damping: 0.0,
-        theta0: -1.0,
-        omega0: 9.0,
-        ..DampedPendulumParams::default()
-    })
-    .unwrap();
+    let ex =
+        damped_pendulum(DampedPendulumParams::default().with_damping(0.0).with_theta0(-1.0).with_omega0(9.0)).unwrap();
     converges_to_the_reference("undamped pendulum, rotating", &ex, 1e-3, 5.0);
 }
 
@@ -682,14 +686,10 @@ fn all_models() -> Vec<(&'static str, Example)> {
         ("slider_crank", slider_crank(SliderCrankParams::default()).unwrap()),
         (
             "slider_crank+load",
-            slider_crank(SliderCrankParams { load: Some(LoadPendulum::default()), ..SliderCrankParams::default() })
-                .unwrap(),
+            slider_crank(SliderCrankParams::default().with_load(Some(LoadPendulum::default()))).unwrap(),
         ),
         ("four_bar", four_bar(FourBarParams::default()).unwrap()),
-        (
-            "four_bar+load",
-            four_bar(FourBarParams { load: Some(LoadPendulum::default()), ..FourBarParams::default() }).unwrap(),
-        ),
+        ("four_bar+load", four_bar(FourBarParams::default().with_load(Some(LoadPendulum::default()))).unwrap()),
         ("moving_support", moving_support_pendulum(MovingSupportParams::default()).unwrap()),
         ("shaken_support", moving_support_pendulum(MovingSupportParams::sinusoidal(0.3, 0.2, 5.0)).unwrap()),
         ("damped_pendulum", damped_pendulum(DampedPendulumParams::default()).unwrap()),
@@ -736,24 +736,19 @@ fn bad_parameters_are_refused() {
         Err(e) => panic!("expected InvalidParameter({name}), got {e}"),
         Ok(_) => panic!("expected InvalidParameter({name}), got a model"),
     };
-    bad(double_pendulum(DoublePendulumParams { m2: 0.0, ..Default::default() }), "m2");
-    bad(double_pendulum(DoublePendulumParams { theta1: f64::NAN, ..Default::default() }), "theta1");
-    bad(chain(ChainParams { n: 0, ..Default::default() }), "n");
-    bad(chain(ChainParams { length: -1.0, ..Default::default() }), "length");
-    bad(slider_crank(SliderCrankParams { rod_length: 0.4, ..Default::default() }), "rod_length");
+    bad(double_pendulum(DoublePendulumParams::default().with_m2(0.0)), "m2");
+    bad(double_pendulum(DoublePendulumParams::default().with_theta1(f64::NAN)), "theta1");
+    bad(chain(ChainParams::default().with_n(0)), "n");
+    bad(chain(ChainParams::default().with_length(-1.0)), "length");
+    bad(slider_crank(SliderCrankParams::default().with_rod_length(0.4)), "rod_length");
     bad(
-        slider_crank(SliderCrankParams {
-            load: Some(LoadPendulum { length: 0.0, ..Default::default() }),
-            ..Default::default()
-        }),
+        slider_crank(SliderCrankParams::default().with_load(Some(LoadPendulum::default().with_length(0.0)))),
         "load length",
     );
-    bad(four_bar(FourBarParams { rocker_mass: f64::INFINITY, ..Default::default() }), "rocker_mass");
-    bad(moving_support_pendulum(MovingSupportParams { gravity: -1.0, ..Default::default() }), "gravity");
-    bad(damped_pendulum(DampedPendulumParams { damping: -0.1, ..Default::default() }), "damping");
-    let shaky = moving_support_pendulum(MovingSupportParams {
-        support_x: TimeFn { polynomial: vec![0.0, f64::NAN], sines: Vec::new() },
-        ..Default::default()
-    });
+    bad(four_bar(FourBarParams::default().with_rocker_mass(f64::INFINITY)), "rocker_mass");
+    bad(moving_support_pendulum(MovingSupportParams::default().with_gravity(-1.0)), "gravity");
+    bad(damped_pendulum(DampedPendulumParams::default().with_damping(-0.1)), "damping");
+    let shaky =
+        moving_support_pendulum(MovingSupportParams::default().with_support_x(TimeFn::polynomial(vec![0.0, f64::NAN])));
     assert!(matches!(shaky, Err(Error::InvalidModel { .. })));
 }

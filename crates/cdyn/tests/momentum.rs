@@ -103,7 +103,7 @@ fn a_declared_momentum_the_model_breaks_is_reported_not_kept() {
 /// Every law of the suite, with fixed rates so that their terms act at
 /// states off the constraints and off the energy.
 fn laws() -> Vec<(&'static str, Control)> {
-    let g = MethodGains { cvsgf: Gain::Rate(20.0), ..MethodGains::paper() };
+    let g = MethodGains::paper().with_cvsgf(Gain::Rate(20.0));
     let mut laws: Vec<(&'static str, Control)> = methods::redundant_cases(&g).into_iter().skip(1).collect();
     laws.push((
         "newton + velocity + projected",
@@ -219,7 +219,7 @@ fn a_floating_chain_keeps_its_centre_of_mass_on_its_line_under_every_method() {
     let mass = model.mass().unwrap().diagonal().to_vec();
     let total: f64 = (0..5).map(|i| mass[3 * i]).sum();
     let centre = |q: &[f64], axis: usize| (0..5).map(|i| mass[3 * i] * q[3 * i + axis]).sum::<f64>() / total;
-    let gains = MethodGains { cvsgf: Gain::Rate(0.2 / h), ..MethodGains::paper() };
+    let gains = MethodGains::paper().with_cvsgf(Gain::Rate(0.2 / h));
     for (name, control) in methods::compare_cases(&gains, true) {
         for scheme in [Scheme::AdamsBashforth3, Scheme::RungeKutta4] {
             let mut sim = Simulation::new(&model, Settings::new(scheme, h, control), &q0, &v0).unwrap();

@@ -25,7 +25,7 @@ fn one_step_of_the_pendulum_is_the_closed_form_shake_root_then_the_tangent_veloc
     // Unit mass on a rod of length L from the origin, gravity g along −y:
     // M⁻¹Φ_qᵀ ∝ q, so the position step moves q̃ = q₀ + h v₀ + h²/2 g
     // along q₀ to the circle, and the velocity step removes the radial part.
-    let p = PendulumParams { theta0: -0.4, omega0: 1.3, gravity: 9.81, length: 0.7, ..PendulumParams::default() };
+    let p = PendulumParams::default().with_theta0(-0.4).with_omega0(1.3).with_gravity(9.81).with_length(0.7);
     let ex = cartesian_pendulum(p).unwrap();
     let h = 0.05;
     let mut sim = Simulation::new(&ex.model, rattle(h), &ex.q0, &ex.v0).unwrap();
@@ -63,7 +63,7 @@ fn worst_violations(ex: &Example, h: f64, steps: u64) -> (f64, f64) {
 #[test]
 fn constraints_hold_to_round_off_after_every_step_on_fixed_and_driven_mechanisms() {
     let cases = [
-        ("chain of 20", chain(ChainParams { n: 20, theta0: 0.6, ..ChainParams::default() }).unwrap(), 2e-3),
+        ("chain of 20", chain(ChainParams::default().with_n(20).with_theta0(0.6)).unwrap(), 2e-3),
         ("driven four-bar", four_bar(FourBarParams::default()).unwrap(), 1e-3),
         ("driven slider-crank", slider_crank(SliderCrankParams::default()).unwrap(), 1e-3),
     ];
@@ -104,7 +104,7 @@ fn the_energy_stays_in_a_band_where_ab3s_drifts() {
     // in the last window is that of the first (a band set by h², not by
     // the time), while AB-3's without control grows with the time.
     let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
-    let chain = chain(ChainParams { n: 10, theta0: 0.8, ..ChainParams::default() }).unwrap();
+    let chain = chain(ChainParams::default().with_n(10).with_theta0(0.8)).unwrap();
     for (name, ex, windows) in
         [("Example 1", &pendulum, [0, 10_000, 90_000, 100_000]), ("chain", &chain, [0, 2_000, 18_000, 20_000])]
     {

@@ -33,25 +33,20 @@ fn joints(point: [f64; 3], axis: [f64; 3], point_b: [f64; 3], b: Option<usize>) 
     let at = |kind| Joint::new(kind, 0, b, point);
     vec![
         (at(JointKind::Spherical), 3),
-        (at(JointKind::Revolute).axis(axis), 1),
-        (at(JointKind::Universal).axis(axis).axis_b(other), 2),
-        (at(JointKind::Cylindrical).axis(axis), 2),
-        (at(JointKind::Prismatic).axis(axis), 1),
-        (at(JointKind::Fixed).axis(axis), 0),
-        (at(JointKind::Distance).point_b(point_b), 5),
+        (at(JointKind::Revolute).with_axis(axis), 1),
+        (at(JointKind::Universal).with_axis(axis).with_axis_b(other), 2),
+        (at(JointKind::Cylindrical).with_axis(axis), 2),
+        (at(JointKind::Prismatic).with_axis(axis), 1),
+        (at(JointKind::Fixed).with_axis(axis), 0),
+        (at(JointKind::Distance).with_point_b(point_b), 5),
         // Driven: nothing is left free at a given time.
         (
             at(JointKind::Revolute)
-                .axis(axis)
-                .angle(TimeFn { polynomial: vec![0.0, 0.5], sines: vec![[0.3, 2.0, 0.0]] }),
+                .with_axis(axis)
+                .with_angle(TimeFn::polynomial(vec![0.0, 0.5]).with_sines(vec![[0.3, 2.0, 0.0]])),
             0,
         ),
-        (
-            at(JointKind::Prismatic)
-                .axis(axis)
-                .displacement(TimeFn { polynomial: vec![0.0, 0.2, -0.4], sines: vec![] }),
-            0,
-        ),
+        (at(JointKind::Prismatic).with_axis(axis).with_displacement(TimeFn::polynomial(vec![0.0, 0.2, -0.4])), 0),
     ]
 }
 
@@ -62,14 +57,15 @@ fn pair(joint: Joint, poses: [([f64; 3], [f64; 4]); 2]) -> Mechanism {
         .iter()
         .enumerate()
         .take(if joint.b.is_none() { 1 } else { 2 })
-        .map(|(i, &(r, p))| Body {
-            position: r,
-            orientation: p,
-            inertia: [[1.0, 0.1, 0.0], [0.1, 1.5, -0.2], [0.0, -0.2, 2.0]],
-            ..Body::new(&format!("b{i}"), 1.0 + i as f64, [1.0; 3])
+        .map(|(i, &(r, p))| {
+            Body::new(&format!("b{i}"), 1.0 + i as f64, [1.0; 3]).with_position(r).with_orientation(p).with_inertia([
+                [1.0, 0.1, 0.0],
+                [0.1, 1.5, -0.2],
+                [0.0, -0.2, 2.0],
+            ])
         })
         .collect();
-    Mechanism { bodies, joints: vec![joint], gravity: [0.0, 0.0, -9.81], loads: vec![] }
+    Mechanism::new([0.0, 0.0, -9.81]).with_bodies(bodies).with_joints(vec![joint])
 }
 
 fn phi(model: &Model, q: &[f64]) -> Vec<f64> {
@@ -197,6 +193,7 @@ proptest! {
                     .map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point, z))
                     .chain((0..2).map(|i| motion(std::array::from_fn(|k| (k == i) as u8 as f64), point_b, z)))
                     .collect(),
+                other => panic!("no allowed motions written for {other:?}"),
             };
             for v in allowed {
                 let phi_dot = &jac * nalgebra::DVector::from_vec(v);
@@ -224,13 +221,11 @@ fn free_body(turn: [f64; 4]) -> Mechanism {
     let column = |c: usize| rotate(turn, std::array::from_fn(|k| (k == c) as u8 as f64));
     let q = [column(0), column(1), column(2)];
     let inertia = std::array::from_fn(|a| std::array::from_fn(|b| (0..3).map(|k| q[k][a] * J[k] * q[k][b]).sum()));
-    let body = Body {
-        inertia,
-        orientation: [turn[0], -turn[1], -turn[2], -turn[3]],
-        angular_velocity: rotate(turn, W0),
-        ..Body::new("top", 2.0, J)
-    };
-    Mechanism { bodies: vec![body], joints: vec![], gravity: [0.0; 3], loads: vec![] }
+    let body = Body::new("top", 2.0, J)
+        .with_inertia(inertia)
+        .with_orientation([turn[0], -turn[1], -turn[2], -turn[3]])
+        .with_angular_velocity(rotate(turn, W0));
+    Mechanism::new([0.0; 3]).with_bodies(vec![body])
 }
 
 /// Largest error of the spatial angular velocity against Euler's solution
@@ -282,14 +277,12 @@ fn a_free_body_with_a_full_inertia_tensor_follows_eulers_solution() {
 /// body angular velocity (0, 150, −4.61538) rad/s; p₀ = (1, 0, 0, 0).
 fn heavy_top() -> Mechanism {
     let w0 = [0.0, 150.0, -4.61538];
-    let top = Body {
-        position: [0.0, 1.0, 0.0],
-        velocity: cross(w0, [0.0, 1.0, 0.0]),
-        angular_velocity: w0,
-        ..Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
-    };
+    let top = Body::new("top", 15.0, [0.234375, 0.46875, 0.234375])
+        .with_position([0.0, 1.0, 0.0])
+        .with_velocity(cross(w0, [0.0, 1.0, 0.0]))
+        .with_angular_velocity(w0);
     let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-    Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -9.81], loads: vec![] }
+    Mechanism::new([0.0, 0.0, -9.81]).with_bodies(vec![top]).with_joints(vec![fixed])
 }
 
 fn heavy_top_at(t_end: f64, h: f64, control: Control, solver: LinearSolver) -> (Vec<f64>, Vec<f64>) {
@@ -414,15 +407,13 @@ fn precessing_top() -> (Mechanism, f64, f64) {
     let p0 = about([0.0, 1.0, 0.0], theta);
     let spin = w3 - omega * theta.cos();
     let w: [f64; 3] = std::array::from_fn(|i| omega * (i == 2) as u8 as f64 + spin * axis[i]);
-    let top = Body {
-        position: axis.map(|x| x * l),
-        orientation: p0,
-        velocity: cross(w, axis.map(|x| x * l)),
-        angular_velocity: rotate([p0[0], -p0[1], -p0[2], -p0[3]], w),
-        ..Body::new("top", m, [ac, ac, c])
-    };
+    let top = Body::new("top", m, [ac, ac, c])
+        .with_position(axis.map(|x| x * l))
+        .with_orientation(p0)
+        .with_velocity(cross(w, axis.map(|x| x * l)))
+        .with_angular_velocity(rotate([p0[0], -p0[1], -p0[2], -p0[3]], w));
     let fixed = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-    let mechanism = Mechanism { bodies: vec![top], joints: vec![fixed], gravity: [0.0, 0.0, -g], loads: vec![] };
+    let mechanism = Mechanism::new([0.0, 0.0, -g]).with_bodies(vec![top]).with_joints(vec![fixed]);
     (mechanism, theta, omega)
 }
 
@@ -487,10 +478,7 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         let mut b = Body::new("arm", 1.0, [1.0, 1.0, 1.0]);
         f(&mut b);
         let joint = Joint::new(JointKind::Spherical, 0, None, [0.0; 3]);
-        Mechanism { bodies: vec![b], joints: vec![joint], gravity: [0.0; 3], loads: vec![] }
-            .build()
-            .err()
-            .map(|e| e.to_string())
+        Mechanism::new([0.0; 3]).with_bodies(vec![b]).with_joints(vec![joint]).build().err().map(|e| e.to_string())
     };
     type Change = fn(&mut Body);
     let cases: [(Change, &str); 7] = [
@@ -513,40 +501,29 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
         let bodies = vec![Body::new("a", 1.0, [1.0; 3]), Body::new("b", 1.0, [1.0; 3])];
         Mechanism::named(bodies, vec![joint], vec![], [0.0; 3]).and_then(|m| m.build()).err().map(|e| e.to_string())
     };
-    let joint = |kind| Joint {
-        kind,
-        a: "a".to_string(),
-        b: Some("b".to_string()),
-        point: [0.0; 3],
-        axis: None,
-        axis_b: None,
-        point_b: None,
-        angle: None,
-        displacement: None,
-    };
+    let named = |j: Joint, a: &str, b: &str| j.map_bodies(|i| [a, b][i].to_string());
+    let joint = |kind| named(Joint::new(kind, 0, Some(1), [0.0; 3]), "a", "b");
+    let spherical = |a, b| named(Joint::new(JointKind::Spherical, 0, Some(1), [0.0; 3]), a, b);
     let cases = [
-        (
-            Joint { angle: Some(TimeFn::linear(0.0, 1.0)), ..joint(JointKind::Spherical) },
-            "a spherical joint takes no angle",
-        ),
-        (Joint { axis: Some([0.0; 3]), ..joint(JointKind::Revolute) }, "element 0 (revolute): axis has zero length"),
+        (joint(JointKind::Spherical).with_angle(TimeFn::linear(0.0, 1.0)), "a spherical joint takes no angle"),
+        (joint(JointKind::Revolute).with_axis([0.0; 3]), "element 0 (revolute): axis has zero length"),
         (joint(JointKind::Revolute), "element 0 (revolute): a revolute joint needs axis"),
-        (Joint { axis: Some([1.0, 0.0, 0.0]), ..joint(JointKind::Spherical) }, "a spherical joint takes no axis"),
+        (joint(JointKind::Spherical).with_axis([1.0, 0.0, 0.0]), "a spherical joint takes no axis"),
+        (joint(JointKind::Universal).with_axis([1.0, 0.0, 0.0]).with_axis_b([1.0, 1.0, 0.0]), "perpendicular"),
+        (joint(JointKind::Distance).with_point_b([0.0; 3]), "point_b must differ from point"),
+        (spherical("c", "b"), "a = \"c\": no body of that name"),
+        (spherical("a", "a"), "connects a to itself"),
         (
-            Joint { axis: Some([1.0, 0.0, 0.0]), axis_b: Some([1.0, 1.0, 0.0]), ..joint(JointKind::Universal) },
-            "perpendicular",
+            named(Joint::new(JointKind::Spherical, 0, Some(1), [f64::INFINITY, 0.0, 0.0]), "a", "b"),
+            "point = inf must be finite",
         ),
-        (Joint { point_b: Some([0.0; 3]), ..joint(JointKind::Distance) }, "point_b must differ from point"),
-        (Joint { a: "c".to_string(), ..joint(JointKind::Spherical) }, "a = \"c\": no body of that name"),
-        (Joint { b: Some("a".to_string()), ..joint(JointKind::Spherical) }, "connects a to itself"),
-        (Joint { point: [f64::INFINITY, 0.0, 0.0], ..joint(JointKind::Spherical) }, "point = inf must be finite"),
     ];
     for (j, expected) in cases {
         let message = two(j).expect("refused");
         assert!(message.contains(expected), "{message:?} should contain {expected:?}");
     }
     // The ground is `b` omitted or named; duplicate and reserved body names are refused.
-    assert_eq!(two(Joint { b: Some("ground".to_string()), ..joint(JointKind::Spherical) }), None);
+    assert_eq!(two(spherical("a", "ground")), None);
     let dup =
         Mechanism::named(vec![Body::new("a", 1.0, [1.0; 3]), Body::new("a", 1.0, [1.0; 3])], vec![], vec![], [0.0; 3]);
     assert!(dup.unwrap_err().to_string().contains("body 1 (a): a body with this name already exists"));
@@ -564,33 +541,29 @@ fn bad_bodies_and_joints_are_refused_with_the_part_and_the_reason() {
 fn spatial_slider_crank(on_axis: bool, h: f64, times: &[f64]) -> Vec<(f64, f64)> {
     let w = 6.0;
     let crank_centre = if on_axis { [0.0, 0.1, 0.12] } else { [0.0, 0.1, 0.16] };
-    let crank = Body {
-        position: crank_centre,
-        velocity: cross([w, 0.0, 0.0], [0.0, 0.0, crank_centre[2] - 0.12]),
-        angular_velocity: [w, 0.0, 0.0],
-        ..Body::new("crank", 0.12, [1e-4, 1e-4, 1e-5])
-    };
+    let crank = Body::new("crank", 0.12, [1e-4, 1e-4, 1e-5])
+        .with_position(crank_centre)
+        .with_velocity(cross([w, 0.0, 0.0], [0.0, 0.0, crank_centre[2] - 0.12]))
+        .with_angular_velocity([w, 0.0, 0.0]);
     let u = [0.2 / 0.3, -0.1 / 0.3, -0.2 / 0.3];
     let rod_inertia = std::array::from_fn(|a| {
         std::array::from_fn(|b| 0.004 * ((a == b) as u8 as f64) + (0.0004 - 0.004) * u[a] * u[b])
     });
-    let rod = Body {
-        inertia: rod_inertia,
-        position: [0.1, 0.05, 0.1],
-        velocity: [0.12, -0.24, 0.0],
-        angular_velocity: [1.92, -0.96, 0.48],
-        ..Body::new("rod", 0.5, [1.0; 3])
-    };
-    let slider = Body { position: [0.2, 0.0, 0.0], velocity: [0.24, 0.0, 0.0], ..Body::new("slider", 2.0, [1e-4; 3]) };
+    let rod = Body::new("rod", 0.5, [1.0; 3])
+        .with_inertia(rod_inertia)
+        .with_position([0.1, 0.05, 0.1])
+        .with_velocity([0.12, -0.24, 0.0])
+        .with_angular_velocity([1.92, -0.96, 0.48]);
+    let slider = Body::new("slider", 2.0, [1e-4; 3]).with_position([0.2, 0.0, 0.0]).with_velocity([0.24, 0.0, 0.0]);
     let joints = vec![
-        Joint::new(JointKind::Revolute, 0, None, [0.0, 0.1, 0.12]).axis([1.0, 0.0, 0.0]),
+        Joint::new(JointKind::Revolute, 0, None, [0.0, 0.1, 0.12]).with_axis([1.0, 0.0, 0.0]),
         Joint::new(JointKind::Spherical, 0, Some(1), [0.0, 0.1, 0.2]),
         Joint::new(JointKind::Universal, 2, Some(1), [0.2, 0.0, 0.0])
-            .axis([1.0, 0.0, 0.0])
-            .axis_b(unit([0.0, -2.0, 1.0])),
-        Joint::new(JointKind::Prismatic, 2, None, [0.2, 0.0, 0.0]).axis([1.0, 0.0, 0.0]),
+            .with_axis([1.0, 0.0, 0.0])
+            .with_axis_b(unit([0.0, -2.0, 1.0])),
+        Joint::new(JointKind::Prismatic, 2, None, [0.2, 0.0, 0.0]).with_axis([1.0, 0.0, 0.0]),
     ];
-    let mechanism = Mechanism { bodies: vec![crank, rod, slider], joints, gravity: [0.0, 0.0, -9.81], loads: vec![] };
+    let mechanism = Mechanism::new([0.0, 0.0, -9.81]).with_bodies(vec![crank, rod, slider]).with_joints(joints);
     let Built { model, q0, v0, .. } = mechanism.build().unwrap();
     let mut sim = Simulation::new(&model, Settings::new(Scheme::RungeKutta4, h, methods::robust()), &q0, &v0).unwrap();
     let (mut angle, mut last) = (0.0_f64, 0.0_f64);
@@ -673,7 +646,7 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
     let (m, k, c) = (2.0, 50.0, 1.5);
     // A body hanging on a damped spring from the origin, stretched 0.1
     // beyond its length 0.9, no gravity: z(t) = −0.9 − 0.1 e^{−ζωt}(cos ω_d t + ζω/ω_d sin ω_d t).
-    let bob = Body { position: [0.0, 0.0, -1.0], ..Body::new("bob", m, [0.1, 0.1, 0.1]) };
+    let bob = Body::new("bob", m, [0.1, 0.1, 0.1]).with_position([0.0, 0.0, -1.0]);
     let spring = Load::Spring {
         a: 0,
         b: None,
@@ -683,7 +656,7 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
         damping: c,
         length: Some(0.9),
     };
-    let hanging = Mechanism { bodies: vec![bob], joints: vec![], gravity: [0.0; 3], loads: vec![spring] };
+    let hanging = Mechanism::new([0.0; 3]).with_bodies(vec![bob]).with_loads(vec![spring]);
     let (psi, q, _) = uncontrolled(&hanging, 1e-3, 2.0);
     let (w, zeta) = ((k / m).sqrt(), c / (2.0 * (k * m).sqrt()));
     let wd = w * (1.0 - zeta * zeta).sqrt();
@@ -701,7 +674,7 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
         Load::Torque { body: 0, torque: [0.0, 0.4, 0.0] },
         Load::Force { body: 0, force: [0.0, 0.0, 0.6], point: Some([0.0, 0.0, 0.0]) },
     ];
-    let free = Mechanism { bodies: vec![torqued], joints: vec![], gravity: [0.0; 3], loads };
+    let free = Mechanism::new([0.0; 3]).with_bodies(vec![torqued]).with_loads(loads);
     let (psi, q, v) = uncontrolled(&free, 1e-3, 1.0);
     let w = body_rate(SpatialBody::of(0).orientation(&q), SpatialBody::of(0).orientation(&v));
     println!("torque: ω(1) = {w:?}, v_z = {}, max |Ψ| {psi:.1e}", v[2]);
@@ -710,10 +683,10 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
     assert!(psi < 1e-12, "|Ψ| = {psi:e}");
 
     // A wheel spinning on a damped revolute axle: ω = ω₀ e^{−c t / J}.
-    let spinning = Body { angular_velocity: [0.0, 0.0, 5.0], ..Body::new("wheel", 1.0, [0.3, 0.3, 0.5]) };
-    let axle = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).axis([0.0, 0.0, 1.0]);
+    let spinning = Body::new("wheel", 1.0, [0.3, 0.3, 0.5]).with_angular_velocity([0.0, 0.0, 5.0]);
+    let axle = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).with_axis([0.0, 0.0, 1.0]);
     let damper = Load::RotaryDamper { a: 0, b: None, axis: [0.0, 0.0, 1.0], damping: 0.2 };
-    let wheel = Mechanism { bodies: vec![spinning], joints: vec![axle], gravity: [0.0; 3], loads: vec![damper] };
+    let wheel = Mechanism::new([0.0; 3]).with_bodies(vec![spinning]).with_joints(vec![axle]).with_loads(vec![damper]);
     let (psi, q, v) = uncontrolled(&wheel, 1e-3, 2.0);
     let w = space_rate(SpatialBody::of(0).orientation(&q), SpatialBody::of(0).orientation(&v));
     let exact = 5.0 * (-0.2 * 2.0 / 0.5_f64).exp();
@@ -724,15 +697,13 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
     // gravity: its angle follows the drive, and the drive's work (λᵀΦ_t)
     // is in the energy balance.
     // Started at the drive's rate θ̇(0) = 4 (v = ω × r).
-    let crank = Body {
-        position: [0.5, 0.0, 0.0],
-        velocity: [0.0, 0.0, -2.0],
-        angular_velocity: [0.0, 4.0, 0.0],
-        ..Body::new("crank", 1.0, [0.01, 0.1, 0.1])
-    };
-    let drive = TimeFn { polynomial: vec![0.0, 3.0], sines: vec![[0.2, 5.0, 0.0]] };
-    let pivot = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).axis([0.0, 1.0, 0.0]).angle(drive.clone());
-    let driven = Mechanism { bodies: vec![crank], joints: vec![pivot], gravity: [0.0, 0.0, -9.81], loads: vec![] };
+    let crank = Body::new("crank", 1.0, [0.01, 0.1, 0.1])
+        .with_position([0.5, 0.0, 0.0])
+        .with_velocity([0.0, 0.0, -2.0])
+        .with_angular_velocity([0.0, 4.0, 0.0]);
+    let drive = TimeFn::polynomial(vec![0.0, 3.0]).with_sines(vec![[0.2, 5.0, 0.0]]);
+    let pivot = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).with_axis([0.0, 1.0, 0.0]).with_angle(drive.clone());
+    let driven = Mechanism::new([0.0, 0.0, -9.81]).with_bodies(vec![crank]).with_joints(vec![pivot]);
     let (psi, q, _) = uncontrolled(&driven, 1e-3, 1.0);
     let p = SpatialBody::of(0).orientation(&q);
     // Turned about +y by θ: p = (cos θ/2, 0, sin θ/2, 0); compare the crank's direction.
@@ -824,29 +795,30 @@ mod flyball {
                 bar + point(M_ROD, r, a, b) + point(M_TIP, p, a, b)
             })
         });
-        spinning(Body { inertia, position: centre, ..Body::new(name, mass, [1.0; 3]) }, omega)
+        spinning(Body::new(name, mass, [1.0; 3]).with_inertia(inertia).with_position(centre), omega)
     }
 
     /// `body`, turning at `omega` about the z axis (body axes = space axes).
     fn spinning(body: Body, omega: f64) -> Body {
         let w = [0.0, 0.0, omega];
-        Body { velocity: cross(w, body.position), angular_velocity: w, ..body }
+        let position = body.position;
+        body.with_velocity(cross(w, position)).with_angular_velocity(w)
     }
 
     pub fn mechanism(beta: f64, s: f64, omega: f64) -> Mechanism {
-        let shaft = Body { position: [0.0, 0.0, 0.5], ..Body::new("shaft", 0.3, [J_ACROSS, J_ACROSS, J_AXIAL]) };
-        let slider = Body { position: [0.0, 0.0, s], ..Body::new("slider", M_SLIDER, [J_SLIDER; 3]) };
+        let shaft = Body::new("shaft", 0.3, [J_ACROSS, J_ACROSS, J_AXIAL]).with_position([0.0, 0.0, 0.5]);
+        let slider = Body::new("slider", M_SLIDER, [J_SLIDER; 3]).with_position([0.0, 0.0, s]);
         let mut bodies = vec![spinning(shaft, omega), spinning(slider, omega)];
         let mut joints = vec![
-            Joint::new(JointKind::Revolute, SHAFT, None, [0.0; 3]).axis([0.0, 0.0, 1.0]),
-            Joint::new(JointKind::Prismatic, SLIDER, Some(SHAFT), [0.0, 0.0, s]).axis([0.0, 0.0, 1.0]),
+            Joint::new(JointKind::Revolute, SHAFT, None, [0.0; 3]).with_axis([0.0, 0.0, 1.0]),
+            Joint::new(JointKind::Prismatic, SLIDER, Some(SHAFT), [0.0, 0.0, s]).with_axis([0.0, 0.0, 1.0]),
         ];
         let mut loads = Vec::new();
         for (side, index) in [1.0, -1.0].into_iter().zip(RODS) {
             let pivot = [side * A, 0.0, 1.0];
             let d = [side * beta.cos(), 0.0, -beta.sin()];
             bodies.push(rod(if side > 0.0 { "rod_a" } else { "rod_b" }, pivot, d, omega));
-            joints.push(Joint::new(JointKind::Revolute, index, Some(SHAFT), pivot).axis([0.0, 1.0, 0.0]));
+            joints.push(Joint::new(JointKind::Revolute, index, Some(SHAFT), pivot).with_axis([0.0, 1.0, 0.0]));
             loads.push(Load::Spring {
                 a: index,
                 b: Some(SLIDER),
@@ -857,7 +829,7 @@ mod flyball {
                 length: Some(0.5),
             });
         }
-        Mechanism { bodies, joints, gravity: [0.0, 0.0, -G], loads }
+        Mechanism::new([0.0, 0.0, -G]).with_bodies(bodies).with_joints(joints).with_loads(loads)
     }
 
     /// The potential in the frame turning at `omega`, `V − ½Ω² I_z`, of

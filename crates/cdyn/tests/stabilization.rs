@@ -31,17 +31,15 @@ use proptest::prelude::*;
 /// A Grashof four-bar (the built-in geometry) whose links have very
 /// different masses and inertias, so that `M` is far from a multiple of `I`.
 fn mixed_four_bar(theta0: f64, load: Option<LoadPendulum>) -> FourBarParams {
-    FourBarParams {
-        crank_mass: 0.3,
-        crank_inertia: 0.02,
-        coupler_mass: 4.0,
-        coupler_inertia: 3.1,
-        rocker_mass: 1.7,
-        rocker_inertia: 0.9,
-        theta0,
-        load,
-        ..FourBarParams::default()
-    }
+    FourBarParams::default()
+        .with_crank_mass(0.3)
+        .with_crank_inertia(0.02)
+        .with_coupler_mass(4.0)
+        .with_coupler_inertia(3.1)
+        .with_rocker_mass(1.7)
+        .with_rocker_inertia(0.9)
+        .with_theta0(theta0)
+        .with_load(load)
 }
 
 /// The four-bar of [`mixed_four_bar`] at crank angle `theta`, undriven,
@@ -68,7 +66,7 @@ fn free_four_bar(theta: f64) -> (Model, Vec<f64>) {
 
 /// A heavy load on a light rod: the mixed masses of the driven mechanisms.
 fn load(angle: f64) -> LoadPendulum {
-    LoadPendulum { mass: 2.5, length: 0.8, angle, omega: 0.0 }
+    LoadPendulum::default().with_mass(2.5).with_length(0.8).with_angle(angle).with_omega(0.0)
 }
 
 /// The driven four-bar of [`mixed_four_bar`] shaking a load: rheonomic, 1 DOF.
@@ -79,17 +77,17 @@ fn driven_four_bar(theta: f64, load_angle: f64) -> (Model, Vec<f64>) {
 
 /// A driven slider-crank with a light crank, a heavy rod and slider, shaking a load.
 fn driven_slider_crank(theta: f64, load_angle: f64) -> (Model, Vec<f64>) {
-    let ex = slider_crank(SliderCrankParams {
-        crank_mass: 0.2,
-        crank_inertia: 0.004,
-        rod_mass: 3.0,
-        rod_inertia: 0.7,
-        slider_mass: 6.0,
-        slider_inertia: 0.05,
-        theta0: theta,
-        load: Some(load(load_angle)),
-        ..SliderCrankParams::default()
-    })
+    let ex = slider_crank(
+        SliderCrankParams::default()
+            .with_crank_mass(0.2)
+            .with_crank_inertia(0.004)
+            .with_rod_mass(3.0)
+            .with_rod_inertia(0.7)
+            .with_slider_mass(6.0)
+            .with_slider_inertia(0.05)
+            .with_theta0(theta)
+            .with_load(Some(load(load_angle))),
+    )
     .unwrap();
     (ex.model, ex.q0)
 }
@@ -303,7 +301,7 @@ proptest! {
 /// pendulum released from rest at the horizontal, over 25 s (more than three
 /// periods of 7.42 s).
 fn released_from_rest(scheme: Scheme, h: f64, control: Control) -> Vec<(f64, f64)> {
-    let ex = cartesian_pendulum(PendulumParams { theta0: 0.0, omega0: 0.0, ..PendulumParams::default() }).unwrap();
+    let ex = cartesian_pendulum(PendulumParams::default().with_theta0(0.0).with_omega0(0.0)).unwrap();
     assert_eq!((ex.q0.as_slice(), ex.v0.as_slice()), ([1.0, 0.0].as_slice(), [0.0, 0.0].as_slice()));
     let mut sim = Simulation::new(&ex.model, Settings::new(scheme, h, control), &ex.q0, &ex.v0).unwrap();
     let mut out = Vec::new();
@@ -593,7 +591,7 @@ fn automatic_cvsgf_gain_sees_the_coupling_of_the_rows() {
 #[test]
 fn the_automatic_energy_term_is_left_out_where_the_damping_is_stiff() {
     for (damping, h) in [(0.1, 0.01), (5.0, 0.01), (0.0, 0.01), (50.0, 1e-4)] {
-        let params = DampedPendulumParams { damping, ..Default::default() };
+        let params = DampedPendulumParams::default().with_damping(damping);
         let ex = damped_pendulum(params).unwrap();
         let rate = damping / params.pivot_inertia();
         let methods = [
@@ -637,7 +635,7 @@ fn robust_and_projection_are_no_worse_than_none_from_light_to_heavy_damping() {
     };
     for scheme in [Scheme::AdamsBashforth3, Scheme::RungeKutta4] {
         for damping in [0.1, 0.5, 1.0, 3.0, 10.0, 30.0] {
-            let ex = damped_pendulum(DampedPendulumParams { damping, theta0: 0.5, ..Default::default() }).unwrap();
+            let ex = damped_pendulum(DampedPendulumParams::default().with_damping(damping).with_theta0(0.5)).unwrap();
             let (none, _) = error(&ex, scheme, Control::none());
             let (robust, tuning) = error(&ex, scheme, methods::robust());
             let kept = methods::robust()
@@ -665,7 +663,7 @@ fn robust_and_projection_are_no_worse_than_none_from_light_to_heavy_damping() {
 /// step, and within 2× of robust.
 #[test]
 fn projection_is_no_worse_than_none_through_the_turning_points_of_a_damped_swing() {
-    let ex = damped_pendulum(DampedPendulumParams { damping: 0.1, ..Default::default() }).unwrap();
+    let ex = damped_pendulum(DampedPendulumParams::default().with_damping(0.1)).unwrap();
     for h in [1e-3, 2e-3] {
         let error = |control: Control| worst_error(&ex, Settings::new(Scheme::AdamsBashforth3, h, control), 10.0, 10).0;
         let (none, robust, projection) =
@@ -712,13 +710,13 @@ fn the_fastest_oscillation_of_the_stiffness_is_reported_against_the_step() {
         rest_length: 0.5,
     });
     let built = spring.build().unwrap();
-    let pendulum = cartesian_pendulum(PendulumParams {
-        length: 2.0,
-        gravity: 9.81,
-        theta0: -std::f64::consts::FRAC_PI_2,
-        omega0: 0.0,
-        ..Default::default()
-    })
+    let pendulum = cartesian_pendulum(
+        PendulumParams::default()
+            .with_length(2.0)
+            .with_gravity(9.81)
+            .with_theta0(-std::f64::consts::FRAC_PI_2)
+            .with_omega0(0.0),
+    )
     .unwrap();
     let cases = [
         ("spring", &built.model, &built.q0, &built.v0, (k / mass).sqrt()),

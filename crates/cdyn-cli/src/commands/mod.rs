@@ -1,6 +1,8 @@
 //! The commands of the `cdyn` binary, one file each: what they read from
 //! the command line and which parts of the library (`cdyn_cli`) they call.
 //! Nothing here computes or draws; the library does.
+//!
+//! May import: `io`, `case`, `study`, `render` (the library's folders).
 
 pub mod bench;
 pub mod compare;

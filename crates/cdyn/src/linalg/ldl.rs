@@ -1,5 +1,5 @@
 //! The pivot test shared by every `L D Lᵀ` of `S` (dense, sparse, and the
-//! small systems' in `small.rs`), what it does with a dependent row
+//! small systems' in `small/`), what it does with a dependent row
 //! ([`DependentRows`]), why a factorization fails ([`Breakdown`]), and the
 //! dense factorization of a small `S`.
 
@@ -83,7 +83,7 @@ impl DependentRows {
 }
 
 /// The pivot test of every `L D Lᵀ` of `S` (this module's and the small
-/// systems' one in `small.rs`): pivot `d` of the row `row()` whose assembled
+/// systems' one in `small/`): pivot `d` of the row `row()` whose assembled
 /// diagonal entry is `s_jj`, for the Jacobian values `jac`. Returns `1/d`
 /// for a pivot above `tolerance · s_jj` (`dependent.tolerance()`, chosen
 /// once per factorization). One below means a dependent row — unless the

@@ -20,6 +20,7 @@
 /// An infinitesimal rigid rotation of the system as a field on the
 /// coordinates, `ξ(q) = B q + b`.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Generator {
     /// What its momentum is called ("angular momentum z").
     pub name: String,
@@ -32,6 +33,13 @@ pub struct Generator {
 }
 
 impl Generator {
+    /// The field `ξ(q) = B q + b` with the non-zero entries `linear` of `B`
+    /// (row, column, weight) and `offset` of `b`, its momentum called
+    /// `name`; checked when it is declared on a model.
+    pub fn new(name: &str, linear: Vec<(u32, u32, f64)>, offset: Vec<(u32, f64)>) -> Self {
+        Self { name: name.to_string(), linear, offset, declared: false }
+    }
+
     /// The rotation about the unit `axis` (normalized here) through `point`
     /// of every body of a mechanism, read from its coordinate names: a
     /// planar body's `name.x`, `name.y` and `name.angle` (the axis must be

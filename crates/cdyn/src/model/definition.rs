@@ -49,6 +49,7 @@ pub(super) enum Inertia {
 /// A direction along which a model may keep its momentum: added by a
 /// mechanism builder (rigid translations) or declared by the user.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct Direction {
     /// What its momentum is called ("linear momentum x").
     pub name: String,

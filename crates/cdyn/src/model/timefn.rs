@@ -6,6 +6,7 @@ use crate::ad::scalar::Scalar;
 
 /// `f(t) = Σ_k c_k t^k + Σ_j a_j sin(ω_j t + φ_j)`.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct TimeFn {
     /// Polynomial coefficients `c_0, c_1, …`.
     pub polynomial: Vec<f64>,
@@ -13,15 +14,32 @@ pub struct TimeFn {
     pub sines: Vec<[f64; 3]>,
 }
 
+crate::setters!(TimeFn {
+    /// With these polynomial coefficients `c_0, c_1, …`.
+    with_polynomial => polynomial: Vec<f64>,
+    /// With these sine terms `(amplitude, angular frequency, phase)`.
+    with_sines => sines: Vec<[f64; 3]>,
+});
+
 impl TimeFn {
     /// `f(t) = c`.
     pub fn constant(c: f64) -> Self {
-        Self { polynomial: vec![c], sines: Vec::new() }
+        Self::polynomial(vec![c])
     }
 
     /// `c0 + c1 t`.
     pub fn linear(c0: f64, c1: f64) -> Self {
-        Self { polynomial: vec![c0, c1], sines: Vec::new() }
+        Self::polynomial(vec![c0, c1])
+    }
+
+    /// `Σ_k c_k t^k` with these coefficients `c_0, c_1, …`.
+    pub fn polynomial(coefficients: Vec<f64>) -> Self {
+        Self { polynomial: coefficients, sines: Vec::new() }
+    }
+
+    /// `a sin(ω t + φ)`.
+    pub fn sine(amplitude: f64, omega: f64, phase: f64) -> Self {
+        Self { polynomial: Vec::new(), sines: vec![[amplitude, omega, phase]] }
     }
 
     /// `f(t)`, for any scalar type (dual numbers give `ḟ`, `f̈`).

@@ -35,6 +35,7 @@ impl<const K: usize> Constraint<K, 1> for UnitNorm {
 
 /// A unit vector of a model: its constraint row and its coordinates.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct UnitVector {
     /// The row of `|x|² − 1 = 0`.
     pub row: usize,

@@ -15,6 +15,7 @@ use crate::reference::PendulumExact;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct ChainParams {
     /// Number of links (and of masses), from 1 to 1 000 000.
     #[cfg_attr(feature = "serde", serde(deserialize_with = "whole_number"))]
@@ -30,6 +31,21 @@ pub struct ChainParams {
     /// Initial rigid angular velocity about the pivot.
     pub omega0: f64,
 }
+
+crate::setters!(ChainParams {
+    /// With `n`: number of links (and of masses), from 1 to 1 000 000.
+    with_n => n: usize,
+    /// With `mass`: mass of each point mass.
+    with_mass => mass: f64,
+    /// With `length`: length of each link.
+    with_length => length: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `theta0`: angle of the straight chain from the downward vertical.
+    with_theta0 => theta0: f64,
+    /// With `omega0`: initial rigid angular velocity about the pivot.
+    with_omega0 => omega0: f64,
+});
 
 impl Default for ChainParams {
     /// Five unit links released at rest from the horizontal.

@@ -13,6 +13,7 @@ use crate::reference::fine_ode::FineOde;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct DampedPendulumParams {
     /// Mass of the bar.
     pub mass: f64,
@@ -29,6 +30,23 @@ pub struct DampedPendulumParams {
     /// Initial angular velocity.
     pub omega0: f64,
 }
+
+crate::setters!(DampedPendulumParams {
+    /// With `mass`: mass of the bar.
+    with_mass => mass: f64,
+    /// With `inertia`: moment of inertia about the centre of mass.
+    with_inertia => inertia: f64,
+    /// With `length`: distance from the pivot to the centre of mass.
+    with_length => length: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `damping`: rotary damping coefficient `c ≥ 0`.
+    with_damping => damping: f64,
+    /// With `theta0`: initial angle from +X.
+    with_theta0 => theta0: f64,
+    /// With `omega0`: initial angular velocity.
+    with_omega0 => omega0: f64,
+});
 
 impl Default for DampedPendulumParams {
     /// A uniform 1 kg, 1 m bar pinned at one end (`l_c = 0.5`, `I = 1/12`),

@@ -18,6 +18,7 @@ use crate::{Model, Potential, Scalar};
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct DoublePendulumParams {
     /// Mass of the first bob.
     pub m1: f64,
@@ -38,6 +39,27 @@ pub struct DoublePendulumParams {
     /// Initial angular velocity of the second rod.
     pub omega2: f64,
 }
+
+crate::setters!(DoublePendulumParams {
+    /// With `m1`: mass of the first bob.
+    with_m1 => m1: f64,
+    /// With `m2`: mass of the second bob.
+    with_m2 => m2: f64,
+    /// With `l1`: length of the first rod (pivot to first bob).
+    with_l1 => l1: f64,
+    /// With `l2`: length of the second rod (first bob to second).
+    with_l2 => l2: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `theta1`: initial angle of the first rod from the downward vertical.
+    with_theta1 => theta1: f64,
+    /// With `theta2`: initial angle of the second rod from the downward vertical.
+    with_theta2 => theta2: f64,
+    /// With `omega1`: initial angular velocity of the first rod.
+    with_omega1 => omega1: f64,
+    /// With `omega2`: initial angular velocity of the second rod.
+    with_omega2 => omega2: f64,
+});
 
 impl Default for DoublePendulumParams {
     /// Unit masses and rods, both released at rest from the horizontal: the

@@ -15,6 +15,7 @@ use super::{
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize, serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Kind {
     /// Example 1 of the paper in Cartesian coordinates: [`cartesian_pendulum`](super::cartesian_pendulum),
     /// [`PendulumParams`](super::PendulumParams).

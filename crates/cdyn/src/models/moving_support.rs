@@ -17,6 +17,7 @@ use crate::reference::fine_ode::FineOde;
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct MovingSupportParams {
     /// Mass of the (driven) support point.
     pub support_mass: f64,
@@ -35,6 +36,25 @@ pub struct MovingSupportParams {
     /// Initial angular velocity of the rod.
     pub omega0: f64,
 }
+
+crate::setters!(MovingSupportParams {
+    /// With `support_mass`: mass of the (driven) support point.
+    with_support_mass => support_mass: f64,
+    /// With `mass`: mass of the bob.
+    with_mass => mass: f64,
+    /// With `length`: length of the rod.
+    with_length => length: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `support_x`: support `x(t)`.
+    with_support_x => support_x: TimeFn,
+    /// With `support_y`: support `y(t)`.
+    with_support_y => support_y: TimeFn,
+    /// With `theta0`: initial rod angle from +X (bob relative to the support).
+    with_theta0 => theta0: f64,
+    /// With `omega0`: initial angular velocity of the rod.
+    with_omega0 => omega0: f64,
+});
 
 impl Default for MovingSupportParams {
     /// A support accelerating uniformly, `x = 0.5 t + t²`, `y = 0.5 t²`

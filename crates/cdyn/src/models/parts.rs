@@ -34,7 +34,7 @@ pub(super) fn add(p: [f64; 2], k: f64, d: [f64; 2]) -> [f64; 2] {
 }
 
 pub(super) fn point_body(name: &str, mass: f64, position: [f64; 2], velocity: [f64; 2]) -> Body {
-    Body { name: name.into(), mass, inertia: None, position, angle: 0.0, velocity, angular_velocity: 0.0 }
+    Body::point(name, mass, position).with_velocity(velocity)
 }
 
 pub(super) fn rigid_body(
@@ -46,7 +46,7 @@ pub(super) fn rigid_body(
     velocity: [f64; 2],
     angular_velocity: f64,
 ) -> Body {
-    Body { name: name.into(), mass, inertia: Some(inertia), position, angle, velocity, angular_velocity }
+    Body::rigid(name, mass, inertia, position, angle).with_velocity(velocity).with_angular_velocity(angular_velocity)
 }
 
 /// An example whose observables are `first` (computed by `observe_first`)
@@ -78,6 +78,7 @@ pub(super) fn example(
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct LoadPendulum {
     /// Mass of the bob.
     pub mass: f64,
@@ -88,6 +89,17 @@ pub struct LoadPendulum {
     /// Initial angular velocity of the rod.
     pub omega: f64,
 }
+
+crate::setters!(LoadPendulum {
+    /// With `mass`: mass of the bob.
+    with_mass => mass: f64,
+    /// With `length`: length of the rod.
+    with_length => length: f64,
+    /// With `angle`: initial angle of the rod from the downward vertical.
+    with_angle => angle: f64,
+    /// With `omega`: initial angular velocity of the rod.
+    with_omega => omega: f64,
+});
 
 impl Default for LoadPendulum {
     /// Half a kilogram on a 1 m rod, released at rest 0.2 rad from the bottom.

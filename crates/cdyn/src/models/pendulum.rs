@@ -14,6 +14,7 @@ use crate::{Constraint, Model, Potential, Scalar};
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct PendulumParams {
     /// Mass of the bob.
     pub mass: f64,
@@ -26,6 +27,19 @@ pub struct PendulumParams {
     /// Initial angular velocity.
     pub omega0: f64,
 }
+
+crate::setters!(PendulumParams {
+    /// With `mass`: mass of the bob.
+    with_mass => mass: f64,
+    /// With `length`: length of the rod.
+    with_length => length: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `theta0`: initial angle from +X, counter-clockwise.
+    with_theta0 => theta0: f64,
+    /// With `omega0`: initial angular velocity.
+    with_omega0 => omega0: f64,
+});
 
 impl Default for PendulumParams {
     fn default() -> Self {

@@ -21,6 +21,7 @@ use crate::planar::{BodyId, Element, Mechanism};
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+#[non_exhaustive]
 pub struct SliderCrankParams {
     /// Crank radius `r`.
     pub crank_radius: f64,
@@ -49,6 +50,33 @@ pub struct SliderCrankParams {
     /// default [`LoadPendulum`]).
     pub load: Option<LoadPendulum>,
 }
+
+crate::setters!(SliderCrankParams {
+    /// With `crank_radius`: crank radius `r`.
+    with_crank_radius => crank_radius: f64,
+    /// With `rod_length`: connecting rod length `l > r`.
+    with_rod_length => rod_length: f64,
+    /// With `crank_mass`: mass of the crank.
+    with_crank_mass => crank_mass: f64,
+    /// With `crank_inertia`: about the crank's centre (its midpoint).
+    with_crank_inertia => crank_inertia: f64,
+    /// With `rod_mass`: mass of the connecting rod.
+    with_rod_mass => rod_mass: f64,
+    /// With `rod_inertia`: about the rod's centre (its midpoint).
+    with_rod_inertia => rod_inertia: f64,
+    /// With `slider_mass`: mass of the slider.
+    with_slider_mass => slider_mass: f64,
+    /// With `slider_inertia`: moment of inertia of the slider (it does not turn, but every planar body has one).
+    with_slider_inertia => slider_inertia: f64,
+    /// With `omega`: constant crank speed `ω`.
+    with_omega => omega: f64,
+    /// With `theta0`: initial crank angle from +X.
+    with_theta0 => theta0: f64,
+    /// With `gravity`: gravitational acceleration, along −Y.
+    with_gravity => gravity: f64,
+    /// With `load`: pendulum hanging from the slider's centre; none by default. In
+    with_load => load: Option<LoadPendulum>,
+});
 
 impl Default for SliderCrankParams {
     /// `r = 0.5`, `l = 1.5`, uniform bars of 1 kg/m, a 1 kg slider, one

@@ -5,7 +5,9 @@
 use crate::error::{Part, Problem, Result, finite, positive};
 use std::collections::HashSet;
 
-/// A body of a [`Mechanism`](super::Mechanism), or the ground.
+/// A body of a [`Mechanism`](super::Mechanism), or the ground. Exhaustive on
+/// purpose (not `#[non_exhaustive]`): there is nothing else an element can
+/// be attached to, so a `match` needs no wildcard arm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BodyId {
     /// The fixed world frame; it has no coordinates.
@@ -23,6 +25,7 @@ pub const GROUND: &str = "ground";
 /// mass.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
+#[non_exhaustive]
 pub struct Body {
     /// How elements and coordinate names (`crank.x`) refer to the body; unique, not `ground`.
     pub name: String,
@@ -43,7 +46,32 @@ pub struct Body {
     pub angular_velocity: f64,
 }
 
+crate::setters!(Body {
+    /// With `mass`: mass, finite and positive.
+    with_mass => mass: f64,
+    /// With `inertia`: moment of inertia about the centre of mass, making the body rigid.
+    with_inertia => inertia(Some): f64,
+    /// With `position`: initial position of the centre of mass, world axes.
+    with_position => position: [f64; 2],
+    /// With `angle`: initial angle; a point mass has none, so it must stay 0.
+    with_angle => angle: f64,
+    /// With `velocity`: initial velocity of the centre of mass, world axes.
+    with_velocity => velocity: [f64; 2],
+    /// With `angular_velocity`: initial angular velocity; 0 for a point mass.
+    with_angular_velocity => angular_velocity: f64,
+});
+
 impl Body {
+    /// A rigid body at `position` with angle `angle`, at rest.
+    pub fn rigid(name: &str, mass: f64, inertia: f64, position: [f64; 2], angle: f64) -> Self {
+        Self { inertia: Some(inertia), angle, ..Self::point(name, mass, position) }
+    }
+
+    /// A point mass at `position`, at rest.
+    pub fn point(name: &str, mass: f64, position: [f64; 2]) -> Self {
+        Self { name: name.into(), mass, inertia: None, position, angle: 0.0, velocity: [0.0; 2], angular_velocity: 0.0 }
+    }
+
     /// Checks the body at `index` of a mechanism whose earlier bodies have
     /// the names `earlier` (a set, so that checking N bodies costs O(N)): a
     /// free, unique name, positive mass and inertia, a finite initial state,

@@ -4,7 +4,9 @@
 use super::body::BodyId;
 use crate::model::timefn::TimeFn;
 
-/// Which coordinate of a body a drive prescribes (`"x"`, `"y"`, `"angle"` in files).
+/// Which coordinate of a body a drive prescribes (`"x"`, `"y"`, `"angle"` in
+/// files). Exhaustive on purpose (not `#[non_exhaustive]`): a planar body has
+/// these three coordinates and no other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(rename_all = "lowercase"))]
 pub enum Coordinate {
@@ -16,6 +18,47 @@ pub enum Coordinate {
     Angle,
 }
 
+/// Declares [`Element`] with the four fields of an element between two
+/// points written once: a variant declared `Name between B { … }` gets `a`,
+/// `pa`, `b`, `pb` (in files `a`, `point_a`, `b`, `point_b`, the points
+/// defaulting to `[0, 0]`). Not `#[serde(flatten)]` of a shared struct:
+/// serde cannot combine it with `deny_unknown_fields`, and a misspelt key
+/// must stay an error.
+macro_rules! elements {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident<$b:ident = $default:ty> {
+            $(
+                $(#[$variant_meta:meta])*
+                $variant:ident $(between $ends:ident)? { $($(#[$field_meta:meta])* $field:ident: $t:ty,)* }
+            ),* $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        pub enum $name<$b = $default> {
+            $(
+                $(#[$variant_meta])*
+                $variant {
+                    $(
+                        /// First body.
+                        a: $ends,
+                        /// Point on `a`.
+                        #[cfg_attr(feature = "serde", serde(rename = "point_a", default))]
+                        pa: [f64; 2],
+                        /// Second body.
+                        b: $ends,
+                        /// Point on `b`.
+                        #[cfg_attr(feature = "serde", serde(rename = "point_b", default))]
+                        pb: [f64; 2],
+                    )?
+                    $($(#[$field_meta])* $field: $t,)*
+                },
+            )*
+        }
+    };
+}
+
+elements! {
 /// An element of a mechanism, as described. `B` is how it refers to a body:
 /// a [`BodyId`] in code, a name (`Element<String>`) as read from a scenario
 /// file, where every element is a table tagged by its [`kind`](Self::kind)
@@ -31,49 +74,19 @@ pub enum Coordinate {
     derive(serde::Deserialize),
     serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)
 )]
+#[non_exhaustive]
 pub enum Element<B = BodyId> {
     /// Points `pa` on `a` and `pb` on `b` coincide.
-    Revolute {
-        /// First body.
-        a: B,
-        /// Point on `a`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_a", default))]
-        pa: [f64; 2],
-        /// Second body.
-        b: B,
-        /// Point on `b`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_b", default))]
-        pb: [f64; 2],
-    },
+    Revolute between B {},
     /// Point `pb` on `b` slides along the line through `pa` on `a` with
     /// direction `axis` (in `a`'s frame); the relative angle stays fixed
     /// when both have one.
-    Prismatic {
-        /// The body carrying the line.
-        a: B,
-        /// A point of the line, on `a`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_a", default))]
-        pa: [f64; 2],
-        /// The sliding body.
-        b: B,
-        /// The sliding point, on `b`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_b", default))]
-        pb: [f64; 2],
+    Prismatic between B {
         /// The line's direction in `a`'s frame; any non-zero length.
         axis: [f64; 2],
     },
     /// A massless rod of this length between two points.
-    Distance {
-        /// First body.
-        a: B,
-        /// Point on `a`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_a", default))]
-        pa: [f64; 2],
-        /// Second body.
-        b: B,
-        /// Point on `b`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_b", default))]
-        pb: [f64; 2],
+    Distance between B {
         /// The rod's length, positive.
         length: f64,
     },
@@ -122,17 +135,7 @@ pub enum Element<B = BodyId> {
         f: TimeFn,
     },
     /// Linear spring between two points.
-    Spring {
-        /// First body.
-        a: B,
-        /// Point on `a`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_a", default))]
-        pa: [f64; 2],
-        /// Second body.
-        b: B,
-        /// Point on `b`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_b", default))]
-        pb: [f64; 2],
+    Spring between B {
         /// Force per unit stretch, not negative.
         stiffness: f64,
         /// Length without force, not negative.
@@ -152,17 +155,7 @@ pub enum Element<B = BodyId> {
         rest_angle: f64,
     },
     /// Linear damper between two points: force `c` times the rate of change of their distance.
-    Damper {
-        /// First body.
-        a: B,
-        /// Point on `a`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_a", default))]
-        pa: [f64; 2],
-        /// Second body.
-        b: B,
-        /// Point on `b`.
-        #[cfg_attr(feature = "serde", serde(rename = "point_b", default))]
-        pb: [f64; 2],
+    Damper between B {
         /// Force per unit stretch rate, not negative.
         damping: f64,
     },
@@ -200,9 +193,11 @@ pub enum Element<B = BodyId> {
         f: TimeFn,
     },
 }
+}
 
 /// The list of a scenario file an element is written in; each takes its own kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Group {
     /// `[[joints]]`: revolute, prismatic, distance, fixed_angle, knife_edge.
     Joints,

@@ -8,6 +8,7 @@ use crate::error::{Part, Problem, Result};
 
 /// A planar mechanism under construction; [`Mechanism::build`] turns it into a model.
 #[derive(Debug, Clone, Default)]
+#[non_exhaustive]
 pub struct Mechanism {
     /// The bodies, in coordinate order.
     pub bodies: Vec<Body>,
@@ -25,28 +26,12 @@ impl Mechanism {
 
     /// Adds a rigid body at `position` with angle `angle`, at rest.
     pub fn rigid(&mut self, name: &str, mass: f64, inertia: f64, position: [f64; 2], angle: f64) -> BodyId {
-        self.push(Body {
-            name: name.into(),
-            mass,
-            inertia: Some(inertia),
-            position,
-            angle,
-            velocity: [0.0; 2],
-            angular_velocity: 0.0,
-        })
+        self.push(Body::rigid(name, mass, inertia, position, angle))
     }
 
     /// Adds a point mass at `position`, at rest.
     pub fn point(&mut self, name: &str, mass: f64, position: [f64; 2]) -> BodyId {
-        self.push(Body {
-            name: name.into(),
-            mass,
-            inertia: None,
-            position,
-            angle: 0.0,
-            velocity: [0.0; 2],
-            angular_velocity: 0.0,
-        })
+        self.push(Body::point(name, mass, position))
     }
 
     /// Adds a body; it is checked by [`Mechanism::build`].

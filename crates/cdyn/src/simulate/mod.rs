@@ -9,7 +9,9 @@
 
 pub mod generalized_alpha;
 pub mod rattle;
+mod settings;
 mod stepper;
 pub mod system;
 
+pub use settings::*;
 pub use stepper::*;

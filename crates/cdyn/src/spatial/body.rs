@@ -1,5 +1,6 @@
-//! A spatial rigid body: what the user gives, checked, and its rotational
-//! kinetic energy as a kinetic element of its Euler parameters.
+//! A spatial rigid body: what the user gives, checked, where its seven
+//! coordinates are in a mechanism's state, and its rotational kinetic
+//! energy as a kinetic element of its Euler parameters.
 
 use super::rotation::body_rate;
 use crate::ad::scalar::Scalar;
@@ -11,6 +12,7 @@ use crate::model::kinetic::{Kinetic, VelocityMap};
 /// `velocity` and `angular_velocity` may be omitted).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
+#[non_exhaustive]
 pub struct Body {
     /// Its name, for joints, error messages and output; unique, not `ground`.
     pub name: String,
@@ -36,6 +38,21 @@ pub struct Body {
     #[cfg_attr(feature = "serde", serde(default))]
     pub angular_velocity: [f64; 3],
 }
+
+crate::setters!(Body {
+    /// With `mass`: mass.
+    with_mass => mass: f64,
+    /// With `inertia`: inertia tensor about the centre of mass, in body axes (symmetric
+    with_inertia => inertia: [[f64; 3]; 3],
+    /// With `position`: centre of mass in space.
+    with_position => position: [f64; 3],
+    /// With `orientation`: euler parameters of the body axes (scalar first). A unit quaternion
+    with_orientation => orientation: [f64; 4],
+    /// With `velocity`: velocity of the centre of mass.
+    with_velocity => velocity: [f64; 3],
+    /// With `angular_velocity`: angular velocity, in body axes.
+    with_angular_velocity => angular_velocity: [f64; 3],
+});
 
 #[cfg(feature = "serde")]
 fn identity() -> [f64; 4] {
@@ -110,6 +127,43 @@ impl Body {
         }
         Ok(self.orientation.map(|x| x / norm))
     }
+}
+
+/// Where a body's coordinates are: `r` at `first .. first + 3`, `p` at
+/// `first + 3 .. first + 7`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SpatialBody {
+    /// Its first coordinate.
+    pub first: usize,
+}
+
+impl SpatialBody {
+    /// Body `index` of a [`Mechanism`].
+    pub fn of(index: usize) -> Self {
+        Self { first: 7 * index }
+    }
+    /// Its centre of mass in `q`.
+    pub fn position(&self, q: &[f64]) -> [f64; 3] {
+        std::array::from_fn(|i| q[self.first + i])
+    }
+    /// Its Euler parameters in `q`.
+    pub fn orientation(&self, q: &[f64]) -> [f64; 4] {
+        std::array::from_fn(|i| q[self.first + 3 + i])
+    }
+    /// The coordinates of its Euler parameters.
+    pub fn euler_parameters(&self) -> [usize; 4] {
+        std::array::from_fn(|i| self.first + 3 + i)
+    }
+    /// All seven coordinates.
+    pub fn coordinates(&self) -> [usize; 7] {
+        std::array::from_fn(|i| self.first + i)
+    }
+}
+
+/// The names of a body's coordinates: `name.x`, `name.y`, `name.z`, `name.e0` … `name.e3`.
+pub fn coordinate_names(name: &str) -> [String; 7] {
+    ["x", "y", "z", "e0", "e1", "e2", "e3"].map(|c| format!("{name}.{c}"))
 }
 
 /// The principal moments of a symmetric 3 × 3 tensor, ascending.

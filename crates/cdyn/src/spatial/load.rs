@@ -19,6 +19,7 @@ use crate::model::force::{Force, Potential};
     derive(serde::Deserialize),
     serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)
 )]
+#[non_exhaustive]
 pub enum Load<B = usize> {
     /// A linear spring and damper from `point` on `a` to `point_b` on `b`
     /// (in space at the initial pose): the force `k (l − length) + c l̇`

@@ -33,18 +33,21 @@
 mod body;
 mod chain;
 mod joint;
+mod joint_rows;
 mod load;
 mod mechanism;
+mod named;
+mod placing;
 pub mod rotation;
 mod sketch;
 #[cfg(feature = "urdf")]
 mod urdf;
 
-pub use body::{Body, Rotation};
+pub use body::{Body, Rotation, SpatialBody, coordinate_names};
 pub use chain::chain;
 pub use joint::{Joint, JointKind};
 pub use load::Load;
-pub use mechanism::{Built, Mechanism, SpatialBody, coordinate_names};
+pub use mechanism::{Built, Mechanism};
 pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]
 pub use urdf::{UrdfRobot, from_urdf, read_urdf};

@@ -3,7 +3,8 @@
 //! scale), and each joint as the two points it connects. A frame is drawn
 //! from the coordinates `q` alone.
 
-use super::mechanism::{Mechanism, SpatialBody};
+use super::body::SpatialBody;
+use super::mechanism::Mechanism;
 use super::rotation::{rotate, unrotate};
 
 /// A point of a body (body axes, from its centre of mass) or of the ground (space).

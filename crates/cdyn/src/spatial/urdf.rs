@@ -181,7 +181,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         carrier[l] = Some(child);
         if let Some(kind) = kind {
             let joint = Joint::new(kind, child, parent, origin);
-            joints.push(if kind == JointKind::Spherical { joint } else { joint.axis(axis) });
+            joints.push(if kind == JointKind::Spherical { joint } else { joint.with_axis(axis) });
             joint_names.push(j.name.clone());
         }
         if damping != 0.0 {

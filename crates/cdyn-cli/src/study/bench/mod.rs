@@ -128,7 +128,7 @@ pub(super) fn timed_runs<T>(
 
 /// The chain of the figures above: `n` links, released at rest.
 pub(super) fn chain_example(n: usize) -> Result<Example> {
-    Ok(chain(ChainParams { n, mass: 1.0, length: 1.0, gravity: 1.0, theta0: 0.3, omega0: 0.0 })?)
+    Ok(chain(ChainParams::default().with_n(n).with_gravity(1.0).with_theta0(0.3))?)
 }
 
 /// The chain's control: CVSGF + energy with hα_g = hα_e = 0.4, by forward Euler.

@@ -6,6 +6,7 @@ use super::{BlockMass, DenseMass, DiagonalMass, MassMatrix};
 /// there. Each product matches once, outside its loops, so the diagonal
 /// kind runs its own loops unchanged.
 #[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
 pub enum MassAt<'a> {
     /// A constant diagonal `M`.
     Diagonal(&'a DiagonalMass),

@@ -14,6 +14,8 @@
 //! The diagonal kind is generic over its storage: a `Vec` for a general
 //! model, an array for a small system, whose loops then keep their
 //! compile-time lengths.
+//!
+//! May import: `error`.
 
 mod at;
 mod block;

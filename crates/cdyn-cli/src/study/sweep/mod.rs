@@ -6,10 +6,23 @@
 //! stored by grid index, so the output is bit-identical whatever the number
 //! of threads. `--shard I/N` runs the points with `index % N == I`; `cdyn
 //! merge` joins shard outputs into exactly what one run writes.
+//!
+//! Here what `sweep.json` holds, the shards and threads, the run, merging
+//! and writing; `grid` the axes of the `[sweep]` table, the scenario at a
+//! point and the scenario's hash; `listing` the printed table.
+//!
+//! May import: `io`, `case`.
+
+mod grid;
+mod listing;
+
+pub use grid::{axes, content_hash};
+pub use listing::{FULL_TABLE_LIMIT, Listing, TOP_K, listing, summary};
 
 use crate::case::runner::run_case_quietly;
 use crate::case::scenario::Scenario;
 use anyhow::{Context, Result, anyhow, bail};
+use grid::{at_point, values_at};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -118,120 +131,6 @@ pub fn worker_threads(requested: Option<usize>) -> Result<Option<usize>> {
     Ok(Some(n))
 }
 
-/// The axes of the scenario's `[sweep]` table, in file order.
-pub fn axes(scenario: &Scenario, file: &str) -> Result<Vec<Axis>> {
-    let table = scenario
-        .sweep
-        .as_ref()
-        .ok_or_else(|| anyhow!("{file}: a sweep needs a [sweep] table, e.g. alpha_g = [10, 20, 40]"))?;
-    if table.is_empty() {
-        bail!("{file}: [sweep] is empty");
-    }
-    table
-        .iter()
-        .map(|(name, value)| {
-            let values: Vec<f64> = value
-                .as_array()
-                .ok_or_else(|| anyhow!("{file}: [sweep] {name}: expected a list of numbers"))?
-                .iter()
-                .map(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
-                .collect::<Option<_>>()
-                .ok_or_else(|| anyhow!("{file}: [sweep] {name}: expected a list of numbers"))?;
-            if values.is_empty() {
-                bail!("{file}: [sweep] {name}: the list is empty");
-            }
-            set(&mut scenario.clone(), name, values[0])
-                .map_err(|e| anyhow!("{file}: [sweep] {name}: not h or a [method] gain: {e}"))?;
-            Ok(Axis { name: name.clone(), values })
-        })
-        .collect()
-}
-
-/// The grid values of point `index` (last axis fastest).
-fn values_at(axes: &[Axis], mut index: usize) -> Vec<f64> {
-    let mut out = vec![0.0; axes.len()];
-    for (k, a) in axes.iter().enumerate().rev() {
-        out[k] = a.values[index % a.values.len()];
-        index /= a.values.len();
-    }
-    out
-}
-
-/// The scenario with one grid point's values set.
-fn at_point(scenario: &Scenario, axes: &[Axis], values: &[f64]) -> Result<Scenario> {
-    let mut s = scenario.clone();
-    for (a, &v) in axes.iter().zip(values) {
-        set(&mut s, &a.name, v)?;
-    }
-    Ok(s)
-}
-
-/// Sets one axis: `h`, or a key of the library's method table (whatever
-/// [`cdyn::control::methods::MethodKeys`] accepts, so a new gain needs no change here).
-fn set(scenario: &mut Scenario, name: &str, value: f64) -> Result<()> {
-    if name == "h" {
-        scenario.integrator.h = value;
-        return Ok(());
-    }
-    let mut table = toml::Table::try_from(scenario.method())?;
-    table.insert(name.to_string(), toml::Value::Float(value));
-    scenario.method = Some(table.try_into().map_err(|e: toml::de::Error| anyhow!("{}", e.message().trim()))?);
-    Ok(())
-}
-
-/// A stable hash (128-bit FNV-1a, hex) of a canonical encoding of the parsed
-/// scenario `table`: keys sorted, numbers by value (so `2` and `2.0`, which
-/// the scenario reads alike, agree), comments and layout ignored. It must
-/// not change between releases or platforms, so it is written out here
-/// rather than taken from `std`'s randomly seeded hashers.
-pub fn content_hash(table: &toml::Table) -> String {
-    fn encode(value: &toml::Value, out: &mut Vec<u8>) {
-        let bytes = |tag: u8, b: &[u8], out: &mut Vec<u8>| {
-            out.push(tag);
-            out.extend_from_slice(&(b.len() as u64).to_le_bytes());
-            out.extend_from_slice(b);
-        };
-        match value {
-            toml::Value::String(s) => bytes(b'S', s.as_bytes(), out),
-            toml::Value::Integer(i) if i.unsigned_abs() < 1 << 53 => {
-                bytes(b'F', &(*i as f64).to_bits().to_le_bytes(), out)
-            }
-            toml::Value::Integer(i) => bytes(b'I', &i.to_le_bytes(), out),
-            toml::Value::Float(f) => {
-                let f = if f.is_nan() {
-                    f64::NAN
-                } else if *f == 0.0 {
-                    0.0
-                } else {
-                    *f
-                };
-                bytes(b'F', &f.to_bits().to_le_bytes(), out)
-            }
-            toml::Value::Boolean(b) => bytes(b'B', &[u8::from(*b)], out),
-            toml::Value::Datetime(d) => bytes(b'D', d.to_string().as_bytes(), out),
-            toml::Value::Array(items) => {
-                bytes(b'A', &(items.len() as u64).to_le_bytes(), out);
-                items.iter().for_each(|v| encode(v, out));
-            }
-            toml::Value::Table(t) => {
-                bytes(b'T', &(t.len() as u64).to_le_bytes(), out);
-                let mut keys: Vec<&String> = t.keys().collect();
-                keys.sort();
-                for k in keys {
-                    bytes(b'K', k.as_bytes(), out);
-                    encode(&t[k], out);
-                }
-            }
-        }
-    }
-    let mut bytes = Vec::new();
-    encode(&toml::Value::Table(table.clone()), &mut bytes);
-    const OFFSET: u128 = 0x6c62272e07bb014262b821756295c58d;
-    const PRIME: u128 = 0x0000000001000000000000000000013B;
-    let hash = bytes.iter().fold(OFFSET, |h, &b| (h ^ u128::from(b)).wrapping_mul(PRIME));
-    format!("{hash:032x}")
-}
-
 /// Runs the grid points of `shard` (all of them without one) on `threads`
 /// threads. `table` is the parsed scenario file, hashed to identify the sweep.
 ///
@@ -332,87 +231,4 @@ pub fn merge(parts: Vec<Sweep>) -> Result<Sweep> {
 pub fn write(sweep: &Sweep, dir: &Path) -> Result<()> {
     let path = dir.join("sweep.json");
     crate::io::output::write(&path, (serde_json::to_string_pretty(sweep)? + "\n").as_bytes())
-}
-
-/// Above this many points the printed table holds only the best
-/// [`TOP_K`]: a million-line table helps nobody and cannot be read back.
-pub const FULL_TABLE_LIMIT: usize = 1000;
-
-/// Rows of the table of a large sweep.
-pub const TOP_K: usize = 20;
-
-/// How much of a sweep to print.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Listing {
-    /// Only the summary line (`--quiet`).
-    Summary,
-    /// Every point up to [`FULL_TABLE_LIMIT`], the best [`TOP_K`] above it.
-    Default,
-    /// Every point (`--all`).
-    All,
-}
-
-/// What the sweep is ranked by: the error against the reference where
-/// there is one, else max |Φ|.
-fn rank_key(sweep: &Sweep) -> (&'static str, fn(&Point) -> f64) {
-    if sweep.points.iter().any(|p| p.max_abs_err.is_some()) {
-        ("max|err|", |p| p.max_abs_err.unwrap_or(f64::INFINITY))
-    } else {
-        ("max|phi|", |p| p.max_abs_phi)
-    }
-}
-
-/// Points ranked best first; failed runs and NaN last, ties by grid index.
-fn ranked(sweep: &Sweep) -> Vec<&Point> {
-    let (_, key) = rank_key(sweep);
-    let value = |p: &Point| if p.error.is_some() || key(p).is_nan() { f64::INFINITY } else { key(p) };
-    let mut points: Vec<&Point> = sweep.points.iter().collect();
-    points.sort_by(|a, b| value(a).total_cmp(&value(b)).then(a.index.cmp(&b.index)));
-    points
-}
-
-/// One line: how many points, how many failed, and the best one.
-pub fn summary(sweep: &Sweep) -> String {
-    let failed = sweep.points.iter().filter(|p| p.error.is_some()).count();
-    let (what, key) = rank_key(sweep);
-    let best = ranked(sweep).into_iter().next().filter(|p| p.error.is_none());
-    let best = best.map_or(String::from("no point ran to the end"), |p| {
-        let at: Vec<String> = sweep.axes.iter().zip(&p.values).map(|(a, v)| format!("{} = {v}", a.name)).collect();
-        format!("best {what} {:.3e} at {}", key(p), at.join(", "))
-    });
-    format!("{} points, {failed} failed; {best}\n", sweep.points.len())
-}
-
-/// What to print of a sweep: the table as `listing` asks (with a line saying
-/// when it is cut), then the summary line.
-pub fn listing(sweep: &Sweep, listing: Listing) -> String {
-    let n = sweep.points.len();
-    match listing {
-        Listing::Summary => summary(sweep),
-        Listing::All => table(sweep, sweep.points.iter()) + &summary(sweep),
-        Listing::Default if n <= FULL_TABLE_LIMIT => table(sweep, sweep.points.iter()) + &summary(sweep),
-        Listing::Default => {
-            let (what, _) = rank_key(sweep);
-            table(sweep, ranked(sweep).into_iter().take(TOP_K))
-                + &format!(
-                    "the {TOP_K} best of {n} points by {what} (more than {FULL_TABLE_LIMIT}; --all prints every point, sweep.json holds them all)\n"
-                )
-                + &summary(sweep)
-        }
-    }
-}
-
-/// One line per given point.
-fn table<'a>(sweep: &Sweep, points: impl Iterator<Item = &'a Point>) -> String {
-    let mut out: String = sweep.axes.iter().map(|a| format!("{:>12}", a.name)).collect();
-    out += &format!(" {:>11} {:>11} {:>11}\n", "max|phi|", "max|psi|", "max|err|");
-    for p in points {
-        out += &p.values.iter().map(|v| format!("{v:>12}")).collect::<String>();
-        let err = p.max_abs_err.map_or("-".into(), |e| format!("{e:.3e}"));
-        match &p.error {
-            Some(e) => out += &format!(" failed: {e}\n"),
-            None => out += &format!(" {:>11.3e} {:>11.3e} {err:>11}\n", p.max_abs_phi, p.max_abs_psi),
-        }
-    }
-    out
 }

@@ -1,9 +1,18 @@
 //! From a scenario to the case it runs: the model (built-in, planar or
 //! spatial mechanism, URDF robot), its consistent initial state, the method
 //! and the settings; a model's error names the scenario entry that made it.
+//!
+//! Here the case and its model; `mechanisms` the planar and spatial
+//! mechanisms of the entries (and a URDF robot's) and the entry behind each
+//! part; `invariants` the declared `[[invariants]]`.
+//!
+//! May import: `io` (and `case`'s scenario, runner and wording).
+
+mod invariants;
+mod mechanisms;
 
 use crate::case::runner::Case;
-use crate::case::scenario::{GravitySpec, InvariantSpec, Scenario, SpatialEntries, read_bounded};
+use crate::case::scenario::{GravitySpec, Scenario};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
 use cdyn::Settings;
@@ -11,7 +20,6 @@ use cdyn::control::methods::{MethodKeys, Preset};
 use cdyn::dynamics::assemble::assemble_with;
 use cdyn::error::{Part, positive};
 use cdyn::models::{Example, Kind};
-use cdyn::planar::{Element, Group, Mechanism};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
 use std::path::Path;
 
@@ -47,7 +55,7 @@ impl Scenario {
     pub fn method(&self) -> MethodKeys {
         let default = match self.integrator.scheme {
             s if s.steps_model() => MethodKeys::default(),
-            _ => MethodKeys { preset: Some(Preset::Robust), ..MethodKeys::default() },
+            _ => MethodKeys::default().with_preset(Preset::Robust),
         };
         self.method.clone().unwrap_or(default)
     }
@@ -233,143 +241,6 @@ impl Scenario {
             }
         }
     }
-
-    /// The spatial mechanism of the `urdf` file named in `[model]` (relative
-    /// to the scenario's folder), if any, and of the `[[bodies]]` and
-    /// `[[joints]]` entries, which may name the robot's links; with the
-    /// numbers of bodies and joints that come from the robot (first).
-    fn spatial_mechanism(
-        &self,
-        file: &str,
-        entries: SpatialEntries,
-        gravity: [f64; 3],
-    ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, Counts)> {
-        let mut robot = cdyn::spatial::Mechanism::default();
-        let (mut joint_names, mut load_names) = (Vec::new(), Vec::new());
-        match self.model.pendulum_keys.get("urdf") {
-            None => {}
-            Some(toml::Value::String(name)) => {
-                let path = Path::new(file).parent().unwrap_or(Path::new("")).join(name);
-                let text = read_bounded(&path).map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
-                let read = cdyn::spatial::read_urdf(&text, gravity)
-                    .map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
-                (robot, joint_names, load_names) = (read.mechanism, read.joint_names, read.load_names);
-            }
-            Some(other) => bail!("{file}: [model] urdf = {other}: expected the path of a URDF file"),
-        }
-        if robot.bodies.is_empty() && entries.bodies.is_empty() {
-            bail!("{file}: a spatial mechanism needs at least one [[bodies]] entry or a urdf file");
-        }
-        // The robot's joints by name, then the scenario's: one list, so that
-        // errors name joints[k] counting the scenario's own from 0 after the robot's.
-        let name = |i: usize| robot.bodies[i].name.clone();
-        let mut joints: Vec<cdyn::spatial::Joint<String>> = robot
-            .joints
-            .iter()
-            .map(|j| cdyn::spatial::Joint {
-                kind: j.kind,
-                a: name(j.a),
-                b: Some(j.b.map_or(cdyn::planar::GROUND.to_string(), name)),
-                point: j.point,
-                axis: j.axis,
-                axis_b: j.axis_b,
-                point_b: j.point_b,
-                angle: j.angle.clone(),
-                displacement: j.displacement.clone(),
-            })
-            .collect();
-        let robot_loads: Vec<cdyn::spatial::Load<String>> = robot
-            .loads
-            .iter()
-            .map(|l| match l {
-                cdyn::spatial::Load::RotaryDamper { a, b, axis, damping } => cdyn::spatial::Load::RotaryDamper {
-                    a: name(*a),
-                    b: Some(b.map_or(cdyn::planar::GROUND.to_string(), name)),
-                    axis: *axis,
-                    damping: *damping,
-                },
-                other => unreachable!("a URDF gives rotary dampers only, not {}", other.kind()),
-            })
-            .collect();
-        let counts = Counts {
-            robot_bodies: robot.bodies.len(),
-            joints: joints.len() + entries.joints.len(),
-            robot_joints: joint_names,
-            robot_loads: load_names,
-        };
-        joints.extend(entries.joints);
-        let mut bodies = robot.bodies;
-        bodies.extend(entries.bodies);
-        let loads = robot_loads.into_iter().chain(entries.forces).collect();
-        let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, loads, gravity);
-        Ok((mechanism, counts))
-    }
-
-    /// The element lists in the order the mechanism takes them.
-    fn element_lists(&self) -> [(Group, &[Element<String>]); 3] {
-        [(Group::Joints, &self.joints), (Group::Drives, &self.drives), (Group::Forces, &self.forces)]
-    }
-
-    /// For every element of the mechanism, the entry that describes it (`joints[2] (revolute)`).
-    fn entries(&self) -> Vec<String> {
-        let entry = |group: Group, (i, e): (usize, &Element<String>)| format!("{}[{i}] ({})", group.name(), e.kind());
-        self.element_lists()
-            .into_iter()
-            .flat_map(|(group, list)| list.iter().enumerate().map(move |e| entry(group, e)))
-            .collect()
-    }
-
-    /// The mechanism of the `[[bodies]]`, `[[joints]]`, `[[drives]]` and
-    /// `[[forces]]` entries, its elements in the order of [`Scenario::entries`].
-    fn mechanism(&self, gravity: [f64; 2]) -> cdyn::Result<Mechanism> {
-        let mut m = Mechanism::new(gravity);
-        for body in &self.bodies {
-            m.push(body.clone());
-        }
-        for (_, list) in self.element_lists() {
-            for element in list {
-                m.add_named(element.clone())?;
-            }
-        }
-        Ok(m)
-    }
-}
-
-/// How many of a spatial mechanism's parts come from its URDF robot,
-/// which come first in each list: bodies, joints, then the loads (after
-/// every joint in the numbering of `Part::Element`).
-struct Counts {
-    robot_bodies: usize,
-    /// Every joint, the robot's and the scenario's.
-    joints: usize,
-    /// The URDF joint behind each of the robot's joints, and behind each of
-    /// its loads (a joint's damping).
-    robot_joints: Vec<String>,
-    robot_loads: Vec<String>,
-}
-
-impl Counts {
-    /// The part as the scenario or the robot names it: `bodies[0] (top)`,
-    /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`,
-    /// `urdf joint "elbow" (revolute)`.
-    fn entry(&self, part: &Part) -> String {
-        let (robot_joints, robot_loads) = (self.robot_joints.len(), self.robot_loads.len());
-        match part {
-            Part::Body { index, name } if *index < self.robot_bodies => format!("urdf link {name:?}"),
-            Part::Body { index, name } => format!("bodies[{}] ({name})", index - self.robot_bodies),
-            Part::Element { index, kind } if *index < robot_joints => {
-                format!("urdf joint {:?} ({kind})", self.robot_joints[*index])
-            }
-            Part::Element { index, kind } if *index < self.joints => {
-                format!("joints[{}] ({kind})", index - robot_joints)
-            }
-            Part::Element { index, kind } if *index < self.joints + robot_loads => {
-                format!("urdf joint {:?} damping ({kind})", self.robot_loads[index - self.joints])
-            }
-            Part::Element { index, kind } => format!("forces[{}] ({kind})", index - self.joints - robot_loads),
-            other => other.to_string(),
-        }
-    }
 }
 
 /// The library's error, naming the scenario's entry (`joints[2] (revolute)`,
@@ -393,79 +264,4 @@ fn worst_entry(example: &Example, rows: &[String]) -> String {
     model.constraint_values(&example.q0, 0.0, &mut phi);
     let worst = (0..phi.len()).max_by(|&a, &b| phi[a].abs().total_cmp(&phi[b].abs()));
     worst.and_then(|r| rows.get(r)).map_or(String::new(), |e| format!(" (worst: {e})"))
-}
-
-impl InvariantSpec {
-    /// Declares it on `example`'s model.
-    fn declare(&self, example: &mut Example) -> std::result::Result<(), String> {
-        let names = example.model.coordinate_names().ok_or("needs a mechanism, whose coordinates have names")?;
-        let spatial = example.sketch.is_some();
-        let (name, direction) = match self {
-            InvariantSpec::Momentum { axis, name } => {
-                let suffixes: &[&str] = if spatial { &[".x", ".y", ".z"] } else { &[".x", ".y"] };
-                if axis.len() != suffixes.len() || axis.iter().any(|a| !a.is_finite()) || axis.iter().all(|a| *a == 0.0)
-                {
-                    return Err(format!("axis = {axis:?}: must be {} finite numbers, not all zero", suffixes.len()));
-                }
-                let direction = names
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(i, n)| suffixes.iter().position(|s| n.ends_with(s)).map(|k| (i, axis[k])))
-                    .filter(|(_, w)| *w != 0.0)
-                    .collect();
-                (name.clone().unwrap_or_else(|| format!("linear momentum along {axis:?}")), direction)
-            }
-            InvariantSpec::AngularMomentum { axis, point, name } => {
-                let axis = match axis.as_deref() {
-                    None => [0.0, 0.0, 1.0],
-                    Some(&[x, y, z]) if spatial => [x, y, z],
-                    Some(a) => {
-                        let expected = if spatial { "3 numbers" } else { "left out: a planar mechanism turns about z" };
-                        return Err(format!("axis = {a:?}: must be {expected}"));
-                    }
-                };
-                let width = if spatial { 3 } else { 2 };
-                let point = match point.as_deref() {
-                    None => [0.0; 3],
-                    Some(p) if p.len() == width => std::array::from_fn(|i| p.get(i).copied().unwrap_or(0.0)),
-                    Some(p) => return Err(format!("point = {p:?}: must be {width} numbers")),
-                };
-                let label =
-                    name.clone().unwrap_or_else(|| format!("angular momentum about {axis:?} through {point:?}"));
-                let g = cdyn::model::angular::Generator::rotation(&label, names, axis, point, true)?;
-                return example.model.declare_angular_momentum(g).map_err(|e| e.to_string());
-            }
-            InvariantSpec::Coordinate { coordinate, name } => {
-                let i = names.iter().position(|n| n == coordinate).ok_or_else(|| {
-                    format!("coordinate = \"{coordinate}\": no such coordinate (they are {})", names.join(", "))
-                })?;
-                (name.clone().unwrap_or_else(|| format!("momentum of {coordinate}")), vec![(i, 1.0)])
-            }
-        };
-        example.model.declare_momentum(&name, &direction).map_err(|e| e.to_string())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_robots_parts_are_named_as_its_urdf_names_them() {
-        // A robot of two links, joints "shoulder" and "elbow" (damped), then
-        // the scenario's one body, two joints and one force.
-        let counts = Counts {
-            robot_bodies: 2,
-            joints: 4,
-            robot_joints: vec!["shoulder".into(), "elbow".into()],
-            robot_loads: vec!["elbow".into()],
-        };
-        let element = |index, kind| counts.entry(&Part::Element { index, kind });
-        assert_eq!(counts.entry(&Part::Body { index: 1, name: "fore".into() }), "urdf link \"fore\"");
-        assert_eq!(counts.entry(&Part::Body { index: 2, name: "weight".into() }), "bodies[0] (weight)");
-        assert_eq!(element(1, "revolute"), "urdf joint \"elbow\" (revolute)");
-        assert_eq!(element(3, "distance"), "joints[1] (distance)");
-        assert_eq!(element(4, "rotary_damper"), "urdf joint \"elbow\" damping (rotary_damper)");
-        assert_eq!(element(5, "spring"), "forces[0] (spring)");
-    }
 }

@@ -1,0 +1,159 @@
+//! The mechanisms of a scenario's entries: planar from `[[bodies]]`,
+//! `[[joints]]`, `[[drives]]`, `[[forces]]`, spatial from those and a URDF
+//! robot's; and the entry (or URDF element) behind each part, for errors.
+
+use crate::case::scenario::{Scenario, SpatialEntries, read_bounded};
+use anyhow::{Result, anyhow, bail};
+use cdyn::error::Part;
+use cdyn::planar::{Element, Group, Mechanism};
+use std::path::Path;
+
+impl Scenario {
+    /// The spatial mechanism of the `urdf` file named in `[model]` (relative
+    /// to the scenario's folder), if any, and of the `[[bodies]]` and
+    /// `[[joints]]` entries, which may name the robot's links; with the
+    /// numbers of bodies and joints that come from the robot (first).
+    pub(super) fn spatial_mechanism(
+        &self,
+        file: &str,
+        entries: SpatialEntries,
+        gravity: [f64; 3],
+    ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, Counts)> {
+        let mut robot = cdyn::spatial::Mechanism::default();
+        let (mut joint_names, mut load_names) = (Vec::new(), Vec::new());
+        match self.model.pendulum_keys.get("urdf") {
+            None => {}
+            Some(toml::Value::String(name)) => {
+                let path = Path::new(file).parent().unwrap_or(Path::new("")).join(name);
+                let text = read_bounded(&path).map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
+                let read = cdyn::spatial::read_urdf(&text, gravity)
+                    .map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
+                (robot, joint_names, load_names) = (read.mechanism, read.joint_names, read.load_names);
+            }
+            Some(other) => bail!("{file}: [model] urdf = {other}: expected the path of a URDF file"),
+        }
+        if robot.bodies.is_empty() && entries.bodies.is_empty() {
+            bail!("{file}: a spatial mechanism needs at least one [[bodies]] entry or a urdf file");
+        }
+        // The robot's joints by name, then the scenario's: one list, so that
+        // errors name joints[k] counting the scenario's own from 0 after the robot's.
+        let name = |i: usize| robot.bodies[i].name.clone();
+        let mut joints: Vec<cdyn::spatial::Joint<String>> =
+            robot.joints.iter().map(|j| j.clone().map_bodies(name)).collect();
+        let robot_loads: Vec<cdyn::spatial::Load<String>> = robot
+            .loads
+            .iter()
+            .map(|l| match l {
+                cdyn::spatial::Load::RotaryDamper { a, b, axis, damping } => cdyn::spatial::Load::RotaryDamper {
+                    a: name(*a),
+                    b: Some(b.map_or(cdyn::planar::GROUND.to_string(), name)),
+                    axis: *axis,
+                    damping: *damping,
+                },
+                other => unreachable!("a URDF gives rotary dampers only, not {}", other.kind()),
+            })
+            .collect();
+        let counts = Counts {
+            robot_bodies: robot.bodies.len(),
+            joints: joints.len() + entries.joints.len(),
+            robot_joints: joint_names,
+            robot_loads: load_names,
+        };
+        joints.extend(entries.joints);
+        let mut bodies = robot.bodies;
+        bodies.extend(entries.bodies);
+        let loads = robot_loads.into_iter().chain(entries.forces).collect();
+        let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, loads, gravity);
+        Ok((mechanism, counts))
+    }
+
+    /// The element lists in the order the mechanism takes them.
+    fn element_lists(&self) -> [(Group, &[Element<String>]); 3] {
+        [(Group::Joints, &self.joints), (Group::Drives, &self.drives), (Group::Forces, &self.forces)]
+    }
+
+    /// For every element of the mechanism, the entry that describes it (`joints[2] (revolute)`).
+    pub(super) fn entries(&self) -> Vec<String> {
+        let entry = |group: Group, (i, e): (usize, &Element<String>)| format!("{}[{i}] ({})", group.name(), e.kind());
+        self.element_lists()
+            .into_iter()
+            .flat_map(|(group, list)| list.iter().enumerate().map(move |e| entry(group, e)))
+            .collect()
+    }
+
+    /// The mechanism of the `[[bodies]]`, `[[joints]]`, `[[drives]]` and
+    /// `[[forces]]` entries, its elements in the order of [`Scenario::entries`].
+    pub(super) fn mechanism(&self, gravity: [f64; 2]) -> cdyn::Result<Mechanism> {
+        let mut m = Mechanism::new(gravity);
+        for body in &self.bodies {
+            m.push(body.clone());
+        }
+        for (_, list) in self.element_lists() {
+            for element in list {
+                m.add_named(element.clone())?;
+            }
+        }
+        Ok(m)
+    }
+}
+
+/// How many of a spatial mechanism's parts come from its URDF robot,
+/// which come first in each list: bodies, joints, then the loads (after
+/// every joint in the numbering of `Part::Element`).
+pub(super) struct Counts {
+    pub(super) robot_bodies: usize,
+    /// Every joint, the robot's and the scenario's.
+    pub(super) joints: usize,
+    /// The URDF joint behind each of the robot's joints, and behind each of
+    /// its loads (a joint's damping).
+    pub(super) robot_joints: Vec<String>,
+    pub(super) robot_loads: Vec<String>,
+}
+
+impl Counts {
+    /// The part as the scenario or the robot names it: `bodies[0] (top)`,
+    /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`,
+    /// `urdf joint "elbow" (revolute)`.
+    pub(super) fn entry(&self, part: &Part) -> String {
+        let (robot_joints, robot_loads) = (self.robot_joints.len(), self.robot_loads.len());
+        match part {
+            Part::Body { index, name } if *index < self.robot_bodies => format!("urdf link {name:?}"),
+            Part::Body { index, name } => format!("bodies[{}] ({name})", index - self.robot_bodies),
+            Part::Element { index, kind } if *index < robot_joints => {
+                format!("urdf joint {:?} ({kind})", self.robot_joints[*index])
+            }
+            Part::Element { index, kind } if *index < self.joints => {
+                format!("joints[{}] ({kind})", index - robot_joints)
+            }
+            Part::Element { index, kind } if *index < self.joints + robot_loads => {
+                format!("urdf joint {:?} damping ({kind})", self.robot_loads[index - self.joints])
+            }
+            Part::Element { index, kind } => format!("forces[{}] ({kind})", index - self.joints - robot_loads),
+            other => other.to_string(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_robots_parts_are_named_as_its_urdf_names_them() {
+        // A robot of two links, joints "shoulder" and "elbow" (damped), then
+        // the scenario's one body, two joints and one force.
+        let counts = Counts {
+            robot_bodies: 2,
+            joints: 4,
+            robot_joints: vec!["shoulder".into(), "elbow".into()],
+            robot_loads: vec!["elbow".into()],
+        };
+        let element = |index, kind| counts.entry(&Part::Element { index, kind });
+        assert_eq!(counts.entry(&Part::Body { index: 1, name: "fore".into() }), "urdf link \"fore\"");
+        assert_eq!(counts.entry(&Part::Body { index: 2, name: "weight".into() }), "bodies[0] (weight)");
+        assert_eq!(element(1, "revolute"), "urdf joint \"elbow\" (revolute)");
+        assert_eq!(element(3, "distance"), "joints[1] (distance)");
+        assert_eq!(element(4, "rotary_damper"), "urdf joint \"elbow\" damping (rotary_damper)");
+        assert_eq!(element(5, "spring"), "forces[0] (spring)");
+    }
+}

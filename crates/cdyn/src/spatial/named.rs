@@ -1,0 +1,106 @@
+//! A spatial mechanism as scenario files write it: joints and loads that
+//! name their bodies, a joint or load on the ground seen from its other
+//! body.
+
+use super::body::Body;
+use super::joint::Joint;
+use super::load::Load;
+use super::mechanism::Mechanism;
+use crate::error::{Error, Part, Problem, Result};
+use std::collections::HashMap;
+
+impl Mechanism {
+    /// A mechanism whose joints name their bodies (`"ground"`, or `b`
+    /// omitted, for the ground), as scenario files do.
+    pub fn named(
+        bodies: Vec<Body>,
+        joints: Vec<Joint<String>>,
+        loads: Vec<Load<String>>,
+        gravity: [f64; 3],
+    ) -> Result<Self> {
+        let mut index = HashMap::new();
+        for (i, body) in bodies.iter().enumerate() {
+            let at = || Part::Body { index: i, name: body.name.clone() };
+            if body.name.is_empty() || body.name == crate::planar::GROUND {
+                return Err(Problem::ReservedName { name: body.name.clone() }.at(at()));
+            }
+            if index.insert(body.name.as_str(), i).is_some() {
+                return Err(Problem::DuplicateName.at(at()));
+            }
+        }
+        let resolve = |key: &'static str, name: &str| match index.get(name) {
+            Some(&i) => Ok(Some(i)),
+            None if name == crate::planar::GROUND => Ok(None),
+            None => Err(Error::from(Problem::UnknownBody { key, name: name.to_string() })),
+        };
+        let joints = joints
+            .into_iter()
+            .enumerate()
+            .map(|(k, j)| {
+                let at = Part::Element { index: k, kind: j.kind.name() };
+                let a = resolve("a", &j.a).map_err(|e| e.at(at.clone()))?;
+                let b = match &j.b {
+                    Some(name) => resolve("b", name).map_err(|e| e.at(at.clone()))?,
+                    None => None,
+                };
+                let Joint { kind, point, axis, axis_b, point_b, angle, displacement, .. } = j;
+                match (a, b) {
+                    (Some(a), b) => Ok(Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement }),
+                    // `a = "ground"`: the same joint seen from `b`, each
+                    // side's point and axis going with its body, and the
+                    // drives turned round.
+                    (None, Some(b)) => Ok(Joint {
+                        kind,
+                        a: b,
+                        b: None,
+                        point: point_b.unwrap_or(point),
+                        axis: axis_b.or(axis),
+                        axis_b: axis_b.and(axis),
+                        point_b: point_b.and(Some(point)),
+                        angle: angle.map(negated),
+                        displacement: displacement.map(negated),
+                    }),
+                    (None, None) => Err(Problem::SameBody { body: crate::planar::GROUND.to_string() }.at(at)),
+                }
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let ground = || Problem::SameBody { body: crate::planar::GROUND.to_string() };
+        let loads = loads
+            .into_iter()
+            .enumerate()
+            .map(|(k, load)| {
+                let at = Part::Element { index: joints.len() + k, kind: load.kind() };
+                let body = |key, name: &str| resolve(key, name).map_err(|e| e.at(at.clone()));
+                let pair = |a: &str, b: &Option<String>| -> Result<(Option<usize>, Option<usize>)> {
+                    Ok((body("a", a)?, b.as_deref().map(|b| body("b", b)).transpose()?.flatten()))
+                };
+                let one = |name: &str| body("body", name)?.ok_or_else(|| Problem::OnGround("loaded").at(at.clone()));
+                Ok(match load {
+                    Load::Spring { a, b, point, point_b, stiffness, damping, length } => match pair(&a, &b)? {
+                        (Some(a), b) => Load::Spring { a, b, point, point_b, stiffness, damping, length },
+                        (None, Some(b)) => {
+                            Load::Spring { a: b, b: None, point: point_b, point_b: point, stiffness, damping, length }
+                        }
+                        (None, None) => return Err(ground().at(at)),
+                    },
+                    Load::RotaryDamper { a, b, axis, damping } => match pair(&a, &b)? {
+                        (Some(a), b) => Load::RotaryDamper { a, b, axis, damping },
+                        (None, Some(b)) => Load::RotaryDamper { a: b, b: None, axis, damping },
+                        (None, None) => return Err(ground().at(at)),
+                    },
+                    Load::Force { body, force, point } => Load::Force { body: one(&body)?, force, point },
+                    Load::Torque { body, torque } => Load::Torque { body: one(&body)?, torque },
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self { bodies, joints, gravity, loads })
+    }
+}
+
+/// `−f(t)`: a drive seen from the other body.
+fn negated(f: crate::model::timefn::TimeFn) -> crate::model::timefn::TimeFn {
+    crate::model::timefn::TimeFn {
+        polynomial: f.polynomial.iter().map(|c| -c).collect(),
+        sines: f.sines.iter().map(|&[a, w, phase]| [-a, w, phase]).collect(),
+    }
+}
