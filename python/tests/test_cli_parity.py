@@ -208,9 +208,9 @@ def test_suite_is_the_clis_suite_json_and_table(cli, tmp_path):
     written = (tmp_path / "suite.json").read_text()
     assert result.summary == json.loads(written)
     assert result.table in out.stdout
-    # Every model, both schemes and both steps; the misses are the CLI's, named.
+    # Every model, all five schemes and both steps; the misses are the CLI's, named.
     models = {c["model"] for c in result.cases}
-    assert "satellite_planar" in models and len(result.cases) == 6 * len(models)
+    assert "satellite_planar" in models and len(result.cases) == 10 * len(models)
     assert result.misses == json.loads(written)["summary"]["misses"]
     with pytest.raises(cdyn.ScenarioError, match="nothing.toml"):
         cdyn.suite([tmp_path / "nothing.toml"], light=True)

@@ -254,6 +254,40 @@ fn the_readme_first_scenario_runs_as_its_command_says() {
 }
 
 #[test]
+fn a_scenario_without_scheme_runs_the_default_the_book_names() {
+    // The book names the default in the scenario reference and in the
+    // work-precision page's advice; a scenario without the key runs it.
+    let reference = std::fs::read_to_string(root().join("docs/scenarios.md")).unwrap();
+    let named = reference
+        .split("; default ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .expect("docs/scenarios.md names a default scheme");
+    let precision = std::fs::read_to_string(root().join("docs/precision.md")).unwrap();
+    let precision = precision.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        precision.contains(&format!("`{named}` with `robust` (the default scheme of a scenario that names none)")),
+        "docs/precision.md's advice names another default than {named}"
+    );
+    let body = "[model]\nkind = \"pendulum\"\n[integrator]\nSCHEMEh = 0.01\nt_end = 0.5\n";
+    let run = |scheme: &str| {
+        let (dir, file) = scenario("default.toml", &body.replace("SCHEME", scheme));
+        let out = dir.join("out");
+        let result = cdyn(&["run", path_str(&file), "--out", path_str(&out)]);
+        assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+        (summary["cases"][0]["scheme"].as_str().unwrap().to_string(), std::fs::read(out.join("default.csv")).unwrap())
+    };
+    let (default, rows) = run("");
+    assert_eq!(default, named);
+    let (explicit, explicit_rows) = run(&format!("scheme = \"{named}\"\n"));
+    assert_eq!((explicit, &explicit_rows), (default, &rows), "the same run, to the bit");
+    let (other, other_rows) = run("scheme = \"ab3\"\n");
+    assert!(other == "ab3" && other_rows != rows);
+}
+
+#[test]
 fn cdyn_paper_prints_the_readme_table_to_the_last_digit() {
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
     let table = blocks(&readme, "text")[0];

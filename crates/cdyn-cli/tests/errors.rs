@@ -210,3 +210,61 @@ fn a_run_stopped_by_stiff_damping_names_generalized_alpha_and_a_stable_step() {
     let out = cdyn(&["run"], Some(&path), &dir.path().join("out"));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+#[test]
+fn a_run_stopped_by_a_stiff_spring_names_generalized_alpha_and_a_stable_step() {
+    // A 2 kg point mass on a spring of 20 000 N/m: ω = 100 rad/s along it.
+    let spring = |scheme: &str, h: &str| {
+        format!(
+            r#"
+[model]
+kind = "mechanism"
+gravity = [0.0, 0.0]
+[method]
+geometric = "none"
+energy = "none"
+[integrator]
+scheme = "{scheme}"
+h = {h}
+t_end = 20.0
+[[bodies]]
+name = "bob"
+mass = 2.0
+position = [0.6, 0.0]
+[[forces]]
+kind = "spring"
+a = "ground"
+point_a = [0.0, 0.0]
+b = "bob"
+point_b = [0.0, 0.0]
+stiffness = 20000.0
+rest_length = 0.5
+"#
+        )
+    };
+    // h ω = 5, past RK-4's 2√2 on the imaginary axis: it diverges, and
+    // half that limit is at h ≤ 1.41e-2.
+    let (line, _) = error_of(&spring("rk4", "0.05"));
+    assert!(line.contains("diverged"), "{line}");
+    assert!(
+        line.contains(
+            "the springs are stiff against the step (h ω = 5.000; rk4's stability limit on oscillations is 2.828)"
+        ),
+        "{line}"
+    );
+    assert!(line.contains("scheme = \"generalized_alpha\" has no such limit, or rk4 needs h ≤ 1.41e-2"), "{line}");
+    // h ω = 2: stable, but past half the limit: a note; generalized-α runs at 0.05.
+    for (scheme, h, note) in [("rk4", "0.02", true), ("rk4", "0.01", false), ("generalized_alpha", "0.05", false)] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("spring.toml");
+        std::fs::write(&path, spring(scheme, h)).unwrap();
+        let out = cdyn(&["run"], Some(&path), &dir.path().join("out"));
+        assert!(out.status.success(), "{scheme} {h}: {}", String::from_utf8_lossy(&out.stderr));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            stdout.contains("the springs are stiff against the step (h ω = 2.000"),
+            note,
+            "{scheme} {h}: {stdout}"
+        );
+    }
+}

@@ -688,3 +688,55 @@ fn worst_error(ex: &cdyn::models::Example, settings: Settings, t_end: f64, every
     .unwrap();
     (worst, *sim.tuning())
 }
+
+/// `h ω`, the step against the fastest oscillation the stiffness allows,
+/// reported for explicit runs with or without control (the hint of a run
+/// whose springs are stiff reads it): a point mass on a spring to the
+/// ground, `ω = √(k/m)` along the spring (the Hessian's other direction
+/// is softer, `k (1 − l₀/l)`), and a pendulum hanging at rest, `ω = √(g/L)`
+/// from its rod's curvature weighted by the tension, since gravity alone
+/// has no stiffness.
+#[test]
+fn the_fastest_oscillation_of_the_stiffness_is_reported_against_the_step() {
+    let (mass, k, h) = (2.0, 800.0, 1e-3);
+    let mut spring = Mechanism::new([0.0, 0.0]);
+    let bob = spring.point("bob", mass, [0.6, 0.0]);
+    spring.add(Element::Spring {
+        a: BodyId::Ground,
+        pa: [0.0, 0.0],
+        b: bob,
+        pb: [0.0, 0.0],
+        stiffness: k,
+        rest_length: 0.5,
+    });
+    let built = spring.build().unwrap();
+    let pendulum = cartesian_pendulum(
+        PendulumParams::default()
+            .with_length(2.0)
+            .with_gravity(9.81)
+            .with_theta0(-std::f64::consts::FRAC_PI_2)
+            .with_omega0(0.0),
+    )
+    .unwrap();
+    let cases = [
+        ("spring", &built.model, &built.q0, &built.v0, (k / mass).sqrt()),
+        ("pendulum", &pendulum.model, &pendulum.q0, &pendulum.v0, (9.81_f64 / 2.0).sqrt()),
+    ];
+    for (name, model, q0, v0, omega) in cases {
+        for control in [Control::none(), methods::robust()] {
+            for scheme in [Scheme::RungeKutta4, Scheme::Rattle] {
+                let control = if scheme == Scheme::Rattle { Control::none() } else { control };
+                let sim = Simulation::new(model, Settings::new(scheme, h, control), q0, v0).unwrap();
+                let got = sim.tuning().oscillation_h;
+                assert!(
+                    (got - omega * h).abs() <= 1e-6 * omega * h,
+                    "{name}, {scheme:?}, {control:?}: {got} against {}",
+                    omega * h
+                );
+            }
+        }
+        // Generalized-α, A-stable, needs no hint and estimates nothing.
+        let sim = Simulation::new(model, Settings::new(Scheme::GeneralizedAlpha, h, Control::none()), q0, v0).unwrap();
+        assert_eq!(sim.tuning().oscillation_h, 0.0, "{name}");
+    }
+}

@@ -15,7 +15,7 @@ const PANEL: (u32, u32) = (640, 430);
 const COLUMNS: usize = 3;
 /// Room above the panels for the title and below them for the legend.
 const TITLE: u32 = 50;
-const LEGEND: u32 = 60;
+const LEGEND: u32 = 90;
 
 /// Writes `dir/suite.png` and `dir/suite.svg`, each under a temporary name
 /// first, so a failure leaves no half-drawn figure.
@@ -42,10 +42,10 @@ fn de<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow:
     anyhow!("{e}")
 }
 
-/// The colour of the `i`-th scheme and step of a model: warm for AB-3 (red,
-/// orange), cold for RK-4 (blue, purple), in the suite's order.
+/// The colour of the `i`-th scheme and step of a model, in the suite's
+/// order (AB-3, RK-4, ABM-4, RATTLE, generalized-α, each at `h` and `h/2`).
 fn colour(i: usize) -> RGBAColor {
-    Palette99::pick([0, 4, 3, 5][i % 4]).to_rgba()
+    Palette99::pick([0, 4, 3, 5, 2, 6, 1, 8, 7, 9][i % 10]).to_rgba()
 }
 
 /// A panel's point for `ratio`: its log10, or `None` where there is nothing to draw (no
@@ -79,7 +79,10 @@ fn panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, groups: &[&Group]) -
 where
     DB::ErrorType: 'static,
 {
-    let methods: Vec<&str> = groups[0].runs.iter().map(|r| r.method.as_str()).collect();
+    // Every method of the model, in the order of its fullest group (the
+    // schemes that step the model run only some of them).
+    let fullest = groups.iter().max_by_key(|g| g.runs.len()).expect("a model has groups");
+    let methods: Vec<&str> = fullest.runs.iter().map(|r| r.method.as_str()).collect();
     let n = methods.len();
     let ratios = || groups.iter().flat_map(|g| g.runs.iter().flat_map(|r| [r.error_vs_none, r.error_vs_projection]));
     let logs: Vec<f64> = ratios().filter_map(log_ratio).filter(|x| x.is_finite()).collect();
@@ -123,7 +126,8 @@ where
     ch.draw_series(std::iter::once(PathElement::new([(0.0, 0.0), (0.0, n as f64)], BLACK.mix(0.6)))).map_err(de)?;
     for (c, g) in groups.iter().enumerate() {
         let colour = colour(c);
-        for (i, r) in g.runs.iter().enumerate() {
+        for r in &g.runs {
+            let i = methods.iter().position(|m| *m == r.method).expect("a method of the fullest group");
             let y = (n - 1 - i) as f64 + 0.2 + 0.6 * c as f64 / groups.len().max(2).saturating_sub(1) as f64;
             for (k, ratio) in [r.error_vs_none, r.error_vs_projection].into_iter().enumerate() {
                 let Some(x) = log_ratio(ratio) else { continue };
@@ -150,15 +154,16 @@ where
         plotters::style::text_anchor::HPos::Left,
         plotters::style::text_anchor::VPos::Center,
     ));
-    let y = 30;
-    let mut x = 20;
+    // The schemes and steps on one line, the markers on the next.
+    let (mut x, y) = (20, 24);
     let coarse = groups.iter().map(|g| g.h).fold(0.0, f64::max);
     for (c, g) in groups.iter().enumerate() {
         let step = if g.h == coarse { "h".to_string() } else { format!("h/{}", (coarse / g.h).round()) };
         area.draw(&Circle::new((x, y), 5, colour(c).filled())).map_err(de)?;
         area.draw(&Text::new(format!("{}, {step}", g.scheme), (x + 12, y), font.clone())).map_err(de)?;
-        x += 140;
+        x += 185;
     }
+    let (mut x, y) = (20, 60);
     let marks = ["dots: error / none", "squares: error / projection", "crosses: the run stopped", "line: ratio 1"];
     for m in marks {
         area.draw(&Text::new(m, (x, y), font.clone())).map_err(de)?;

@@ -32,6 +32,13 @@
 //!   rate is kept), and so is the projection of `Ψ` (the `projection`
 //!   method was 37× worse than none on the flyball governor, and 2× on
 //!   the damped pendulum at AB-3 with `h λ_d` = 0.018).
+//! * Two more figures say whether the step is stiff for an explicit
+//!   scheme, for the hint a run gets: `h λ_d` against the scheme's real
+//!   stability interval, and `h ω`, `ω` the fastest oscillation of the
+//!   springs, potentials and constraint forces (`ω²` the largest
+//!   eigenvalue of `P M⁻¹ K`, `K` the stiffness of Newton's matrix in
+//!   generalized-α), against its interval on the imaginary axis
+//!   ([`imaginary_stability_interval`]).
 
 use crate::control::evaluation::Evaluation;
 use crate::control::{Control, Energy, EnergyGain, Gain, Geometric, Rate, Velocity};
@@ -55,6 +62,9 @@ pub struct Operators {
     /// `λ_d`, the fastest damping of the non-conservative forces
     /// (`dissipation_rate` in this module).
     pub dissipation: f64,
+    /// `ω`, the fastest oscillation of the stiffness (`oscillation_frequency`
+    /// in this module; 0 where it is not estimated).
+    pub frequency: f64,
 }
 
 /// What the automatic gains were chosen from, and the resulting rate × h.
@@ -72,6 +82,9 @@ pub struct Tuning {
     /// `h λ_d`: the step against the fastest damping of the
     /// non-conservative forces (0 without them).
     pub dissipation_h: f64,
+    /// `h ω`: the step against the fastest oscillation of the springs,
+    /// potentials and constraint forces (0 where not estimated).
+    pub oscillation_h: f64,
     /// Whether the automatic energy term, or the projection of `Ψ`, was
     /// left out because that damping is stiff (`dissipation_h >
     /// STIFF_DISSIPATION_H`).
@@ -96,6 +109,27 @@ pub fn real_stability_interval(scheme: Scheme) -> f64 {
         // an oscillation ẍ = −ω²x while h ω < 2.
         Formula::Rattle => 2.0,
         // Generalized-α is A-stable: no limit on h λ.
+        Formula::GeneralizedAlpha => f64::INFINITY,
+    }
+}
+
+/// The stability interval `[0, y]` of a scheme on the imaginary axis: the
+/// largest `y = h ω` up to which an undamped oscillation `ẏ = iω y` does
+/// not grow (0 where it grows at any step).
+pub fn imaginary_stability_interval(scheme: Scheme) -> f64 {
+    match scheme.info().formula {
+        // Forward Euler and AB-2: |ζ| > 1 for every h ω > 0.
+        Formula::Multistep(w) if w.len() <= 2 => 0.0,
+        // AB-3: where its root leaves the unit circle (the test finds it).
+        Formula::Multistep(_) => 0.723_627_226_987_110_9,
+        // RK-4: |R(i y)| = 1 at y = 2√2.
+        Formula::RungeKutta { .. } => 2.0 * std::f64::consts::SQRT_2,
+        // ABM-4 PECE: where a spurious root leaves the unit circle. Below
+        // it the principal root grows too, as 0.16 (h ω)⁶ a step (1e-5 at
+        // h ω = 0.2, 0.7 % at 0.8): slowly, like the scheme's error.
+        Formula::PredictorCorrector { .. } => 0.926_201_614_102_906,
+        // Velocity Verlet: h ω < 2.
+        Formula::Rattle => 2.0,
         Formula::GeneralizedAlpha => f64::INFINITY,
     }
 }
@@ -164,7 +198,22 @@ pub(crate) fn coupling<E: Evaluation>(d: &E, n: usize) -> f64 {
 /// `C w = −∂Q/∂v · w` from `damping(w, out)` and `P` the `M`-orthogonal
 /// projection onto `Φ_q w = 0` — by power iteration. 0 without
 /// velocity-dependent forces. Allocates: called once per simulation.
-pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, mut damping: impl FnMut(&[f64], &mut [f64])) -> f64 {
+pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, damping: impl FnMut(&[f64], &mut [f64])) -> f64 {
+    constrained_radius(d, n, damping)
+}
+
+/// `ω`: the fastest oscillation of the motions the constraints allow —
+/// the square root of the spectral radius of `P M⁻¹ K`, `K w` from
+/// `stiffness(w, out)` (the potentials' Hessians, `−∂Q/∂q`, and the
+/// constraints' curvatures weighted by the multipliers) — by power
+/// iteration. Allocates: called once per simulation.
+pub(crate) fn oscillation_frequency<E: Evaluation>(d: &E, n: usize, stiffness: impl FnMut(&[f64], &mut [f64])) -> f64 {
+    constrained_radius(d, n, stiffness).sqrt()
+}
+
+/// The spectral radius of `P M⁻¹ A`, `A w` from `apply(w, out)`, by power
+/// iteration in the `M`-norm.
+fn constrained_radius<E: Evaluation>(d: &E, n: usize, mut apply: impl FnMut(&[f64], &mut [f64])) -> f64 {
     let m = d.phi().len();
     let mass = d.mass();
     let (mut force, mut b, mut mw) = (vec![0.0; n], vec![0.0; m], vec![0.0; n]);
@@ -185,7 +234,7 @@ pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, mut damping: impl
             return rate;
         }
         w.iter_mut().for_each(|a| *a /= norm);
-        damping(&w, &mut force);
+        apply(&w, &mut force);
         constrained(&force, &mut w);
         mass.mul(&w, &mut mw);
         let next = w.iter().zip(&mw).map(|(a, b)| a * b).sum::<f64>().sqrt();
@@ -201,7 +250,7 @@ pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, mut damping: impl
 /// `control` with every automatic gain replaced by the chosen rate, and
 /// what they were chosen from.
 pub fn resolve(control: Control, scheme: Scheme, h: f64, operators: Operators) -> (Control, Tuning) {
-    let Operators { coupling, max_row_norm2, dissipation } = operators;
+    let Operators { coupling, max_row_norm2, dissipation, frequency } = operators;
     let target = target(scheme, control.application);
     let mut c = control;
     let exact = |r: Rate| {
@@ -268,35 +317,58 @@ pub fn resolve(control: Control, scheme: Scheme, h: f64, operators: Operators) -
         }
         e => e,
     };
-    (c, Tuning { coupling, rate_h: rate * h, target, dissipation_h, energy_left_out })
+    let oscillation_h = frequency * h;
+    (c, Tuning { coupling, rate_h: rate * h, target, dissipation_h, oscillation_h, energy_left_out })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The largest root modulus of a PECE scheme on `ẏ = λ y` at `z = h λ`:
-    /// `y_{k+1} = y_k + z (c_0 y* + Σ_j c_{j+1} y_{k−j})` with the prediction
-    /// `y* = y_k + z Σ_j p_j y_{k−j}`, as the eigenvalues of its companion matrix.
-    fn pece_spectral_radius(p: &[f64], c: &[f64], z: f64) -> f64 {
-        let k = p.len();
-        // y_{k+1} = Σ_j a_j y_{k−j}.
-        let mut a = vec![0.0; k];
-        a[0] = 1.0 + z * c[0];
-        for j in 0..k {
-            a[j] += z * c[0] * z * p[j];
-        }
-        for (j, cj) in c[1..].iter().enumerate() {
-            a[j] += z * cj;
-        }
-        let mut m = nalgebra::DMatrix::zeros(k, k);
+    use nalgebra::Complex;
+
+    /// The roots of `ζᵏ = Σⱼ aⱼ ζᵏ⁻¹⁻ʲ`, as the eigenvalues of its companion matrix.
+    fn roots(a: &[Complex<f64>]) -> Vec<Complex<f64>> {
+        let k = a.len();
+        let mut m = nalgebra::DMatrix::<Complex<f64>>::zeros(k, k);
         for j in 0..k {
             m[(0, j)] = a[j];
         }
         for i in 1..k {
-            m[(i, i - 1)] = 1.0;
+            m[(i, i - 1)] = Complex::new(1.0, 0.0);
         }
-        m.complex_eigenvalues().iter().map(|e| e.norm()).fold(0.0, f64::max)
+        m.schur().eigenvalues().expect("a complex Schur form is triangular").iter().copied().collect()
+    }
+
+    /// A PECE scheme on `ẏ = λ y` at `z = h λ`: `y_{k+1} = y_k + z (c_0 y* +
+    /// Σ_j c_{j+1} y_{k−j})` with the prediction `y* = y_k + z Σ_j p_j
+    /// y_{k−j}`, as `y_{k+1} = Σ_j a_j y_{k−j}`.
+    fn pece(p: &[f64], c: &[f64], z: Complex<f64>) -> Vec<Complex<f64>> {
+        let mut a = vec![Complex::new(0.0, 0.0); p.len()];
+        a[0] = 1.0 + z * c[0];
+        for j in 0..p.len() {
+            a[j] += z * c[0] * z * p[j];
+        }
+        for (j, cj) in c[1..].iter().enumerate() {
+            a[j] += z * *cj;
+        }
+        a
+    }
+
+    /// Adams–Bashforth with weights `w` at `z`: `y_{k+1} = y_k + z Σ_j w_j y_{k−j}`.
+    fn multistep(w: &[f64], z: Complex<f64>) -> Vec<Complex<f64>> {
+        let mut a: Vec<Complex<f64>> = w.iter().map(|w| z * *w).collect();
+        a[0] += 1.0;
+        a
+    }
+
+    fn radius(a: &[Complex<f64>]) -> f64 {
+        roots(a).iter().map(|r| r.norm()).fold(0.0, f64::max)
+    }
+
+    /// The largest root modulus of a PECE scheme at a real `z`.
+    fn pece_spectral_radius(p: &[f64], c: &[f64], z: f64) -> f64 {
+        radius(&pece(p, c, Complex::new(z, 0.0)))
     }
 
     #[test]
@@ -324,6 +396,49 @@ mod tests {
                 Formula::Rattle | Formula::GeneralizedAlpha => unreachable!("not among the general schemes"),
             };
             assert!(at_boundary.abs() < 1e-12, "{scheme:?}: {at_boundary}");
+        }
+    }
+
+    #[test]
+    fn the_imaginary_stability_intervals_end_where_an_oscillation_starts_to_grow() {
+        let at = |y: f64| Complex::new(0.0, y);
+        for scheme in Scheme::GENERAL {
+            let y = imaginary_stability_interval(scheme);
+            let (inside, outside) = (y * (1.0 - 1e-6), y * (1.0 + 1e-6));
+            match scheme.info().formula {
+                Formula::RungeKutta { .. } => {
+                    let r = |y: f64| {
+                        let z = at(y);
+                        (1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0).norm()
+                    };
+                    assert!((r(y) - 1.0).abs() < 1e-12 && r(outside) > 1.0 && r(inside) < 1.0, "{scheme:?}");
+                }
+                Formula::Multistep(w) if y == 0.0 => {
+                    // Euler and AB-2 grow at any step.
+                    assert!(radius(&multistep(w, at(0.01))) > 1.0 + 1e-12, "{scheme:?}");
+                }
+                Formula::Multistep(w) => {
+                    let r = |y: f64| radius(&multistep(w, at(y)));
+                    assert!(r(inside) <= 1.0 + 1e-12 && r(outside) > 1.0, "{scheme:?}");
+                    assert!((1..1000).all(|k| r(y * k as f64 / 1000.0) <= 1.0 + 1e-12), "{scheme:?}");
+                }
+                Formula::PredictorCorrector { predictor, corrector } => {
+                    // The spurious roots (all but the one nearest e^{iy}) reach the circle at y.
+                    let spurious = |y: f64| {
+                        let mut r = roots(&pece(predictor, corrector, at(y)));
+                        let principal = (0..r.len())
+                            .min_by(|&a, &b| (r[a] - at(y).exp()).norm().total_cmp(&(r[b] - at(y).exp()).norm()))
+                            .unwrap();
+                        r.remove(principal);
+                        r.iter().map(|r| r.norm()).fold(0.0, f64::max)
+                    };
+                    assert!(spurious(inside) < 1.0 && spurious(outside) > 1.0, "{scheme:?}");
+                    // The principal root grows as about 0.16 y⁶ below it.
+                    let growth = radius(&pece(predictor, corrector, at(0.2))) - 1.0;
+                    assert!((growth / (0.16 * 0.2_f64.powi(6)) - 1.0).abs() < 0.1, "{scheme:?}: {growth:e}");
+                }
+                Formula::Rattle | Formula::GeneralizedAlpha => unreachable!("not among the general schemes"),
+            }
         }
     }
 }

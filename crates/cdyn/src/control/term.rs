@@ -399,18 +399,30 @@ impl Control {
             let grad = d.grad_potential();
             // The rate at which the other terms change Ψ (moving q through V,
             // v through T) is cancelled too: the whole control gives Ψ̇ = −α_e Ψ.
-            let mut others = dot(grad, u_q) + mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
+            // U so far: CVSGF's gradient in U_q, Baumgarte's term or the
+            // unit vectors' carried velocities in U_v (each pass skipped
+            // where U is still zero: two passes of robust's step).
+            let mut others = 0.0;
+            if matches!(self.geometric, Geometric::Gradient(_)) {
+                others += dot(grad, u_q);
+            }
+            if matches!(self.geometric, Geometric::Baumgarte { .. }) || !d.unit_vectors().is_empty() {
+                others += mass.psi_v_dot(v, |i| u_v[i], |_| 0.0, 0.0);
+            }
             if alpha_g.is_some() {
                 // ∇V·(−M⁻¹Φ_qᵀ z_Φ) = −(Φ_q w)·z_Φ
                 others -= dot(phi_q_w, z_q);
             }
             // vᵀM(−α_v M⁻¹Φ_qᵀ z_Φ̇) = −α_v (Φ_q v)·z_Φ̇
-            others -= alpha_v * (0..z_dot.len()).map(|r| phi_q_v(r) * z_dot[r]).sum::<f64>();
+            let phi_q_v_z_dot = (0..z_dot.len()).map(|r| phi_q_v(r) * z_dot[r]).sum::<f64>();
+            others -= alpha_v * phi_q_v_z_dot;
             let target = alpha_e * psi + others;
             // N = c|P M⁻¹∇V|²_M + |P_E P v|²_M, |P_E P v|²_M = vᵀMv − (Φ_q v)·y_v − pᵀ(EᵀME)⁻¹p
             // (P_E and P commute, since Φ_q E = 0).
             let whole = 2.0 * mass.kinetic(v);
-            let mut norm = whole - (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>() - kept;
+            let phi_q_v_y_v =
+                if separate_y_v { (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>() } else { phi_q_v_z_dot };
+            let mut norm = whole - phi_q_v_y_v - kept;
             if positions {
                 norm += c * (dot(grad, w) - dot(phi_q_w, y_w));
             }

@@ -134,9 +134,9 @@ pub enum Error {
         /// Iterations taken.
         iterations: u32,
     },
-    /// Generalized-α's Newton iteration failed.
+    /// Generalized-α's Newton iteration did not converge.
     #[error(
-        "generalized-α's Newton iteration {cause} at step {step}, t = {}: relative |Δq̈| = {correction:.3e} after {iterations} corrections (take a smaller h, or allow more newton iterations)",
+        "generalized-α's Newton iteration did not converge at step {step}, t = {}: relative |Δq̈| = {correction:.3e} after {iterations} corrections (take a smaller h, or allow more newton iterations)",
         Time(*t)
     )]
     NewtonFailed {
@@ -144,12 +144,25 @@ pub enum Error {
         step: u64,
         /// Time the step was to reach.
         t: f64,
-        /// `did not converge`, or `met a singular matrix`.
-        cause: &'static str,
         /// `|Δq̈|∞` of the correction that would come next, over the largest
-        /// acceleration (NaN where singular).
+        /// acceleration.
         correction: f64,
         /// Corrections taken.
+        iterations: u32,
+    },
+    /// Generalized-α's Newton matrix is singular at independent constraint
+    /// rows (a dependent row is [`Error::SingularConstraints`], or dropped
+    /// with `dependent_rows = "tolerate"`).
+    #[error(
+        "generalized-α's Newton matrix is singular at step {step}, t = {} (after {iterations} corrections) with independent constraint rows: the step's mass, damping and stiffness, M + c_v C + c_q K, have no inverse on the constraints, as where a negative stiffness cancels the inertia (take a smaller h)",
+        Time(*t)
+    )]
+    NewtonSingular {
+        /// Steps taken, including the one that failed.
+        step: u64,
+        /// Time the step was to reach.
+        t: f64,
+        /// Corrections taken before.
         iterations: u32,
     },
     /// Method keys that do not describe one method.

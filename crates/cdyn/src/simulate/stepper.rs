@@ -144,8 +144,10 @@ impl<S: System> Stepper<S> {
         // Automatic gains, and the rate × h every control term runs at.
         // A state the dynamics cannot evaluate fails the first step, which
         // reports it with the run's record; the gains are then moot.
-        // The projection reads the damping's rate (whether to project `Ψ`).
-        let operators = if settings.control.is_active() || settings.control.projection.is_some() {
+        // The projection reads the damping's rate (whether to project `Ψ`);
+        // an explicit scheme's run reports the damping's and the springs'
+        // rates against its step (a hint where they are stiff).
+        let operators = if settings.scheme != Scheme::GeneralizedAlpha || settings.control.projection.is_some() {
             system.operators(x.as_slice(), 0.0).unwrap_or(Operators { coupling: 1.0, ..Operators::default() })
         } else {
             Operators::default()
@@ -270,20 +272,19 @@ impl<S: System> Stepper<S> {
                 }
             }
         } else if self.settings.scheme == Scheme::GeneralizedAlpha {
-            let (cause, correction, iterations) = match self.system.generalized_alpha(self.x.as_mut_slice(), t, h) {
+            let (step, t) = (step + 1, t + h);
+            match self.system.generalized_alpha(self.x.as_mut_slice(), t - h, h) {
                 Ok(r) => {
                     self.newton_iterations += u64::from(r.iterations);
                     self.newton_correction = self.newton_correction.max(r.correction);
-                    ("", 0.0, 0)
                 }
-                Err(AlphaFailure::Eval(e)) => return Err(eval_error(e, step, t + h)),
-                Err(AlphaFailure::Singular) => ("met a singular matrix", f64::NAN, 0),
+                Err(AlphaFailure::Eval(e)) => return Err(eval_error(e, step - 1, t)),
+                Err(AlphaFailure::Singular { iterations }) => {
+                    return Err(Error::NewtonSingular { step, t, iterations });
+                }
                 Err(AlphaFailure::NotConverged { correction, iterations }) => {
-                    ("did not converge", correction, iterations)
+                    return Err(Error::NewtonFailed { step, t, correction, iterations });
                 }
-            };
-            if !cause.is_empty() {
-                return Err(Error::NewtonFailed { step: step + 1, t: t + h, cause, correction, iterations });
             }
         } else {
             self.integrator

@@ -169,6 +169,8 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
             coupling: crate::control::gains::coupling(&self.d, N),
             max_row_norm2: rows.fold(0.0, f64::max),
             dissipation: crate::control::gains::dissipation_rate(&self.d, N, damping),
+            // Not estimated for the small systems (no stiffness hint).
+            frequency: 0.0,
         })
     }
     fn set_control(&mut self, control: Control) {

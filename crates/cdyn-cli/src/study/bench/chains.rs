@@ -8,7 +8,8 @@ use cdyn::{Scheme, Settings, Simulation};
 use serde::Serialize;
 use std::time::Instant;
 
-/// One size of a chain at h = 1e-3: AB-3 with `cvsgf_energy`, or generalized-α.
+/// One size of a chain at h = 1e-3: an explicit scheme with `cvsgf_energy`,
+/// or RATTLE or generalized-α without control.
 #[derive(Debug, Serialize)]
 pub struct ChainRun {
     /// Bodies.
@@ -81,8 +82,8 @@ pub(super) fn spatial_baseline(n: usize, steps: u64, trials: usize) -> Result<Sp
     })
 }
 
-/// A chain's run at h = 1e-3: AB-3 with [`chain_control`], or a scheme
-/// that steps the model (RATTLE, generalized-α) without control.
+/// A chain's run at h = 1e-3: an explicit scheme with [`chain_control`],
+/// or a scheme that steps the model (RATTLE, generalized-α) without control.
 pub(super) fn timed_chain(
     n: usize,
     model: &cdyn::Model,

@@ -26,9 +26,15 @@ pub struct FlyballRun {
 }
 
 /// The schemes and steps timed: RK-4 at the step of the IFToMM files and
-/// at about its largest stable one, generalized-α at 1 kHz.
-const RUNS: [(Scheme, f64); 3] =
-    [(Scheme::RungeKutta4, 5e-5), (Scheme::RungeKutta4, 2.5e-4), (Scheme::GeneralizedAlpha, 1e-3)];
+/// at about its largest stable one, ABM-4 and RATTLE at about theirs,
+/// generalized-α at 1 kHz.
+const RUNS: [(Scheme, f64); 5] = [
+    (Scheme::RungeKutta4, 5e-5),
+    (Scheme::RungeKutta4, 2.5e-4),
+    (Scheme::AdamsBashforthMoulton4, 1e-4),
+    (Scheme::Rattle, 1e-4),
+    (Scheme::GeneralizedAlpha, 1e-3),
+];
 
 /// Each of [`RUNS`] over 1 s (`light`: 0.05 s), best of three trials.
 pub(super) fn flyball_runs(light: bool) -> Result<Vec<FlyballRun>> {

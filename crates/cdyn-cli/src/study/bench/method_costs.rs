@@ -21,7 +21,7 @@ pub struct MethodCost {
     pub ratio_to_cvsgf_energy: f64,
     /// Newton iterations per step of the projection (`projection`), of
     /// RATTLE's position step (`rattle`), or generalized-α's corrections.
-    pub projection_iterations_per_step: Option<f64>,
+    pub iterations_per_step: Option<f64>,
     /// Largest `|Φ|` seen, sampled (outside the clock) every [`PHI_EVERY`] steps and at the end.
     pub max_abs_phi: f64,
     /// The most allocations per step of any run.
@@ -143,7 +143,7 @@ pub(super) fn compare_methods(
             method: METHODS[c],
             us_per_step: median(seconds[c].clone()) / total_steps * 1e6,
             ratio_to_cvsgf_energy: median(ratios[c].clone()),
-            projection_iterations_per_step: (controls[c].projection.is_some() || settings[c].scheme.steps_model())
+            iterations_per_step: (controls[c].projection.is_some() || settings[c].scheme.steps_model())
                 .then(|| iterations[c] as f64 / (total_steps * trials as f64)),
             max_abs_phi: worst[c],
             allocations_per_step: allocs[c] as f64 / steps as f64,

@@ -25,12 +25,14 @@
 //!   ratio the median of the ratios within a trial, so that a slow spell
 //!   of the machine, which hits the methods of one trial alike, cancels.
 //!   `rattle` and `generalized_alpha` (no control) beside them.
-//! - Generalized-α on the planar chain by N (h = 1e-3, no control) and
-//!   its cost exponent.
+//! - The planar chain by N (h = 1e-3) with the other schemes: ABM-4 with
+//!   the same control, RATTLE and generalized-α without; each one's cost
+//!   exponent.
 //! - The stiff flyball governor (IFToMM A05) over 1 s: RK-4 at h = 5e-5
 //!   (its step in the IFToMM files), RK-4 at 2.5e-4 (about its largest
-//!   stable step; 5e-4 stops), generalized-α at 1e-3: microseconds per
-//!   step and milliseconds per simulated second.
+//!   stable step; 4e-4 stops), ABM-4 and RATTLE at 1e-4 (theirs: 2e-4
+//!   stops ABM-4 and RATTLE is 1 m off there), generalized-α at 1e-3:
+//!   microseconds per step and milliseconds per simulated second.
 //! - Allocations per step, counted by the binary's global allocator.
 
 use crate::io::alloc_count::allocations;
@@ -57,9 +59,17 @@ use method_costs::method_comparisons;
 pub use method_costs::{METHODS, MethodComparison, MethodCost, PHI_EVERY};
 pub use table::table;
 
+/// The layout of `bench.json` this code writes. 2: `schema_version`
+/// itself, `abm4_chain` and `rattle_chain` with their cost exponents, ABM-4
+/// and RATTLE on the flyball, and the methods' `iterations_per_step` (was
+/// `projection_iterations_per_step`).
+pub const SCHEMA_VERSION: u32 = 2;
+
 /// What `bench.json` holds.
 #[derive(Debug, Serialize)]
 pub struct Report {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
     /// A `--light` run: few steps, figures that mean little.
     pub light: bool,
     /// Example 1 against hand-written code.
@@ -80,6 +90,14 @@ pub struct Report {
     pub generalized_alpha_chain: Vec<ChainRun>,
     /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
     pub generalized_alpha_chain_cost_exponent: Option<f64>,
+    /// ABM-4 with the chain's control on the planar chain, by N.
+    pub abm4_chain: Vec<ChainRun>,
+    /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
+    pub abm4_chain_cost_exponent: Option<f64>,
+    /// RATTLE on the planar chain, by N.
+    pub rattle_chain: Vec<ChainRun>,
+    /// Least-squares slope of log(cost) against log(N) over N ≥ 100.
+    pub rattle_chain_cost_exponent: Option<f64>,
     /// The flyball governor at each scheme and step.
     pub flyball: Vec<FlyballRun>,
     /// Over every run above, the methods' included.
@@ -138,10 +156,13 @@ pub fn run(light: bool) -> Result<Report> {
     let example1 = example1(light)?;
     let (sizes, t_end): (&[usize], f64) =
         if light { (&[10, 100, 1000], 0.05) } else { (&[10, 100, 1000, 10_000], 10.0) };
-    let chain = sizes.iter().map(|&n| chain_run(n, t_end, Scheme::AdamsBashforth3)).collect::<Result<Vec<_>>>()?;
-    // Generalized-α's step costs several of AB-3's: a tenth of the run.
-    let generalized_alpha_chain =
-        sizes.iter().map(|&n| chain_run(n, t_end / 10.0, Scheme::GeneralizedAlpha)).collect::<Result<Vec<_>>>()?;
+    let chains = |scheme, t_end| sizes.iter().map(|&n| chain_run(n, t_end, scheme)).collect::<Result<Vec<_>>>();
+    let chain = chains(Scheme::AdamsBashforth3, t_end)?;
+    // Generalized-α's step costs several of AB-3's: a tenth of the run;
+    // ABM-4's two evaluations and RATTLE's position step, half.
+    let generalized_alpha_chain = chains(Scheme::GeneralizedAlpha, t_end / 10.0)?;
+    let abm4_chain = chains(Scheme::AdamsBashforthMoulton4, t_end / 2.0)?;
+    let rattle_chain = chains(Scheme::Rattle, t_end / 2.0)?;
     let flyball = flyball_runs(light)?;
     // The spatial chain's step costs about 20 times the planar one's: its
     // light run stops at N = 100 (the full one takes minutes at N = 10 000).
@@ -163,11 +184,14 @@ pub fn run(light: bool) -> Result<Report> {
         .iter()
         .chain(&spatial_chain)
         .chain(&generalized_alpha_chain)
+        .chain(&abm4_chain)
+        .chain(&rattle_chain)
         .map(|c| c.allocations_per_step)
         .chain(flyball.iter().map(|f| f.allocations_per_step))
         .chain(methods.iter().flat_map(|m| m.methods.iter().map(|c| c.allocations_per_step)))
         .fold(example1.allocations_per_step, f64::max);
     Ok(Report {
+        schema_version: SCHEMA_VERSION,
         light,
         example1,
         chain_cost_exponent: fit(&chain),
@@ -178,6 +202,10 @@ pub fn run(light: bool) -> Result<Report> {
         methods,
         generalized_alpha_chain_cost_exponent: fit(&generalized_alpha_chain),
         generalized_alpha_chain,
+        abm4_chain_cost_exponent: fit(&abm4_chain),
+        abm4_chain,
+        rattle_chain_cost_exponent: fit(&rattle_chain),
+        rattle_chain,
         flyball,
         max_allocations_per_step,
     })

@@ -16,10 +16,21 @@ pub fn table(r: &Report) -> String {
     );
     out += &format!("  hand-written         {:>8.1} ns/step\n", e.handwritten_ns_per_step);
     for (title, runs, exponent) in [
-        ("N-link chain", &r.chain, r.chain_cost_exponent),
-        ("spatial chain (rods in Euler parameters, spherical joints)", &r.spatial_chain, r.spatial_chain_cost_exponent),
+        ("N-link chain, CVSGF + energy, AB-3", &r.chain, r.chain_cost_exponent),
+        (
+            "spatial chain (rods in Euler parameters, spherical joints), CVSGF + energy, AB-3",
+            &r.spatial_chain,
+            r.spatial_chain_cost_exponent,
+        ),
+        ("N-link chain, CVSGF + energy, ABM-4", &r.abm4_chain, r.abm4_chain_cost_exponent),
+        ("N-link chain, RATTLE, no control", &r.rattle_chain, r.rattle_chain_cost_exponent),
+        (
+            "N-link chain, generalized-α, no control",
+            &r.generalized_alpha_chain,
+            r.generalized_alpha_chain_cost_exponent,
+        ),
     ] {
-        out += &format!("{title}, CVSGF + energy, AB-3, h = 1e-3:\n");
+        out += &format!("{title}, h = 1e-3:\n");
         out += &format!("  {:>6} {:>8} {:>12} {:>12} {:>8}\n", "N", "steps", "µs/step", "max|Φ|", "solver");
         for c in runs {
             out += &format!(
@@ -56,7 +67,7 @@ pub fn table(r: &Report) -> String {
     );
     for m in &r.methods {
         for c in &m.methods {
-            let iterations = c.projection_iterations_per_step.map_or("-".into(), |i| format!("{i:.3}"));
+            let iterations = c.iterations_per_step.map_or("-".into(), |i| format!("{i:.3}"));
             out += &format!(
                 "  {:>8} {:>6} {:>7} {:>8} {:>13} {:>12.3} {:>6.2}× {:>10} {:>10.2e}\n",
                 m.model,

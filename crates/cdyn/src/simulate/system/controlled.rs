@@ -35,6 +35,8 @@ pub struct ControlledSystem<'m> {
     /// Most rows dropped as dependent by an evaluation since the last
     /// [`System::take_dependent_rows`].
     dependent: usize,
+    /// What a dependent row does (as the dynamics are set to).
+    dependent_rows: DependentRows,
     /// The momenta the model keeps ([`crate::dynamics::momentum::detect`]).
     symmetries: Symmetries,
     /// Those the corrections keep (none with [`Invariants::Free`](crate::control::Invariants::Free)).
@@ -71,6 +73,7 @@ impl<'m> ControlledSystem<'m> {
             projection: crate::dynamics::manifold::Work::new(model),
             evaluations: 0,
             dependent: 0,
+            dependent_rows: DependentRows::Error,
             symmetries: Symmetries::default(),
             momenta: Momenta::NONE,
             held: Held::default(),
@@ -100,6 +103,7 @@ impl<'m> ControlledSystem<'m> {
     /// Sets what a dependent constraint row does (default: an error).
     pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
         self.dynamics.set_dependent_rows(dependent);
+        self.dependent_rows = dependent;
     }
 
     /// The model it evaluates.
@@ -210,10 +214,26 @@ impl System for ControlledSystem<'_> {
             out.fill(0.0);
             model.add_damping(q, v, w, t, out);
         };
+        // K of generalized-α's Newton matrix: the potentials' and forces'
+        // stiffness, and the constraints' curvatures weighted by λ.
+        let mut entries = Vec::new();
+        model.iteration_entries(&mut entries);
+        let forces = entries.len();
+        model.curvature_entries(&mut entries);
+        let mut values = vec![0.0; entries.len()];
+        model.iteration_values(q, v, t, 1.0, 0.0, &mut values[..forces]);
+        model.curvature_values(q, t, self.dynamics.lambda(), 1.0, &mut values[forces..]);
+        let stiffness = |w: &[f64], out: &mut [f64]| {
+            out.fill(0.0);
+            for (&(r, c), k) in entries.iter().zip(&values) {
+                out[r as usize] += k * w[c as usize];
+            }
+        };
         Ok(Operators {
             coupling: crate::control::gains::coupling(&d, n),
             max_row_norm2: rows.fold(0.0, f64::max),
             dissipation: crate::control::gains::dissipation_rate(&d, n, damping),
+            frequency: crate::control::gains::oscillation_frequency(&d, n, stiffness),
         })
     }
     fn set_control(&mut self, control: Control) {
@@ -239,7 +259,13 @@ impl System for ControlledSystem<'_> {
         true
     }
     fn prepare_generalized_alpha(&mut self, settings: GeneralizedAlpha, q0: &[f64], v0: &[f64], h: f64) {
-        let mut work = generalized_alpha::Work::new(self.model, &self.dynamics, settings);
+        let mut work = generalized_alpha::Work::new(
+            self.model,
+            &self.dynamics,
+            settings,
+            self.dependent_rows,
+            self.control.projection.is_some(),
+        );
         // A state the dynamics cannot evaluate leaves it unstarted: the first step says why.
         let _ = work.start(self.model, &mut self.dynamics, q0, v0, 0.0, h, &mut self.evaluations);
         self.alpha = Some(work);
@@ -253,7 +279,7 @@ impl System for ControlledSystem<'_> {
         self.dependent = self.dependent.max(self.dynamics.dependent_rows());
         taken.map_err(|f| match f {
             generalized_alpha::Failure::Breakdown(b, t) => AlphaFailure::Eval(EvalError::at(b, t)),
-            generalized_alpha::Failure::Singular => AlphaFailure::Singular,
+            generalized_alpha::Failure::Singular { iterations } => AlphaFailure::Singular { iterations },
             generalized_alpha::Failure::NotConverged { correction, iterations } => {
                 AlphaFailure::NotConverged { correction, iterations }
             }

@@ -150,8 +150,12 @@ pub enum RattleFailure {
 pub enum AlphaFailure {
     /// The dynamics could not be evaluated at an iterate.
     Eval(EvalError),
-    /// The Newton matrix is singular (or its solution not finite).
-    Singular,
+    /// The Newton matrix is singular (or its solution not finite) though
+    /// the constraint rows are independent (or the dependent ones dropped).
+    Singular {
+        /// Corrections taken before.
+        iterations: u32,
+    },
     /// Newton did not converge within its allowed corrections.
     NotConverged {
         /// `|Δq|∞` of the correction that would come next.
