@@ -359,7 +359,8 @@ def sweep(source: ScenarioLike, *, threads: Optional[int] = None) -> Sweep:
 def suite(scenarios: Sequence[Union[str, "os.PathLike[str]"]] = (), *, light: bool = False) -> Suite:
     """Judges every method of ``cdyn compare`` on the shipped models (a few,
     shorter, with ``light``) and the scenario files ``scenarios``, at AB-3,
-    RK-4 and ABM-4, h and h/2, against a fine reference, as ``cdyn suite``
+    RK-4 and ABM-4 (RATTLE and generalized-α with no control and with
+    projection), h and h/2, against a fine reference, as ``cdyn suite``
     does; the result's ``summary`` equals the CLI's ``suite.json``."""
     return Suite(*_cdyn.run_suite([os.fspath(p) for p in scenarios], light))
 
