@@ -34,6 +34,8 @@
 //!   stops ABM-4 and RATTLE is 1 m off there), generalized-α at 1e-3:
 //!   microseconds per step and milliseconds per simulated second.
 //! - Allocations per step, counted by the binary's global allocator.
+//!
+//! May import: `io`, `case`, and the rest of `study`.
 
 use crate::io::alloc_count::allocations;
 use anyhow::Result;

@@ -12,6 +12,8 @@
 //! stops with an error counts as infinitely wrong. The violations are the
 //! largest over every step after `t = 0`; those at `t = 0` (the assembly's)
 //! are kept apart.
+//!
+//! May import: `io`, `case`, and the rest of `study`.
 
 use crate::case::runner::Case;
 use crate::case::scenario::{self, Scenario};

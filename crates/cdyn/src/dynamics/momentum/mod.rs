@@ -22,6 +22,8 @@
 //! with their gain set on what is left (`|P_E v|²_M = 2T − pᵀ(EᵀME)⁻¹p`,
 //! the kinetic energy of the motion relative to the momenta), so that `Ψ`
 //! still decays at its rate (docs: "Corrections that keep the momenta").
+//!
+//! May import: `linalg`, `model`, and the rest of `dynamics`.
 
 use crate::model::Model;
 use crate::model::angular::Generator;
