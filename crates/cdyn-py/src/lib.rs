@@ -329,12 +329,7 @@ fn run_precision(
         .map(cdyn::Scheme::try_from)
         .collect::<Result<Vec<_>, _>>()
         .map_err(ScenarioError::new_err)?;
-    // As `cdyn precision --methods` reads its list.
-    let methods = match &methods[..] {
-        [] => Methods::Default,
-        [all] if all == "all" => Methods::All,
-        named => Methods::Named(named.to_vec()),
-    };
+    let methods = Methods::from_names(&methods);
     let options = Options { schemes, methods, steps: h, t_end, light };
     let result = py.detach(|| precision::run(&scenario, &options)).map_err(scenario_error)?;
     let json = serde_json::to_string_pretty(&result).map_err(|e| Error::new_err(e.to_string()))? + "\n";

@@ -45,11 +45,7 @@ pub fn precision(args: PrecisionArgs) -> Result<()> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let methods = match &args.methods[..] {
-        [] => Methods::Default,
-        [all] if all == "all" => Methods::All,
-        named => Methods::Named(named.to_vec()),
-    };
+    let methods = Methods::from_names(&args.methods);
     let options = Options { schemes, methods, steps: args.h, t_end: args.t_end, light: args.light };
     output_dir(&args.out)?;
     let result = precision::run(&args.scenario, &options)?;
