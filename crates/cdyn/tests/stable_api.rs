@@ -14,11 +14,9 @@ const CLOSED: &[&str] = &[
     "FourBarBranch", // the two assemblies of a four-bar
 ];
 
-/// Not yet `#[non_exhaustive]` (file, name): their files are being
-/// reworked elsewhere; remove each once it is marked. `Operators` and
-/// `Tuning` are what the automatic gains are chosen from and report.
-const PENDING: &[(&str, &str)] =
-    &[("dynamics/momentum/mod.rs", "Kind"), ("control/gains.rs", "Operators"), ("control/gains.rs", "Tuning")];
+/// Not yet `#[non_exhaustive]` (file, name): none now; a type listed here
+/// makes the test say so until it is marked.
+const PENDING: &[(&str, &str)] = &[];
 
 fn pending(item: &Item) -> bool {
     PENDING.iter().any(|(file, name)| item.file.ends_with(file) && item.name == *name)

@@ -54,6 +54,7 @@ pub const STIFF_DISSIPATION_H: f64 = 0.01;
 
 /// What the automatic gains are chosen from, at the initial state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Operators {
     /// `μ_max` of the paper's CVSGF operator (`coupling` in this module).
     pub coupling: f64,
@@ -70,6 +71,7 @@ pub struct Operators {
 /// What the automatic gains were chosen from, and the resulting rate × h.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub struct Tuning {
     /// Largest mode `μ_max` of the paper's CVSGF operator at the initial
     /// state (1 for uncoupled constraints; 0 without constraints).

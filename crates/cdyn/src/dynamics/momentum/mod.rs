@@ -83,6 +83,7 @@ pub struct Momentum {
 
 /// What a momentum is.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Kind {
     /// `eᵀ M v` along a constant direction `e`.
     Constant,
