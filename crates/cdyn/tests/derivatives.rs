@@ -110,3 +110,45 @@ fn accelerations_satisfy_the_constraint_equations() {
         assert!(residual.abs() < 1e-12, "coordinate {i}: residual {residual}");
     }
 }
+
+#[test]
+fn potential_rate_is_read_off_the_right_hand_side_only_where_it_is_exact() {
+    // Φ_q M⁻¹∇V from the evaluation's own right-hand side equals the product
+    // formed directly, to round-off of γ's scale; it is not kept unless asked,
+    // nor where a non-conservative force makes G differ from −∇V.
+    let model = model();
+    let (q, v, t) = ([0.3, -0.4, 0.8, 0.2], [0.5, 1.0, -0.7, 0.3], 0.9);
+    let mut d = Dynamics::new(&model);
+    d.evaluate(&model, &q, &v, t).unwrap();
+    assert!(d.potential_rate().is_none(), "kept without being asked");
+    d.keep_potential_rate(&model, true);
+    d.evaluate(&model, &q, &v, t).unwrap();
+    let mut w = vec![0.0; model.n()];
+    d.mass(&model).solve(d.grad_potential(), &mut w);
+    let mut direct = vec![0.0; model.m()];
+    d.jac_mul(&model, &w, &mut direct);
+    let kept = d.potential_rate().expect("kept where asked, G = −∇V");
+    let scale = d.gamma().iter().chain(&direct).fold(0.0f64, |s, x| s.max(x.abs()));
+    for r in 0..model.m() {
+        assert!((kept[r] - direct[r]).abs() <= 8.0 * f64::EPSILON * scale, "row {r}: {} vs {}", kept[r], direct[r]);
+    }
+    let damped = Model::builder(vec![1.0, 2.0, 3.0, 0.5])
+        .constrain(Twisted, [2, 0, 3])
+        .potential(Coupled, [1, 3])
+        .force(Drag, [1])
+        .build()
+        .unwrap();
+    let mut d = Dynamics::new(&damped);
+    d.keep_potential_rate(&damped, true);
+    d.evaluate(&damped, &q, &v, t).unwrap();
+    assert!(d.potential_rate().is_none(), "kept although G ≠ −∇V");
+}
+
+/// A linear drag: a non-conservative force.
+struct Drag;
+
+impl cdyn::Force<1> for Drag {
+    fn force<D: Scalar>(&self, _: [D; 1], [v]: [D; 1], _: D) -> [D; 1] {
+        [-v * 0.5]
+    }
+}

@@ -58,6 +58,12 @@ pub(crate) trait Evaluation {
         &NO_MOMENTA
     }
 
+    /// `out = Φ_q w` for `w = M⁻¹Ψ_q`, from the evaluation itself where it
+    /// has it.
+    fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
+        self.jac_mul(w, out);
+    }
+
     /// `out = Φ_q x`.
     fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
         for (r, o) in out.iter_mut().enumerate() {

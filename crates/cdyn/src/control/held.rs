@@ -255,7 +255,7 @@ impl Held {
             let (phi_dot, phi_t) = (d.phi_dot(), d.phi_t());
             y_v.iter_mut().zip(phi_dot).zip(phi_t).for_each(|((y, pd), pt)| *y = pd - pt);
             mass.solve(grad, w);
-            d.jac_mul(w, y_w);
+            d.potential_rate(w, y_w);
             d.solve_many(&mut [&mut *y_v, &mut *y_w]);
             self.energy_v.copy_from_slice(v);
             self.energy_q.copy_from_slice(w);

@@ -61,7 +61,7 @@ impl Control {
         let positions = c > 0.0;
         if positions || (energy && alpha_g.is_some()) {
             mass.solve(d.grad_potential(), w);
-            d.jac_mul(w, phi_q_w);
+            d.potential_rate(w, phi_q_w);
         }
         if positions {
             y_w.copy_from_slice(phi_q_w);

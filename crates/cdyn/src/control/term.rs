@@ -118,6 +118,12 @@ impl Control {
         }
     }
 
+    /// Whether its terms read `Φ_q M⁻¹∇V` (the projected energy law's
+    /// position part), which the dynamics then keeps from its right-hand side.
+    pub(crate) fn reads_potential_rate(&self) -> bool {
+        matches!(self.energy, Energy::Projected { .. })
+    }
+
     /// Whether any control term can be non-zero.
     pub fn is_active(&self) -> bool {
         self.geometric != Geometric::None || self.velocity != Velocity::None || self.energy != Energy::None

@@ -1,5 +1,6 @@
 //! What the system does, uncontrolled, at one state: `Φ`, `Φ_q`, `γ`, the
-//! multipliers `λ` and the accelerations `A` ([`Dynamics`]), the energy
+//! multipliers `λ` and the accelerations `A` ([`Dynamics`]) with the
+//! products and solves that reuse them, the energy
 //! constraint `Ψ` ([`energy`]), the violations a sample reports
 //! ([`diagnostics`]), the momenta it keeps ([`momentum`]), and the Newton
 //! projections onto the constraint manifold shared by assembly
@@ -12,6 +13,7 @@ pub mod diagnostics;
 pub mod energy;
 pub(crate) mod manifold;
 pub mod momentum;
+mod products;
 mod solver;
 mod uncontrolled;
 

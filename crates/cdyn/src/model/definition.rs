@@ -7,7 +7,7 @@ use crate::linalg::mass::{BlockMass, DenseMass, DiagonalMass, MassMatrix};
 use crate::model::angular::Generator;
 use crate::model::constraint::{ConstraintBlock, ConstraintValues};
 use crate::model::force::{ForceBlock, PotentialBlock};
-use crate::model::invariant::{Declared, Invariant};
+use crate::model::invariant::Declared;
 use crate::model::kinetic::KineticBlock;
 use crate::model::unit_vector::UnitVector;
 
@@ -108,49 +108,10 @@ pub(crate) fn check_rows(m: usize, n: usize) -> Result<()> {
 }
 
 impl Model {
-    /// Declares, on a built model, that it keeps the momentum along
-    /// `direction` (as [`ModelBuilder::momentum`](crate::model::ModelBuilder::momentum)).
-    pub fn declare_momentum(&mut self, name: &str, direction: &[(usize, f64)]) -> Result<()> {
-        self.momenta.push(checked_direction(name, direction, true, self.n())?);
-        Ok(())
-    }
-
-    /// Declares, on a built model, that it keeps the momentum of the
-    /// rotation `generator` (as [`ModelBuilder::angular_momentum`](crate::model::ModelBuilder::angular_momentum)).
-    pub fn declare_angular_momentum(&mut self, generator: Generator) -> Result<()> {
-        generator
-            .check(self.n())
-            .map_err(|reason| Problem::Rotation(reason).at(Part::Block { what: "an angular momentum" }))?;
-        self.rotations.push(Generator { declared: true, ..generator });
-        Ok(())
-    }
-
     /// The rotations declared or proposed by a mechanism builder, whose
     /// angular momenta a run checks ([`crate::dynamics::momentum::detect`]).
     pub fn rotations(&self) -> &[Generator] {
         &self.rotations
-    }
-
-    /// Declares, on a built model, that it keeps `I(q, v)` of the
-    /// coordinates `at` (as [`ModelBuilder::invariant`](crate::model::ModelBuilder::invariant)).
-    pub fn declare_invariant<I: Invariant<K>, const K: usize>(
-        &mut self,
-        name: &str,
-        invariant: I,
-        at: [usize; K],
-    ) -> Result<()> {
-        let n = self.n();
-        for (j, &index) in at.iter().enumerate() {
-            let what = Part::Block { what: "an invariant" };
-            if index >= n {
-                return Err(Problem::NoSuchCoordinate { index, n }.at(what));
-            }
-            if at[..j].contains(&index) {
-                return Err(Problem::CoordinateTwice { index }.at(what));
-            }
-        }
-        self.invariants.push(Declared::new(name, invariant, at));
-        Ok(())
     }
 
     /// The invariants declared with [`ModelBuilder::invariant`](crate::model::ModelBuilder::invariant).
@@ -323,6 +284,11 @@ impl Model {
             Some(g) => self.potentials.iter().map(|p| p.energy_and_gradient(q, g)).sum(),
             None => self.potentials.iter().map(|p| p.energy(q)).sum(),
         }
+    }
+
+    /// Whether the model has non-conservative forces (the applied force is `−∇V` without them).
+    pub fn has_forces(&self) -> bool {
+        !self.forces.is_empty()
     }
 
     /// Adds the non-conservative forces into `f`; returns their power.

@@ -9,6 +9,7 @@
 pub mod angular;
 mod builder;
 pub mod constraint;
+mod declare;
 mod definition;
 pub mod force;
 pub mod invariant;

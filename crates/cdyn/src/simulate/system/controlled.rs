@@ -62,6 +62,7 @@ impl<'m> ControlledSystem<'m> {
     pub fn with_solver(model: &'m Model, control: Control, e0: f64, solver: LinearSolver) -> Self {
         let mut dynamics = Dynamics::with_solver(model, solver);
         dynamics.reuse_factorization(control.projection.is_some());
+        dynamics.keep_potential_rate(model, control.reads_potential_rate());
         Self {
             model,
             control,
@@ -238,6 +239,7 @@ impl System for ControlledSystem<'_> {
     }
     fn set_control(&mut self, control: Control) {
         self.dynamics.reuse_factorization(control.projection.is_some());
+        self.dynamics.keep_potential_rate(self.model, control.reads_potential_rate());
         self.control = control;
     }
     fn symmetries(&self) -> &Symmetries {
@@ -353,6 +355,12 @@ impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
     }
     fn add_weighted_jt_pair(&self, y: [&[f64]; 2], out: [&mut [f64]; 2]) {
         self.dynamics.add_weighted_jt_pair(self.model, y, out);
+    }
+    fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
+        match self.dynamics.potential_rate() {
+            Some(rate) => out.copy_from_slice(rate),
+            None => self.dynamics.jac_mul(self.model, w, out),
+        }
     }
     fn unit_vectors(&self) -> &[crate::model::unit_vector::UnitVector] {
         self.model.unit_vectors()
