@@ -80,7 +80,7 @@ fn a_spatial_runs_page_and_gif_animate_it_in_3d() {
     let corner = |f: &serde_json::Value| -> Vec<f64> {
         f["corners"][0].as_array().unwrap().iter().map(|x| x.as_f64().unwrap().abs()).collect()
     };
-    let mut half: Vec<f64> = faces.iter().flat_map(|f| corner(f)).collect();
+    let mut half: Vec<f64> = faces.iter().flat_map(corner).collect();
     half.sort_by(f64::total_cmp);
     let (thin, wide) = (half[0], half[half.len() - 1]);
     assert!((wide - 0.5 * 0.1875f64.sqrt()).abs() < 1e-12 && (thin - 0.005 * radius).abs() < 1e-12, "{half:?}");
