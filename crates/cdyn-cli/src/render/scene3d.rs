@@ -247,7 +247,7 @@ impl Camera {
     pub fn project(&self, p: [f64; 3]) -> ([f64; 2], f64) {
         let d: [f64; 3] = std::array::from_fn(|i| p[i] - self.eye[i]);
         let dot = |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
-        let depth = -dot(self.back).max(-1e300);
+        let depth = -dot(self.back);
         let z = depth.max(1e-9);
         ([self.middle[0] + self.focal * dot(self.right) / z, self.middle[1] - self.focal * dot(self.up) / z], depth)
     }
