@@ -8,7 +8,8 @@
 # 3-D) gets the same checks, and orbiting it changes the view and playing it
 # advances the frame. Installs Debian's chromium when missing; skips (exit 0,
 # one line) where that cannot work: not root, no apt-get or no package registry.
-# `.ci/browser-test.sh --screenshot docs/viewer.png` also remakes the picture of the README.
+# `.ci/browser-test.sh --screenshot docs/viewer.png` also remakes the picture of the README,
+# `--screenshot-3d docs/viewer3d.png` the book's picture of a spatial run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks a `report.html` written by `cdyn run --html` in headless Chromium.
 
-Usage: check_viewer.py REPORT_HTML [--also REPORT_HTML[#fragment]]... [--spatial REPORT_HTML]... [--screenshot OUT_PNG]
+Usage: check_viewer.py REPORT_HTML [--also REPORT_HTML[#fragment]]... [--spatial REPORT_HTML]...
+                       [--screenshot OUT_PNG] [--screenshot-3d OUT_PNG]
 
 REPORT_HTML is a planar mechanism's page; pages given with --also (a
 compare's, a model without a drawing) get the first two checks below;
@@ -195,6 +196,7 @@ def main():
     screenshot_out = args[args.index("--screenshot") + 1] if "--screenshot" in args else None
     also = [args[i + 1] for i, a in enumerate(args) if a == "--also"]
     spatial = [args[i + 1] for i, a in enumerate(args) if a == "--spatial"]
+    screenshot_3d = args[args.index("--screenshot-3d") + 1] if "--screenshot-3d" in args else None
 
     with tempfile.TemporaryDirectory() as tmp:
         # The checks can fail: a page that logs an error and fetches an image is caught.
@@ -231,6 +233,10 @@ def main():
             url = "file://" + os.path.abspath(report) + "#pos=0.3&trace"
             chromium(url, "--screenshot=" + os.path.abspath(screenshot_out), "--window-size=1000,1000")
             check(os.path.isfile(screenshot_out), "wrote " + screenshot_out)
+        if screenshot_3d and spatial:
+            url = "file://" + os.path.abspath(spatial[0]) + "#pos=0.3&yaw=-70&pitch=25&zoom=1.6"
+            chromium(url, "--screenshot=" + os.path.abspath(screenshot_3d), "--window-size=1000,760")
+            check(os.path.isfile(screenshot_3d), "wrote " + screenshot_3d)
 
     if failures:
         sys.exit(f"{len(failures)} check(s) failed")
