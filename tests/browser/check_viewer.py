@@ -1,10 +1,14 @@
 #!/usr/bin/env python3
 """Checks a `report.html` written by `cdyn run --html` in headless Chromium.
 
-Usage: check_viewer.py REPORT_HTML [--also REPORT_HTML[#fragment]]... [--screenshot OUT_PNG]
+Usage: check_viewer.py REPORT_HTML [--also REPORT_HTML[#fragment]]... [--spatial REPORT_HTML]...
+                       [--screenshot OUT_PNG] [--screenshot-3d OUT_PNG]
 
 REPORT_HTML is a planar mechanism's page; pages given with --also (a
-compare's, a model without a drawing) get the first two checks below.
+compare's, a model without a drawing) get the first two checks below;
+spatial runs' pages (--spatial) get all of them, and besides: orbiting
+(`#yaw=60&pitch=20&zoom=1.5`) changes the view and the scene's pixels at
+the same instant, and playing (no `#pos`) advances the animation's frame.
 
 Standard library only; Chromium is driven from its command line:
   * the page at two slider positions (`#pos=0`, `#pos=0.5`), each loaded
@@ -22,6 +26,7 @@ Standard library only; Chromium is driven from its command line:
 """
 
 import json
+import math
 import os
 import re
 import shutil
@@ -143,9 +148,44 @@ def near(rgb, hex_colour, tol=40):
 def load(report, pos, tmp):
     url = "file://" + os.path.abspath(report) + f"#pos={pos}"
     dom, err, log = chromium(url, "--dump-dom")
-    shot = os.path.join(tmp, f"pos{pos}.png")
+    shot = os.path.join(tmp, f"shot{len(os.listdir(tmp))}.png")
     _, err2, log2 = chromium(url, "--screenshot=" + shot)
     return body_attributes(dom), console_lines(err) + console_lines(err2), page_requests(log) + page_requests(log2), shot
+
+
+def scene_changes(attrs, shot0, shot1):
+    """How many pixels of the scene (where `attrs` says it is) differ between two screenshots."""
+    w, h, px0 = read_png(shot0)
+    _, _, px1 = read_png(shot1)
+    scene = json.loads(attrs.get("data-scene", "{}"))
+    x0, y0 = int(scene.get("x", 0)), int(scene.get("y", 0))
+    x1, y1 = min(w, x0 + int(scene.get("width", 0))), min(h, y0 + int(scene.get("height", 0)))
+    return sum(px0[y][x] != px1[y][x] for y in range(y0, y1) for x in range(x0, x1))
+
+
+def animation(report, tmp, what=""):
+    """The checks of a page with an animation, at two slider positions; returns the loads."""
+    loads = {pos: load(report, pos, tmp) for pos in (0, 0.5)}
+    for pos, (attrs, console, requests, _) in loads.items():
+        check(attrs.get("data-ready") == "1", f"{what}pos={pos}: the page ran to its end")
+        check("data-errors" not in attrs, f"{what}pos={pos}: no script error {attrs.get('data-errors', '')}")
+        check(not console, f"{what}pos={pos}: no console message {console}")
+        check(not requests, f"{what}pos={pos}: no network request {requests}")
+    (a0, _, _, shot0), (a1, _, _, shot1) = loads[0], loads[0.5]
+    bodies0, bodies1 = json.loads(a0.get("data-bodies", "[]")), json.loads(a1.get("data-bodies", "[]"))
+    check(len(bodies0) > 0 and len(bodies0) == len(bodies1), f"{what}{len(bodies0)} bodies drawn")
+    moved = max((abs(p["x"] - q["x"]) + abs(p["y"] - q["y"]) for p, q in zip(bodies0, bodies1)), default=0)
+    check(moved > 5, f"{what}a body centre moved {moved:.1f} px between pos=0 and pos=0.5")
+    changed = scene_changes(a0, shot0, shot1)
+    check(changed > 500, f"{what}{changed} pixels of the scene differ between pos=0 and pos=0.5")
+    w, h, px0 = read_png(shot0)
+    for b in bodies0:
+        cx, cy = round(b["x"]), round(b["y"])
+        hits = sum(
+            near(px0[y][x], b["colour"]) for y in range(cy - 3, cy + 4) for x in range(cx - 3, cx + 4) if 0 <= x < w and 0 <= y < h
+        )
+        check(hits >= 20, f"{what}t = 0: body {b['name']} drawn in {b['colour']} at ({cx}, {cy}) ({hits} of 49 pixels)")
+    return loads
 
 
 def main():
@@ -155,6 +195,8 @@ def main():
     report = args[0]
     screenshot_out = args[args.index("--screenshot") + 1] if "--screenshot" in args else None
     also = [args[i + 1] for i, a in enumerate(args) if a == "--also"]
+    spatial = [args[i + 1] for i, a in enumerate(args) if a == "--spatial"]
+    screenshot_3d = args[args.index("--screenshot-3d") + 1] if "--screenshot-3d" in args else None
 
     with tempfile.TemporaryDirectory() as tmp:
         # The checks can fail: a page that logs an error and fetches an image is caught.
@@ -165,42 +207,36 @@ def main():
         check(len(console_lines(err)) >= 1, "probe: a console message is seen")
         check(any("127.0.0.1:9/probe.png" in u for u in page_requests(log)), "probe: a page's network request is seen")
 
-        loads = {pos: load(report, pos, tmp) for pos in (0, 0.5)}
-        for pos, (attrs, console, requests, _) in loads.items():
-            check(attrs.get("data-ready") == "1", f"pos={pos}: the page ran to its end")
-            check("data-errors" not in attrs, f"pos={pos}: no script error {attrs.get('data-errors', '')}")
-            check(not console, f"pos={pos}: no console message {console}")
-            check(not requests, f"pos={pos}: no network request {requests}")
+        loads = animation(report, tmp)
         for page in also:
             path, _, fragment = page.partition("#")
             dom, err, log = chromium("file://" + os.path.abspath(path) + "#" + fragment, "--dump-dom")
             attrs, console, requests = body_attributes(dom), console_lines(err), page_requests(log)
             check(attrs.get("data-ready") == "1" and "data-errors" not in attrs, f"{page}: the page ran to its end without error {attrs.get('data-errors', '')}")
             check(not console and not requests, f"{page}: no console message {console}, no network request {requests}")
-        (a0, _, _, shot0), (a1, _, _, shot1) = loads[0], loads[0.5]
-        bodies0, bodies1 = json.loads(a0.get("data-bodies", "[]")), json.loads(a1.get("data-bodies", "[]"))
-        check(len(bodies0) > 0 and len(bodies0) == len(bodies1), f"{len(bodies0)} bodies drawn")
-        moved = max((abs(p["x"] - q["x"]) + abs(p["y"] - q["y"]) for p, q in zip(bodies0, bodies1)), default=0)
-        check(moved > 5, f"a body centre moved {moved:.1f} px between pos=0 and pos=0.5")
-
-        w, h, px0 = read_png(shot0)
-        _, _, px1 = read_png(shot1)
-        scene = json.loads(a0.get("data-scene", "{}"))
-        x0, y0 = int(scene.get("x", 0)), int(scene.get("y", 0))
-        x1, y1 = min(w, x0 + int(scene.get("width", 0))), min(h, y0 + int(scene.get("height", 0)))
-        changed = sum(px0[y][x] != px1[y][x] for y in range(y0, y1) for x in range(x0, x1))
-        check(changed > 500, f"{changed} pixels of the scene differ between pos=0 and pos=0.5")
-        for b in bodies0:
-            cx, cy = round(b["x"]), round(b["y"])
-            hits = sum(
-                near(px0[y][x], b["colour"]) for y in range(cy - 3, cy + 4) for x in range(cx - 3, cx + 4) if 0 <= x < w and 0 <= y < h
-            )
-            check(hits >= 20, f"t = 0: body {b['name']} drawn in {b['colour']} at ({cx}, {cy}) ({hits} of 49 pixels)")
+        for page in spatial:
+            spatial_loads = animation(page, tmp, "3-D ")
+            # Orbiting changes the view: the same instant from elsewhere.
+            turned = load(page, "0.5&yaw=60&pitch=20&zoom=1.5", tmp)
+            (a0, _, _, shot0), (a1, console, requests, shot1) = spatial_loads[0.5], turned
+            check(not console and not requests and "data-errors" not in a1, f"3-D turned: no console message {console}, request {requests} or error")
+            view0, view1 = json.loads(a0.get("data-view", "{}")), json.loads(a1.get("data-view", "{}"))
+            check(abs(view1.get("yaw", 0) - math.radians(60)) < 1e-9 and view0.get("yaw") != view1.get("yaw"), f"3-D: the view turned from {view0} to {view1}")
+            changed = scene_changes(a0, shot0, shot1)
+            check(changed > 2000, f"3-D: {changed} pixels of the scene differ between two views of t = pos 0.5")
+            # Playing advances the frames (Chromium's virtual time runs the animation).
+            dom, _, _ = chromium("file://" + os.path.abspath(page), "--dump-dom")
+            frame = int(body_attributes(dom).get("data-frame", "0"))
+            check(frame > 0, f"3-D: playing, the animation reached frame {frame}")
 
         if screenshot_out:
             url = "file://" + os.path.abspath(report) + "#pos=0.3&trace"
             chromium(url, "--screenshot=" + os.path.abspath(screenshot_out), "--window-size=1000,1000")
             check(os.path.isfile(screenshot_out), "wrote " + screenshot_out)
+        if screenshot_3d and spatial:
+            url = "file://" + os.path.abspath(spatial[0]) + "#pos=0.3&yaw=-70&pitch=25&zoom=1.6"
+            chromium(url, "--screenshot=" + os.path.abspath(screenshot_3d), "--window-size=1000,760")
+            check(os.path.isfile(screenshot_3d), "wrote " + screenshot_3d)
 
     if failures:
         sys.exit(f"{len(failures)} check(s) failed")

@@ -51,17 +51,71 @@ fn the_heavy_top_example_ends_on_the_published_euler_parameters() {
     }
 }
 
+/// The page's inline data in `dir`.
+fn page_data(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let open = r#"<script id="data" type="application/json">"#;
+    let start = text.find(open).unwrap() + open.len();
+    serde_json::from_str(&text[start..start + text[start..].find("</script>").unwrap()]).unwrap()
+}
+
 #[test]
-fn a_spatial_runs_page_says_where_its_figure_is_and_gif_is_refused_saying_why() {
+fn a_spatial_runs_page_and_gif_animate_it_in_3d() {
+    // The heavy top: no URDF, so drawn as the box of its inertia — a thin
+    // square plate (Iy = Ix + Iz), 0.433 m wide and the smallest drawn thickness.
     let (dir, path) = scenario("top.toml", &example("heavy_top.toml"));
     let out = dir.join("out");
-    let html = cdyn(&["run", path_str(&path), "--out", path_str(&out), "--html"]);
-    assert!(html.status.success(), "{}", String::from_utf8_lossy(&html.stderr));
-    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
-    assert!(page.contains("\"spatial\":true") && page.contains("its figure is mechanism.png"));
-    let gif = cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("gif")), "--gif"]);
-    let line = one_error_line(&gif);
-    assert!(line.contains("--gif: the animation is for planar mechanisms"), "{line}");
+    let r = cdyn(&["run", path_str(&path), "--out", path_str(&out), "--html", "--gif"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let data = page_data(&out);
+    let sketch = &data["sketch"];
+    let top = &sketch["bodies"][0];
+    assert_eq!(
+        (top["name"].as_str(), top["shaped"].as_bool(), top["first"].as_u64()),
+        (Some("top"), Some(false), Some(0))
+    );
+    let faces = top["faces"].as_array().unwrap();
+    assert_eq!(faces.len(), 6);
+    let radius = sketch["radius"].as_f64().unwrap();
+    let corner = |f: &serde_json::Value| -> Vec<f64> {
+        f["corners"][0].as_array().unwrap().iter().map(|x| x.as_f64().unwrap().abs()).collect()
+    };
+    let mut half: Vec<f64> = faces.iter().flat_map(corner).collect();
+    half.sort_by(f64::total_cmp);
+    let (thin, wide) = (half[0], half[half.len() - 1]);
+    assert!((wide - 0.5 * 0.1875f64.sqrt()).abs() < 1e-12 && (thin - 0.005 * radius).abs() < 1e-12, "{half:?}");
+    // The top turns about its fixed point at the origin, 1 m away: the scene holds both.
+    assert!(radius > 0.5 && radius < 2.0, "{radius}");
+    let frames = data["cases"][0]["frames"]["q"].as_array().unwrap();
+    assert_eq!((frames.len(), frames[0].as_array().unwrap().len()), (21, 7));
+    assert!(!std::fs::read_to_string(out.join("report.html")).unwrap().contains("CDYN_3D"));
+    gif_moves(&out.join("animation.gif"), 21);
+
+    // The URDF arm: its links' own primitives, the massless tool's sphere on the hand.
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let out = dir.join("arm");
+    let r = cdyn(&["run", path_str(&examples.join("arm.urdf")), "--out", path_str(&out), "--html"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let data = page_data(&out);
+    let bodies = data["sketch"]["bodies"].as_array().unwrap();
+    let counts: Vec<(usize, usize, bool)> = bodies
+        .iter()
+        .map(|b| (b["faces"].as_array().unwrap().len(), b["spheres"].as_array().unwrap().len(), b["shaped"] == true))
+        .collect();
+    assert_eq!(counts, [(18, 0, true), (6, 0, true), (0, 1, true)], "cylinder, box, sphere");
+    assert_eq!(bodies[2]["spheres"][0]["radius"].as_f64(), Some(0.05));
+}
+
+/// The GIF at `path` has `n` frames of 480 × 360 pixels, and many pixels change between the first and the middle one.
+fn gif_moves(path: &Path, n: usize) {
+    use image::AnimationDecoder;
+    let file = std::fs::File::open(path).unwrap();
+    let frames = image::codecs::gif::GifDecoder::new(file).unwrap().into_frames().collect_frames().unwrap();
+    assert_eq!(frames.len(), n);
+    assert_eq!(frames[0].buffer().dimensions(), (480, 360));
+    let (first, middle) = (frames[0].buffer(), frames[n / 2].buffer());
+    let changed = first.pixels().zip(middle.pixels()).filter(|(a, b)| a != b).count();
+    assert!(changed > 500, "the mechanism did not move: {changed} pixels differ");
 }
 
 #[test]

@@ -229,6 +229,26 @@ fn the_urdf_arm_in_redundant_coordinates_follows_its_joint_space_dynamics() {
 }
 
 #[test]
+fn urdf_visuals_are_placed_in_the_axes_of_the_body_that_carries_them() {
+    use cdyn::spatial::Shape;
+    let arm = from_urdf(ARM, [0.0, 0.0, -G]).unwrap();
+    let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+    let [upper, fore, hand] = [0, 1, 2].map(|i| &arm.bodies[i].visuals[..]);
+    // The upper arm's cylinder is centred on its centre of mass, in its axes.
+    assert_eq!(upper.len(), 1);
+    assert_eq!(upper[0].shape, Shape::Cylinder { radius: 0.04, length: 0.3 });
+    assert!(close(&upper[0].position, &[0.0; 3]) && close(&upper[0].orientation, &[1.0, 0.0, 0.0, 0.0]));
+    // The forearm's box is at its centre of mass too, but its inertial axes
+    // are turned 0.2 rad about y from the link's: the box is turned back.
+    assert!(close(&fore[0].position, &[0.0; 3]), "{:?}", fore[0]);
+    assert!(close(&fore[0].orientation, &[(0.1f64).cos(), 0.0, -(0.1f64).sin(), 0.0]), "{:?}", fore[0]);
+    // The massless tool's sphere rides on the hand, 0.25 − 0.1 along its x.
+    assert_eq!(hand.len(), 1);
+    assert_eq!(hand[0].shape, Shape::Sphere { radius: 0.05 });
+    assert!(close(&hand[0].position, &[0.15, 0.0, 0.0]), "{:?}", hand[0]);
+}
+
+#[test]
 fn bad_urdf_files_are_refused_naming_the_element() {
     let cases = [
         ("<robot name=\"x\"><link name=\"a\"/>", "not a valid URDF"),
@@ -253,10 +273,7 @@ fn bad_urdf_files_are_refused_naming_the_element() {
             ),
             "body 2 (hand): inertia is not physical",
         ),
-        (
-            &*ARM.replace("<link name=\"tool\"/>", "<link name=\"tool\"/><link name=\"spare\"/>"),
-            "2 root links (base_link, spare)",
-        ),
+        (&*ARM.replace("</robot>", "<link name=\"spare\"/></robot>"), "2 root links (base_link, spare)"),
         (
             &*ARM.replace("<axis xyz=\"0 1 0\"/>", "<axis xyz=\"0 0 0\"/>"),
             "joint \"shoulder_pitch\": axis [0.0, 0.0, 0.0] has zero length",

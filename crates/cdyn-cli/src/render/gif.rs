@@ -1,8 +1,9 @@
 //! `animation.gif`: the mechanism's motion as an animated GIF, for slides
 //! and READMEs — the frames the viewer animates, at most [`MAX_FRAMES`] of
-//! them, drawn to scale as the page draws them (bodies as bars from the
-//! centre of mass to the points elements attach to, joints, springs,
-//! ground points), at about real time.
+//! them, at about real time ([`encode`]); a planar mechanism drawn to scale
+//! as the page draws it (bodies as bars from the centre of mass to the
+//! points elements attach to, joints, springs, ground points) here, a
+//! spatial one in [`crate::render::gif3d`].
 
 use crate::case::frames::Frames;
 use anyhow::{Context, Result, anyhow};
@@ -16,11 +17,11 @@ use std::path::Path;
 /// Most frames in a GIF.
 pub const MAX_FRAMES: usize = 200;
 /// Width and height in pixels.
-const SIZE: (u32, u32) = (480, 360);
+pub const SIZE: (u32, u32) = (480, 360);
 /// Shortest delay between frames: browsers show shorter ones slower.
 const MIN_DELAY_MS: f64 = 20.0;
 /// The viewer's body colours, in the same order.
-const COLOURS: [RGBColor; 10] = [
+pub const COLOURS: [RGBColor; 10] = [
     RGBColor(0x1f, 0x77, 0xb4),
     RGBColor(0xd6, 0x27, 0x28),
     RGBColor(0x2c, 0xa0, 0x2c),
@@ -35,11 +36,20 @@ const COLOURS: [RGBColor; 10] = [
 
 /// Writes the animation of `frames` of the mechanism `drawing` to `path`.
 pub fn write(path: &Path, drawing: &Drawing, frames: &Frames) -> Result<()> {
+    let view = View::fit(drawing, frames);
+    encode(path, frames, |area, q, t| draw_frame(area, drawing, &view, q, t).map_err(|e| anyhow!("{e:?}")))
+}
+
+/// The drawing of one frame: into this area, the positions and the time.
+pub type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+/// Writes to `path` the animation of [`MAX_FRAMES`] of `frames` at most,
+/// each drawn by `draw` into a [`SIZE`] image, at about real time.
+pub fn encode(path: &Path, frames: &Frames, mut draw: impl FnMut(Area, &[f64], f64) -> Result<()>) -> Result<()> {
     if frames.is_empty() {
         anyhow::bail!("no frames to animate for {}", path.display());
     }
     crate::render::plot::ensure_font()?;
-    let view = View::fit(drawing, frames);
     let picked = pick(frames.len(), MAX_FRAMES);
     let span = frames.t[frames.len() - 1] - frames.t[0];
     let delay_ms = (1000.0 * span / picked.len().max(1) as f64).max(MIN_DELAY_MS);
@@ -49,14 +59,8 @@ pub fn write(path: &Path, drawing: &Drawing, frames: &Frames) -> Result<()> {
         encoder.set_repeat(Repeat::Infinite).map_err(|e| anyhow!("cannot encode {}: {e}", path.display()))?;
         let mut pixels = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
         for &k in &picked {
-            draw_frame(
-                BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(),
-                drawing,
-                &view,
-                frames.q(k),
-                frames.t[k],
-            )
-            .with_context(|| format!("cannot draw {}", path.display()))?;
+            draw(BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area(), frames.q(k), frames.t[k])
+                .with_context(|| format!("cannot draw {}", path.display()))?;
             let rgba: Vec<u8> = pixels.chunks(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
             let image = RgbaImage::from_raw(SIZE.0, SIZE.1, rgba).ok_or_else(|| anyhow!("bad frame size"))?;
             let delay = Delay::from_numer_denom_ms(delay_ms.round() as u32, 1);

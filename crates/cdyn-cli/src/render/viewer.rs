@@ -1,10 +1,13 @@
 //! `report.html`: one self-contained page (script, style and data inline,
 //! nothing fetched) showing a run — the mechanism animated from its frames
-//! with play/pause, speed and a time slider, the Φ, Ψ and error plots with
+//! with play/pause, speed and a time slider (a spatial one in 3-D, with
+//! orbit and zoom: `viewer3d.js`), the Φ, Ψ and error plots with
 //! a cursor on the same time, the summary table and the method and gains.
 
+use crate::case::frames::Frames;
 use crate::case::runner::{Case, CaseResult};
 use crate::io::output;
+use crate::render::scene3d::Scene;
 use anyhow::{Context, Result};
 use serde_json::{Value, json};
 use std::path::Path;
@@ -21,16 +24,12 @@ pub struct ViewerArgs {
 }
 
 impl ViewerArgs {
-    /// Before anything runs: refuses `--gif` for a model without a drawing,
+    /// Before anything runs: refuses `--gif` for a model without a drawing
+    /// (planar) or sketch (spatial),
     /// and drops the drawings when neither option is given, so that no
     /// frames are kept for nothing.
     pub fn prepare(self, cases: &mut [Case]) -> Result<()> {
-        if self.gif && cases.iter().all(|c| c.example.drawing.is_none()) {
-            if cases.iter().any(|c| c.example.sketch.is_some()) {
-                anyhow::bail!(
-                    "--gif: the animation is for planar mechanisms; a spatial run's figure is mechanism.png/.svg (four instants)"
-                );
-            }
+        if self.gif && cases.iter().all(|c| c.example.drawing.is_none() && c.example.sketch.is_none()) {
             anyhow::bail!(
                 "--gif: this model has no drawing (models in independent angles have none; their Cartesian twins do)"
             );
@@ -49,18 +48,24 @@ impl ViewerArgs {
             write_html(dir, title, cases, results)?;
         }
         if self.gif {
-            let drawn = cases.iter().zip(results).find_map(|(c, r)| Some((c.example.drawing.as_ref()?, &r.frames)));
-            if let Some((drawing, frames)) = drawn.filter(|(_, f)| !f.is_empty()) {
-                crate::render::gif::write(&dir.join(GIF), drawing, frames)?;
+            let path = dir.join(GIF);
+            if let Some((case, r)) = cases.iter().zip(results).find(|(_, r)| !r.frames.is_empty()) {
+                if let Some(drawing) = &case.example.drawing {
+                    crate::render::gif::write(&path, drawing, &r.frames)?;
+                } else if let Some(sketch) = &case.example.sketch {
+                    crate::render::gif3d::write(&path, sketch, &r.frames)?;
+                }
             }
         }
         Ok(())
     }
 }
 
-/// The page; `/*CDYN_DATA*/null` is replaced by the data.
+/// The page; `/*CDYN_DATA*/null` is replaced by the data, `/*CDYN_3D*/` by the 3-D renderer.
 const TEMPLATE: &str = include_str!("viewer.html");
 const DATA_SLOT: &str = "/*CDYN_DATA*/null";
+const RENDERER_3D: &str = include_str!("viewer3d.js");
+const RENDERER_3D_SLOT: &str = "/*CDYN_3D*/";
 
 /// Most points per plotted line: about one per pixel of the page's plots.
 const PLOT_POINTS: usize = 1000;
@@ -86,17 +91,21 @@ pub fn write_html(dir: &Path, title: &str, cases: &[Case], results: &[CaseResult
 /// The page's text.
 pub fn page(title: &str, cases: &[Case], results: &[CaseResult], info: &Value) -> Result<String> {
     let drawing = cases.iter().find_map(|c| c.example.drawing.as_ref());
+    let sketch = cases.iter().find_map(|c| c.example.sketch.as_ref()).map(|sketch| {
+        let frames: Vec<&Frames> = results.iter().map(|r| &r.frames).collect();
+        Scene::of(sketch, &frames).json(sketch)
+    });
     let runs = cases.iter().zip(results).map(|(case, result)| run(case, result)).collect::<Result<Vec<_>>>()?;
     let data = json!({
         "title": title,
         "version": env!("CARGO_PKG_VERSION"),
         "drawing": drawing,
-        "spatial": cases.iter().any(|c| c.example.sketch.is_some()),
+        "sketch": sketch,
         "cases": runs,
         "info": info,
     });
-    debug_assert!(TEMPLATE.contains(DATA_SLOT));
-    Ok(TEMPLATE.replacen(DATA_SLOT, &inline_json(&data)?, 1))
+    debug_assert!(TEMPLATE.contains(DATA_SLOT) && TEMPLATE.contains(RENDERER_3D_SLOT));
+    Ok(TEMPLATE.replacen(RENDERER_3D_SLOT, RENDERER_3D, 1).replacen(DATA_SLOT, &inline_json(&data)?, 1))
 }
 
 /// `value` as JSON that can stand inside a `<script>` element: no `<` at

@@ -37,6 +37,10 @@ pub struct Body {
     /// Angular velocity, in body axes.
     #[cfg_attr(feature = "serde", serde(default))]
     pub angular_velocity: [f64; 3],
+    /// What it looks like in 3-D views (a URDF link's `<visual>` boxes,
+    /// cylinders and spheres); none: the box of its inertia. No dynamics.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub visuals: Vec<super::visual::Visual>,
 }
 
 crate::setters!(Body {
@@ -52,6 +56,8 @@ crate::setters!(Body {
     with_velocity => velocity: [f64; 3],
     /// With `angular_velocity`: angular velocity, in body axes.
     with_angular_velocity => angular_velocity: [f64; 3],
+    /// With `visuals`: what it looks like in 3-D views.
+    with_visuals => visuals: Vec<super::visual::Visual>,
 });
 
 #[cfg(feature = "serde")]
@@ -88,6 +94,7 @@ impl Body {
             orientation: [1.0, 0.0, 0.0, 0.0],
             velocity: [0.0; 3],
             angular_velocity: [0.0; 3],
+            visuals: Vec::new(),
         }
     }
 

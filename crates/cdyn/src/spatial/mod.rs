@@ -26,7 +26,8 @@
 //! forces, torques) are placed by points and axes in space at the initial
 //! pose, and carried into each body's frame there, so that a mechanism is
 //! always assembled where it is defined. `from_urdf` (feature `urdf`)
-//! reads a robot; [`Sketch`] is what figures draw.
+//! reads a robot; [`Sketch`] is what figures draw, bodies as their
+//! [`Visual`]s.
 //!
 //! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `planar`.
 
@@ -42,6 +43,7 @@ pub mod rotation;
 mod sketch;
 #[cfg(feature = "urdf")]
 mod urdf;
+mod visual;
 
 pub use body::{Body, Rotation, SpatialBody, coordinate_names};
 pub use chain::chain;
@@ -51,3 +53,4 @@ pub use mechanism::{Built, Mechanism};
 pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]
 pub use urdf::{UrdfRobot, from_urdf, read_urdf};
+pub use visual::{Shape, Visual};

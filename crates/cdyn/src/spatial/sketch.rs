@@ -1,11 +1,12 @@
 //! What a spatial mechanism looks like, for figures of a run: each body as
 //! the points of it that joints attach to (in its own axes, so drawn to
-//! scale), and each joint as the two points it connects. A frame is drawn
-//! from the coordinates `q` alone.
+//! scale) and its shapes, and each joint as the two points it connects. A
+//! frame is drawn from the coordinates `q` alone.
 
 use super::body::SpatialBody;
 use super::mechanism::Mechanism;
 use super::rotation::{rotate, unrotate};
+use super::visual::Visual;
 
 /// A point of a body (body axes, from its centre of mass) or of the ground (space).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +26,10 @@ pub struct Limb {
     pub at: SpatialBody,
     /// The points joints attach to, body axes, from the centre of mass.
     pub points: Vec<[f64; 3]>,
+    /// What it looks like: the body's visuals, or the box of its inertia.
+    pub shapes: Vec<Visual>,
+    /// Whether `shapes` are the body's own visuals (not its inertia's box).
+    pub shaped: bool,
 }
 
 /// A spatial mechanism as a figure draws it.
@@ -57,7 +62,13 @@ impl Mechanism {
             .bodies
             .iter()
             .enumerate()
-            .map(|(i, b)| Limb { name: b.name.clone(), at: SpatialBody::of(i), points: Vec::new() })
+            .map(|(i, b)| Limb {
+                name: b.name.clone(),
+                at: SpatialBody::of(i),
+                points: Vec::new(),
+                shapes: if b.visuals.is_empty() { vec![Visual::of_inertia(b)] } else { b.visuals.clone() },
+                shaped: !b.visuals.is_empty(),
+            })
             .collect();
         let mut anchor = |body: Option<usize>, point: [f64; 3]| match body.filter(|&b| b < self.bodies.len()) {
             None => Anchor { body: None, point },

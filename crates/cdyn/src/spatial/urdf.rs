@@ -8,7 +8,9 @@
 //! → none (a free body). A massless link is allowed only behind `fixed`
 //! joints (a frame: what hangs on it hangs on its nearest massive
 //! ancestor). A revolute joint's `<dynamics damping>` becomes a rotary
-//! damper.
+//! damper. A link's `<visual>` boxes, cylinders and spheres are what its
+//! body looks like in 3-D views (meshes are not read: a body without
+//! primitive visuals is drawn as the box of its inertia).
 //!
 //! Refused, with the element named: `planar` and `spherical` URDF joints,
 //! `<mimic>`, Coulomb `friction`, damping on a prismatic joint, a massless
@@ -23,6 +25,7 @@ use super::joint::{Joint, JointKind};
 use super::load::Load;
 use super::mechanism::Mechanism;
 use super::rotation::{about, compose, rotate};
+use super::visual::{Shape, Visual};
 use crate::error::{Error, Part, Problem, Result};
 use std::collections::HashMap;
 
@@ -189,5 +192,26 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
             load_names.push(j.name.clone());
         }
     }
+    for &l in &order[1..] {
+        if let (Some(b), Some(at)) = (carrier[l], pose[l]) {
+            let body = (bodies[b].position, bodies[b].orientation);
+            bodies[b].visuals.extend(visuals(&robot.links[l]).map(|(v, origin)| v.into_body(then(at, origin), body)));
+        }
+    }
     Ok(UrdfRobot { mechanism: Mechanism { bodies, joints, gravity, loads }, joint_names, load_names })
+}
+
+/// A link's `<visual>` boxes, cylinders and spheres (a capsule as the
+/// cylinder around it), each in its own `<origin>`; meshes are not read.
+fn visuals(link: &urdf_rs::Link) -> impl Iterator<Item = (Visual, &urdf_rs::Pose)> {
+    link.visual.iter().filter_map(|v| {
+        let shape = match v.geometry {
+            urdf_rs::Geometry::Box { size } => Shape::Box { size: size.0 },
+            urdf_rs::Geometry::Cylinder { radius, length } => Shape::Cylinder { radius, length },
+            urdf_rs::Geometry::Capsule { radius, length } => Shape::Cylinder { radius, length: length + 2.0 * radius },
+            urdf_rs::Geometry::Sphere { radius } => Shape::Sphere { radius },
+            urdf_rs::Geometry::Mesh { .. } => return None,
+        };
+        Some((Visual::new(shape, [0.0; 3], [1.0, 0.0, 0.0, 0.0]), &v.origin))
+    })
 }
