@@ -165,6 +165,15 @@ pub enum Error {
         /// Corrections taken before.
         iterations: u32,
     },
+    /// An input that does not exist, or a value it cannot take
+    /// ([`crate::model::input`]).
+    #[error("input {name:?}: {reason}")]
+    Input {
+        /// The input's name (`#3` for a position that has none).
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// Method keys that do not describe one method.
     #[error("{0}")]
     Method(#[from] KeyProblem),

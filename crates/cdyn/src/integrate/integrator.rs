@@ -62,6 +62,14 @@ impl<B: Buffer> Integrator<B> {
         }
     }
 
+    /// Forgets the past evaluations: the next steps are the start-up
+    /// scheme's until the history is filled again (after an input changed
+    /// the right-hand side, whose past values no longer describe it).
+    pub fn restart(&mut self) {
+        self.filled = 0;
+        self.evaluated = false;
+    }
+
     /// The scheme the next step uses: the start-up one until enough history exists.
     pub fn active_scheme(&self) -> Scheme {
         let info = self.scheme.info();

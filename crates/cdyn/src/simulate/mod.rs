@@ -8,6 +8,7 @@
 //! `control`.
 
 pub mod generalized_alpha;
+mod inputs;
 pub mod rattle;
 mod settings;
 mod stepper;

@@ -72,6 +72,17 @@ impl<'m> Simulation<'m> {
     pub fn model(&self) -> &'m Model {
         self.system.model()
     }
+
+    /// Changes an input by `set` between steps, keeping `Ψ` and restarting
+    /// the scheme (see [`Simulation::set_input`]).
+    pub(super) fn change_input(&mut self, set: impl FnOnce()) -> std::result::Result<(), Failure> {
+        let (t, n) = (self.t(), self.system.n());
+        let shift = self.system.change_input(self.x.as_mut_slice(), t, set)?;
+        self.x.as_mut_slice()[2 * n] += shift;
+        self.integrator.restart();
+        self.system.restart(self.x.as_slice(), t);
+        Ok(())
+    }
 }
 
 /// Checks an initial state has `n` finite positions and velocities.
