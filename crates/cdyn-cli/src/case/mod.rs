@@ -1,4 +1,5 @@
-//! One run: the scenario file and its typed keys ([`scenario`]), the case
+//! One run: the scenario file and its typed keys ([`scenario`]), its inputs
+//! and outputs ([`inputs`]), the case
 //! it builds and how a case is run, to files or in memory ([`runner`]),
 //! and the positions kept for the viewer's animation ([`frames`]).
 //!
@@ -6,6 +7,7 @@
 
 mod build;
 pub mod frames;
+pub mod inputs;
 pub mod runner;
 pub mod scenario;
 mod wording;

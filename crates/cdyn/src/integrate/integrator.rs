@@ -8,6 +8,7 @@ use super::scheme::{Application, Formula, Scheme};
 
 /// Steps a state with one scheme and one way of applying the control.
 /// All buffers are allocated here, none in [`step`](Self::step).
+#[derive(Clone)]
 pub struct Integrator<B = Vec<f64>> {
     scheme: Scheme,
     application: Application,

@@ -22,16 +22,22 @@ pub struct Driven {
 }
 
 impl<B> Element<B> {
-    /// The keys of this element that an input may drive.
+    /// The keys of this element that an input may drive ([`input_keys`]).
     pub fn input_keys(&self) -> &'static [&'static str] {
-        match self {
-            Element::AppliedForce { .. } => &["fx", "fy"],
-            Element::AppliedTorque { .. } => &["torque"],
-            Element::DriveCoordinate { .. } | Element::DriveAngle { .. } => &["function"],
-            Element::Spring { .. } => &["rest_length"],
-            Element::TorsionSpring { .. } => &["rest_angle"],
-            _ => &[],
-        }
+        input_keys(self.kind())
+    }
+}
+
+/// The keys that an input may drive of an element of `kind` (its name in
+/// scenario files, [`Element::kind`]).
+pub fn input_keys(kind: &str) -> &'static [&'static str] {
+    match kind {
+        "force" => &["fx", "fy"],
+        "torque" => &["torque"],
+        "coordinate" | "relative_angle" => &["function"],
+        "spring" => &["rest_length"],
+        "torsion_spring" => &["rest_angle"],
+        _ => &[],
     }
 }
 

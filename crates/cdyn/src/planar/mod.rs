@@ -30,5 +30,5 @@ pub use body::{Body, BodyId, GROUND};
 pub use build::Built;
 pub use drawing::{Anchor, Drawing, Link, Shape};
 pub use element::{Coordinate, Element, Group};
-pub use inputs::Driven;
+pub use inputs::{Driven, input_keys};
 pub use mechanism::Mechanism;

@@ -17,6 +17,12 @@ use crate::simulate::system::{AlphaFailure, ControlledSystem, EvalError, RattleF
 
 /// A running simulation of any controlled [`System`]: the general
 /// [`Simulation`] of a [`Model`], or a [`SmallSimulation`](crate::small::SmallSimulation).
+///
+/// A clone is a snapshot: the state, the scheme's history, the gains and
+/// every buffer a step reads, so that stepping the clone repeats the run
+/// bit for bit (the model, with the values of its inputs, is shared: see
+/// [`Simulation::snapshot`]).
+#[derive(Clone)]
 pub struct Stepper<S: System> {
     system: S,
     integrator: Integrator<S::State>,

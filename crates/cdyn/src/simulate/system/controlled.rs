@@ -18,6 +18,7 @@ use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
 
 /// A model with a control law: the right-hand side an [`Integrator`](crate::integrate::Integrator) steps.
+#[derive(Clone)]
 pub struct ControlledSystem<'m> {
     model: &'m Model,
     control: Control,
