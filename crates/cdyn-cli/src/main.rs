@@ -107,6 +107,18 @@ enum Command {
         #[command(flatten)]
         args: commands::precision::PrecisionArgs,
     },
+    /// Export a scenario as an FMI 2.0 co-simulation FMU (its inputs, outputs and parameters as variables).
+    #[command(after_help = "Example: cdyn fmu examples/pd_pendulum.toml --out pd_pendulum.fmu")]
+    Fmu {
+        /// The scenario (TOML).
+        scenario: PathBuf,
+        /// The FMU to write, NAME.fmu (NAME is its model identifier).
+        #[arg(long)]
+        out: PathBuf,
+        /// The shared library of crates/cdyn-capi to carry (default: $CDYN_FMU_LIBRARY, else libcdyn_capi.so beside cdyn).
+        #[arg(long)]
+        library: Option<PathBuf>,
+    },
     /// Run a scenario file.
     #[command(after_help = "Example: cdyn run examples/four_bar.toml --out out/four_bar --html")]
     Run {
@@ -150,6 +162,7 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Man { out } => commands::manual::man(Cli::command(), out.as_deref()).map(done),
         Command::Paper { out } => commands::paper::paper(&out),
         Command::Run { case } => commands::run::run(case),
+        Command::Fmu { scenario, out, library } => commands::fmu::fmu(&scenario, &out, library.as_deref()).map(done),
         Command::Compare { case } => commands::compare::compare(case),
         Command::Precision { args } => commands::precision::precision(args).map(done),
         Command::Bench { out, light } => commands::bench::bench(&out, light).map(done),

@@ -33,6 +33,20 @@ impl<'m> Simulation<'m> {
     }
 }
 
+impl Simulation<'_> {
+    /// Puts the simulation at positions `q`, velocities `v` and `∫Ė = e`
+    /// (as [`q`](Self::q), [`v`](Self::v), [`energy_input`](Self::energy_input)
+    /// read them), at the same time and step; the scheme starts again
+    /// from there. Nothing is projected: a state off the constraints is
+    /// pulled back by the control law, as any violation is.
+    pub fn set_state(&mut self, q: &[f64], v: &[f64], e: f64) -> Result<()> {
+        crate::simulate::stepper::check_initial_state(self.model().n(), q, v)?;
+        crate::error::finite("energy input", e)?;
+        self.replace_state(q, v, e);
+        Ok(())
+    }
+}
+
 impl Snapshot<'_> {
     /// Steps taken when it was taken.
     pub fn steps(&self) -> u64 {

@@ -79,6 +79,17 @@ impl<'m> Simulation<'m> {
         self.system.model()
     }
 
+    /// Writes `(q, v, e)` into the state and restarts the scheme (see [`Simulation::set_state`]).
+    pub(super) fn replace_state(&mut self, q: &[f64], v: &[f64], e: f64) {
+        let (t, n) = (self.t(), self.system.n());
+        let x = self.x.as_mut_slice();
+        x[..n].copy_from_slice(q);
+        x[n..2 * n].copy_from_slice(v);
+        x[2 * n] = e;
+        self.integrator.restart();
+        self.system.restart(self.x.as_slice(), t);
+    }
+
     /// Changes an input by `set` between steps, keeping `Ψ` and restarting
     /// the scheme (see [`Simulation::set_input`]).
     pub(super) fn change_input(&mut self, set: impl FnOnce()) -> std::result::Result<(), Failure> {
