@@ -342,3 +342,42 @@ fn bad_inputs_and_outputs_get_one_line_naming_the_entry_and_key() {
         }
     }
 }
+
+/// `cdyn fmu` reads a scenario as `cdyn run` does: a bad key is the same
+/// one line, and no FMU (nor a partial file) is left; a good one is a ZIP
+/// of the model description, the scenario and the library it was given.
+#[test]
+fn cdyn_fmu_refuses_what_cdyn_run_refuses_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let library = dir.path().join("libfake.so");
+    std::fs::write(&library, b"not a library: packed as it is").unwrap();
+    let fmu = |scenario: &Path, out: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_cdyn"))
+            .args([
+                "fmu",
+                scenario.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--library",
+                library.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap()
+    };
+    let bad = WITH_INPUT.replace("mass = 1.0", "mass = 1.0\nmas = 2.0");
+    let (run_error, bad_dir) = error_of(&bad);
+    let out = fmu(&bad_dir.join("bad.toml"), &dir.path().join("bad.fmu"));
+    assert!(!out.status.success());
+    assert_eq!(String::from_utf8_lossy(&out.stderr), run_error);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "only the library: no FMU, no partial file");
+    let good = dir.path().join("good.toml");
+    std::fs::write(&good, WITH_INPUT).unwrap();
+    let out = fmu(&good, &dir.path().join("pendulum.fmu"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let zip = std::fs::read(dir.path().join("pendulum.fmu")).unwrap();
+    for name in ["modelDescription.xml", "resources/scenario.toml", "binaries/linux64/pendulum.so"] {
+        assert!(zip.windows(name.len()).any(|w| w == name.as_bytes()), "{name} in the FMU");
+    }
+    let out = fmu(&good, &dir.path().join("2nd.fmu"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("model identifier"));
+}

@@ -7,7 +7,6 @@ use std::path::Path;
 
 /// Writes the FMU of `scenario` to `out`, carrying `library` (or the one found).
 pub fn fmu(scenario: &Path, out: &Path, library: Option<&Path>) -> Result<()> {
-    let library = fmu::find_library(library)?;
-    fmu::write(scenario, out, &library)?;
+    fmu::write(scenario, out, library)?;
     print(&format!("wrote {}\n", out.display()))
 }

@@ -99,8 +99,9 @@ pub fn model_description(name: &str, guid: &str, h: f64, t_end: f64, variables: 
 }
 
 /// Writes the FMU of the scenario at `scenario` to `out` (`NAME.fmu`, NAME
-/// a C identifier: the model identifier), carrying `library`.
-pub fn write(scenario: &Path, out: &Path, library: &Path) -> Result<()> {
+/// a C identifier: the model identifier), carrying `library` (see
+/// [`find_library`]), once the scenario is read and its case built.
+pub fn write(scenario: &Path, out: &Path, library: Option<&Path>) -> Result<()> {
     let name = out
         .file_stem()
         .and_then(|s| s.to_str())
@@ -133,8 +134,9 @@ pub fn write(scenario: &Path, out: &Path, library: &Path) -> Result<()> {
         }
         None => None,
     };
+    let library = find_library(library)?;
     let binary =
-        std::fs::read(library).with_context(|| format!("cannot read the FMU library {}", library.display()))?;
+        std::fs::read(&library).with_context(|| format!("cannot read the FMU library {}", library.display()))?;
     let description = model_description(
         name,
         &guid(&table, urdf.as_deref()),
