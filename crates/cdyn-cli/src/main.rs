@@ -55,6 +55,9 @@ enum Command {
         /// A quick smoke run with few steps (for CI; the numbers mean little).
         #[arg(long)]
         light: bool,
+        /// Only the real-time figures (each step timed on its own; a co-simulation step), into realtime.json.
+        #[arg(long)]
+        realtime: bool,
     },
     /// Run a grid over gains and step sizes (the scenario's [sweep] table) in parallel; writes sweep.json and heat maps.
     #[command(after_help = "Example: cdyn sweep examples/sweep_gains.toml --out out/sweep --threads 2")]
@@ -165,7 +168,7 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Fmu { scenario, out, library } => commands::fmu::fmu(&scenario, &out, library.as_deref()).map(done),
         Command::Compare { case } => commands::compare::compare(case),
         Command::Precision { args } => commands::precision::precision(args).map(done),
-        Command::Bench { out, light } => commands::bench::bench(&out, light).map(done),
+        Command::Bench { out, light, realtime } => commands::bench::bench(&out, light, realtime).map(done),
         Command::Sweep { scenario, out, shard, threads, listing } => {
             commands::sweep::sweep(&scenario, &out, shard.as_deref(), threads, &listing).map(done)
         }

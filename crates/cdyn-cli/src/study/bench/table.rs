@@ -91,5 +91,21 @@ pub fn table(r: &Report) -> String {
         );
     }
     out += &format!("allocations per step (max): {}\n", r.max_allocations_per_step);
-    out
+    out + &realtime_table(&r.realtime)
+}
+
+/// The real-time rows: each step timed on its own, and a co-simulation step.
+pub fn realtime_table(r: &Realtime) -> String {
+    let mut out = "each step timed on its own (real time):\n".to_string();
+    out += &format!(
+        "  {:<54} {:>7} {:>10} {:>10} {:>10} {:>8} {:>7}\n",
+        "case", "steps", "median µs", "99.9% µs", "max µs", "slowest", "allocs"
+    );
+    for t in r.step_times.iter().chain(&r.cosimulation) {
+        out += &format!(
+            "  {:<54} {:>7} {:>10.2} {:>10.2} {:>10.2} {:>8} {:>7}\n",
+            t.case, t.steps, t.median_us, t.p999_us, t.max_us, t.slowest_step, t.allocations
+        );
+    }
+    out + &format!("co-simulation step / bare step (medians): {:.2}×\n", r.cosimulation_ratio)
 }

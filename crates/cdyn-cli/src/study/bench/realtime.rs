@@ -1,0 +1,106 @@
+//! Real-time figures: each step timed on its own over a long run, and the
+//! median, 99.9th percentile and maximum of those times — a real-time
+//! user needs every step within budget, not the mean. The planar chain at
+//! N = 10, 100, 1000 (AB-3 with the chain's control, h = 1e-3) and the
+//! flyball governor (RK-4 at its scenario's h = 5e-5); then a
+//! co-simulation step of the pendulum of `examples/pd_pendulum.toml` as
+//! `fmi2DoStep` makes it — the input set (which restarts the scheme when
+//! it changes), one step, the outputs read, through the case stepped
+//! from outside that the FMU and the C API step — against a bare step.
+
+use super::{chain_control, chain_example};
+use crate::case::live::Live;
+use crate::case::scenario;
+use crate::io::alloc_count::allocations;
+use anyhow::Result;
+use cdyn::{Scheme, Settings, Simulation};
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// The times of the steps of one run.
+#[derive(Debug, Serialize)]
+pub struct StepTimes {
+    /// What was stepped.
+    pub case: String,
+    /// Steps timed, each on its own.
+    pub steps: usize,
+    /// Median time of a step.
+    pub median_us: f64,
+    /// 99.9th percentile.
+    pub p999_us: f64,
+    /// The slowest step.
+    pub max_us: f64,
+    /// Which step was the slowest (0: the first).
+    pub slowest_step: usize,
+    /// Allocations over the run (0 expected).
+    pub allocations: u64,
+}
+
+/// Times each of `steps` calls of `step` on its own.
+fn per_step(case: String, steps: usize, mut step: impl FnMut() -> Result<()>) -> Result<StepTimes> {
+    let mut times = vec![0.0_f64; steps];
+    let before = allocations();
+    for t in times.iter_mut() {
+        let clock = Instant::now();
+        step()?;
+        *t = clock.elapsed().as_secs_f64() * 1e6;
+    }
+    let allocations = allocations() - before;
+    let (slowest_step, &max_us) = times.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).unwrap_or((0, &0.0));
+    times.sort_by(f64::total_cmp);
+    let at = |p: f64| times[((p * steps as f64).ceil() as usize).clamp(1, steps) - 1];
+    Ok(StepTimes { case, steps, median_us: at(0.5), p999_us: at(0.999), max_us, slowest_step, allocations })
+}
+
+/// The real-time figures (`cdyn bench --realtime`, and part of `bench.json`).
+#[derive(Debug, Serialize)]
+pub struct Realtime {
+    /// A `--light` run: few steps, figures that mean little.
+    pub light: bool,
+    /// Each step timed on its own: the chain by N and the flyball.
+    pub step_times: Vec<StepTimes>,
+    /// A bare step of the pendulum, then a co-simulation step of it.
+    pub cosimulation: [StepTimes; 2],
+    /// Median co-simulation step over median bare step.
+    pub cosimulation_ratio: f64,
+}
+
+/// The real-time figures: 1e5 steps each (`light`: 200, for CI).
+pub fn run_realtime(light: bool) -> Result<Realtime> {
+    let steps = if light { 200 } else { 100_000 };
+    let mut runs = Vec::new();
+    for n in [10, 100, 1000] {
+        let ex = chain_example(n)?;
+        let settings = Settings::new(Scheme::AdamsBashforth3, 1e-3, chain_control(1e-3));
+        let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0)?;
+        runs.push(per_step(format!("chain N = {n}, AB-3, cvsgf_energy, h = 1e-3"), steps, || Ok(sim.step()?))?);
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let flyball = root.join("suite/flyball_governor.toml");
+    let case = scenario::load(&flyball)?.case(&flyball)?;
+    let ex = &case.example;
+    let mut sim = Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0)?;
+    let name = format!("flyball governor, {}, h = {}", case.settings.scheme.info().name, case.settings.h);
+    runs.push(per_step(name, steps, || Ok(sim.step()?))?);
+    // Co-simulation against bare steps, on the same case.
+    let pendulum = root.join("pd_pendulum.toml");
+    let parsed = scenario::load(&pendulum)?;
+    let case = parsed.case(&pendulum)?;
+    let ex = &case.example;
+    let mut sim = Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0)?;
+    let bare = per_step("pendulum, bare step".into(), steps, || Ok(sim.step()?))?;
+    let mut live = Live::from_scenario(&parsed, &pendulum)?;
+    let mut outputs = vec![0.0; live.output_names().len()];
+    let mut k = 0_usize;
+    let cosim = per_step("pendulum, co-simulation step (input, step, outputs)".into(), steps, || {
+        // A torque that changes every 10 steps, as a controller at 100 Hz sets it.
+        k += 1;
+        live.set_input(0, ((k / 10) as f64 * 0.1).sin())?;
+        live.step(1)?;
+        live.outputs(&mut outputs);
+        Ok(())
+    })?;
+    let cosimulation_ratio = cosim.median_us / bare.median_us;
+    Ok(Realtime { light, step_times: runs, cosimulation: [bare, cosim], cosimulation_ratio })
+}
