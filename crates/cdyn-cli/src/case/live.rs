@@ -75,7 +75,25 @@ impl Live {
             observed: vec![0.0; observables],
             reference: (vec![0.0; n], vec![0.0; n], vec![0.0; observables]),
         };
-        Ok(Live { sim, outputs, case })
+        let mut live = Live { sim, outputs, case };
+        live.warm_up().map_err(|e| anyhow!("{file}: {e}"))?;
+        Ok(live)
+    }
+
+    /// Takes a step, reads the outputs and goes back to the start (a
+    /// snapshot restores to the bit): the code and the buffers a step uses
+    /// are touched here, out of a real-time loop. `cdyn bench --realtime
+    /// --light`, the pendulum's first co-simulation step in three runs
+    /// each: 16.2, 6.9, 6.3 µs without this, 2.6, 5.8, 3.7 µs with it
+    /// (the median step: 1.1 µs). A step that fails here fails again when
+    /// taken.
+    fn warm_up(&mut self) -> cdyn::Result<()> {
+        let start = self.sim.snapshot();
+        let mut outputs = vec![0.0; self.outputs.names.len()];
+        if self.sim.step().is_ok() {
+            self.outputs(&mut outputs);
+        }
+        self.sim.restore(&start)
     }
 
     /// The case stepped.

@@ -96,16 +96,27 @@ pub fn table(r: &Report) -> String {
 
 /// The real-time rows: each step timed on its own, and a co-simulation step.
 pub fn realtime_table(r: &Realtime) -> String {
-    let mut out = "each step timed on its own (real time):\n".to_string();
+    let mut out = "each step timed on its own (real time), µs; wall clock, then this thread's CPU time:\n".to_string();
     out += &format!(
-        "  {:<54} {:>7} {:>10} {:>10} {:>10} {:>8} {:>7}\n",
-        "case", "steps", "median µs", "99.9% µs", "max µs", "slowest", "allocs"
+        "  {:<52} {:>7} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>7} {:>7} {:>6}\n",
+        "case", "steps", "median", "99.9%", "max", "cpu med", "cpu 99.9", "cpu max", "at step", "first", "allocs"
     );
     for t in r.step_times.iter().chain(&r.cosimulation) {
+        let (w, c) = (&t.wall, &t.cpu);
         out += &format!(
-            "  {:<54} {:>7} {:>10.2} {:>10.2} {:>10.2} {:>8} {:>7}\n",
-            t.case, t.steps, t.median_us, t.p999_us, t.max_us, t.slowest_step, t.allocations
+            "  {:<52} {:>7} {:>8.2} {:>8.2} {:>9.1} {:>8.2} {:>8.2} {:>8.1} {:>7} {:>7.1} {:>6}\n",
+            t.case,
+            t.steps,
+            w.median_us,
+            w.p999_us,
+            w.max_us,
+            c.median_us,
+            c.p999_us,
+            c.max_us,
+            c.slowest_step,
+            t.first_step_cpu_us,
+            t.allocations
         );
     }
-    out + &format!("co-simulation step / bare step (medians): {:.2}×\n", r.cosimulation_ratio)
+    out + &format!("co-simulation step / bare step (CPU medians): {:.2}×\n", r.cosimulation_ratio)
 }
