@@ -2,11 +2,38 @@
 //! an instance reads its scenario from resources/ and checks the GUID;
 //! refused calls return fmi2Error with one line logged, never a crash;
 //! two instances stay apart; FMU states repeat the run bit for bit;
-//! parameters set before initialization rebuild the case.
+//! parameters set before initialization rebuild the case; a communication
+//! step (fmi2SetReal, fmi2DoStep, fmi2GetReal) allocates nothing.
 
 use cdyn_capi::fmi::*;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::sync::Mutex;
+
+/// Counts this thread's allocations (other threads of the harness do not count).
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
 
 const SCENARIO: &str = include_str!("../../../examples/pd_pendulum.toml");
 
@@ -179,4 +206,23 @@ fn parameters_set_before_initialization_rebuild_the_case_and_reset_undoes_them()
     fmu.start();
     assert_eq!(unsafe { fmi2DoStep(fmu.c, 0.0, 0.1, 1) }, OK);
     assert!(fmu.get(ANGLE) < -0.01 && fmu.get(GRAVITY_Y) == -9.81);
+}
+
+/// What an importer does every communication step — set the input, step
+/// (10 steps of h), read every output — allocates nothing, from the first
+/// step after initialization on, a changed input included.
+#[test]
+fn a_communication_step_allocates_nothing() {
+    let (_dir, uri) = resources(SCENARIO);
+    let fmu = instantiate(&uri, &guid(SCENARIO));
+    fmu.start();
+    let (vrs, mut outputs) = ([T, ANGLE, 11, 12, 13], [0.0; 5]);
+    for k in 0..50 {
+        let before = ALLOCATIONS.with(|c| c.get());
+        assert_eq!(fmu.set(TAU, (k as f64 * 0.1).sin()), OK);
+        assert_eq!(unsafe { fmi2DoStep(fmu.c, k as f64 * 0.01, 0.01, 1) }, OK);
+        assert_eq!(unsafe { fmi2GetReal(fmu.c, vrs.as_ptr(), vrs.len(), outputs.as_mut_ptr()) }, OK);
+        assert_eq!(ALLOCATIONS.with(|c| c.get()) - before, 0, "communication step {k}");
+    }
+    assert!((outputs[0] - 0.5).abs() < 1e-12);
 }

@@ -61,7 +61,7 @@ pub use flyball::FlyballRun;
 use flyball::flyball_runs;
 use method_costs::method_comparisons;
 pub use method_costs::{METHODS, MethodComparison, MethodCost, PHI_EVERY};
-pub use realtime::{Percentiles, Realtime, StepTimes, run_realtime};
+pub use realtime::{Percentiles, Realtime, StepTimes, per_step, run_realtime};
 pub use table::{realtime_table, table};
 
 /// The layout of `bench.json` this code writes. 2: `schema_version`

@@ -74,7 +74,7 @@ fn thread_cpu_us() -> f64 {
 }
 
 /// Times each of `steps` calls of `step` on its own, by both clocks.
-fn per_step(case: String, steps: usize, mut step: impl FnMut() -> Result<()>) -> Result<StepTimes> {
+pub fn per_step(case: String, steps: usize, mut step: impl FnMut() -> Result<()>) -> Result<StepTimes> {
     let (mut wall, mut cpu) = (vec![0.0_f64; steps], vec![0.0_f64; steps]);
     let before = allocations();
     for (w, c) in wall.iter_mut().zip(cpu.iter_mut()) {
