@@ -7,6 +7,8 @@
 //! `fmi2DoStep` makes it — the input set (which restarts the scheme when
 //! it changes), one step, the outputs read, through the case stepped
 //! from outside that the FMU and the C API step — against a bare step.
+//! (The FMI functions themselves are timed by the example
+//! `crates/cdyn-capi/examples/fmi_overhead.rs`: that crate depends on this one.)
 
 use super::{chain_control, chain_example};
 use crate::case::live::Live;
@@ -26,8 +28,8 @@ pub struct StepTimes {
     /// Steps timed, each on its own.
     pub steps: usize,
     /// Elapsed (wall-clock) time: what a loop on this machine sees, the
-    /// scheduler's preemptions included (on a shared machine, gaps of 4 to
-    /// 20 ms in the maximum and, for steps above ~30 µs, the 99.9th
+    /// scheduler's preemptions included (on a shared machine, gaps of 4 ms
+    /// and more in the maximum and, for steps above ~30 µs, the 99.9th
     /// percentile).
     pub wall: Percentiles,
     /// This thread's CPU time: the step's own cost, page faults included,
