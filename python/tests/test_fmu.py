@@ -2,11 +2,15 @@
 requirements-test.txt): its model description validates with no problems,
 FMPy's simulation equals `cdyn run` to the bit, the Python PD controller of
 examples/pd_pendulum.py gives the same run through the FMU, the C API and
-the Python API, and refused calls are fmi2Error with a logged line."""
+the Python API (and examples/pd_pendulum.c ends where they do), and
+refused calls are fmi2Error with a logged line."""
 
 import importlib.util
 import os
 import pathlib
+import re
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -25,8 +29,6 @@ def fmu(tmp_path_factory):
     """pd_pendulum.fmu, written by the cdyn binary with the library beside it."""
     binary = os.environ["CDYN_BIN"]
     out = tmp_path_factory.mktemp("fmu") / "pd_pendulum.fmu"
-    import subprocess
-
     done = subprocess.run([binary, "fmu", SCENARIO, "--out", out], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     return out
@@ -53,13 +55,36 @@ def test_fmpy_simulation_equals_cdyn_run(fmu, cli, tmp_path):
         assert np.array_equal(result[name], expected), (name, np.max(np.abs(result[name] - expected)))
 
 
-def test_the_pd_controller_runs_alike_through_the_fmu_the_c_api_and_python(fmu):
+@pytest.fixture(scope="module")
+def example():
+    """examples/pd_pendulum.py as a module."""
     spec = importlib.util.spec_from_file_location("pd_pendulum", ROOT / "examples" / "pd_pendulum.py")
-    example = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(example)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_pd_controller_runs_alike_through_the_fmu_the_c_api_and_python(fmu, example):
     through_fmu, through_c, through_python = example.main(["pd_pendulum.py", str(fmu), library()])
     assert through_fmu == through_c == through_python
     assert abs(through_fmu[-1] - example.TARGET) < 0.2, "the controller holds the link near its target"
+
+
+def test_the_c_example_ends_where_the_python_controller_does(example, tmp_path):
+    """examples/pd_pendulum.c, the same controller in C, compiled by gcc:
+    its angle at t = 2 s (printed with 17 digits) is the Python runs' to the bit."""
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        pytest.skip("no gcc")
+    lib = pathlib.Path(library()).parent
+    exe = tmp_path / "pd_pendulum"
+    include = ROOT / "crates" / "cdyn-capi" / "include"
+    source = ROOT / "examples" / "pd_pendulum.c"
+    subprocess.run([gcc, "-std=c99", source, f"-I{include}", f"-L{lib}", "-lcdyn_capi", "-lm", "-o", exe], check=True)
+    env = {**os.environ, "LD_LIBRARY_PATH": str(lib)}
+    out = subprocess.run([exe, SCENARIO], env=env, capture_output=True, text=True, check=True).stdout
+    angle = float(re.search(r"t = 2\.000 s: angle (\S+) rad \(target", out).group(1))
+    assert angle == example.with_python()[-1], out
 
 
 class Logged:
