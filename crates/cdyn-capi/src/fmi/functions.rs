@@ -10,7 +10,7 @@ use super::{
 use crate::guard::guarded;
 use std::ffi::{CStr, c_char, c_int, c_void};
 
-/// `fmi2Component`: an [`Instance`] behind a pointer.
+/// `fmi2Component`: an `Instance` behind a pointer.
 pub type Component = *mut c_void;
 /// `fmi2FMUstate`: a saved instance behind a pointer.
 pub type FmuState = *mut c_void;
