@@ -18,7 +18,7 @@ True
 from __future__ import annotations
 
 import json
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 import os
 
 import numpy as np
@@ -37,6 +37,7 @@ __all__ = [
     "Sweep",
     "Suite",
     "Precision",
+    "Simulation",
     "load",
     "loads",
     "from_dict",
@@ -266,6 +267,95 @@ class Precision:
 
     def __repr__(self) -> str:
         return f"<cdyn.Precision {len(self.lines)} lines of {self.summary['scenario']}>"
+
+
+class Simulation:
+    """A scenario's case stepped from Python instead of run to its end:
+    inputs (the scenario's ``[[inputs]]``) set and outputs (its ``[output]
+    select``, by default every CSV column of ``cdyn run``) read between
+    steps; the state read, written, saved and restored. Steps release the GIL.
+
+    Each Simulation has a model of its own, so two never share inputs. A
+    changed input restarts the scheme (AB-3 and ABM-4 take RK-4 steps again)
+    and keeps the energy balance (see the book's page on inputs and FMUs).
+
+    >>> import cdyn
+    >>> sim = cdyn.Simulation("examples/pd_pendulum.toml")  # doctest: +SKIP
+    >>> sim.set_input("tau", 0.5); sim.step(10); sim.outputs()  # doctest: +SKIP
+    """
+
+    __slots__ = {"_sim": "The native simulation."}
+
+    def __init__(self, source: ScenarioLike) -> None:
+        self._sim = _cdyn.Simulation(scenario(source))
+
+    @property
+    def input_names(self) -> List[str]:
+        """The inputs' names, in order (their positions for ``set_input``)."""
+        return list(self._sim.input_names)
+
+    @property
+    def output_names(self) -> List[str]:
+        """The outputs' names, in the order ``outputs()`` returns them."""
+        return list(self._sim.output_names)
+
+    @property
+    def t(self) -> float:
+        """Current time (steps × h)."""
+        return float(self._sim.t)
+
+    @property
+    def steps(self) -> int:
+        """Steps taken."""
+        return int(self._sim.steps)
+
+    @property
+    def h(self) -> float:
+        """The step size."""
+        return float(self._sim.h)
+
+    def set_input(self, input: Union[int, str], value: float) -> None:
+        """Sets an input by position or name; takes effect from the next step.
+        A value that is not finite, or an unknown input, raises cdyn.Error."""
+        self._sim.set_input(input, float(value))
+
+    def input(self, index: int) -> float:
+        """The current value of input ``index``."""
+        return float(self._sim.input(index))
+
+    def step(self, n: int = 1) -> None:
+        """Takes ``n`` steps; a failed step raises SimulationError."""
+        self._sim.step(n)
+
+    def outputs(self) -> np.ndarray:
+        """The outputs at the current state, as ``output_names`` orders them
+        (the values ``cdyn run`` writes to its CSV at the same step)."""
+        return self._sim.outputs()
+
+    def output(self, name: str) -> float:
+        """The output ``name`` at the current state."""
+        return float(self.outputs()[self.output_names.index(name)])
+
+    def state(self) -> Tuple[np.ndarray, np.ndarray, float]:
+        """The full state: positions q, velocities v and the energy input ∫Ė."""
+        return self._sim.state()
+
+    def set_state(self, q: Sequence[float], v: Sequence[float], e: float) -> None:
+        """Puts the simulation at the state ``(q, v, e)`` (as ``state()``
+        returns it), at the same time; the scheme starts again from there."""
+        self._sim.set_state(np.asarray(q, dtype=float), np.asarray(v, dtype=float), float(e))
+
+    def snapshot(self) -> Any:
+        """Everything needed to come back to this point of the run
+        (``restore`` repeats the run from here bit for bit)."""
+        return self._sim.snapshot()
+
+    def restore(self, state: Any) -> None:
+        """Goes back to a ``snapshot()`` of this simulation."""
+        self._sim.restore(state)
+
+    def __repr__(self) -> str:
+        return f"<cdyn.Simulation t={self.t} inputs={self.input_names}>"
 
 
 def load(path: Union[str, "os.PathLike[str]"]) -> Scenario:

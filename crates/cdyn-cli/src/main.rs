@@ -55,6 +55,9 @@ enum Command {
         /// A quick smoke run with few steps (for CI; the numbers mean little).
         #[arg(long)]
         light: bool,
+        /// Only the real-time figures (each step timed on its own; a co-simulation step), into realtime.json.
+        #[arg(long)]
+        realtime: bool,
     },
     /// Run a grid over gains and step sizes (the scenario's [sweep] table) in parallel; writes sweep.json and heat maps.
     #[command(after_help = "Example: cdyn sweep examples/sweep_gains.toml --out out/sweep --threads 2")]
@@ -107,6 +110,18 @@ enum Command {
         #[command(flatten)]
         args: commands::precision::PrecisionArgs,
     },
+    /// Export a scenario as an FMI 2.0 co-simulation FMU (its inputs, outputs and parameters as variables).
+    #[command(after_help = "Example: cdyn fmu examples/pd_pendulum.toml --out pd_pendulum.fmu")]
+    Fmu {
+        /// The scenario (TOML).
+        scenario: PathBuf,
+        /// The FMU to write, NAME.fmu (NAME is its model identifier).
+        #[arg(long)]
+        out: PathBuf,
+        /// The shared library of crates/cdyn-capi to carry (default: $CDYN_FMU_LIBRARY, else libcdyn_capi.so beside cdyn).
+        #[arg(long)]
+        library: Option<PathBuf>,
+    },
     /// Run a scenario file.
     #[command(after_help = "Example: cdyn run examples/four_bar.toml --out out/four_bar --html")]
     Run {
@@ -150,9 +165,10 @@ fn run(cli: Cli) -> Result<Ended> {
         Command::Man { out } => commands::manual::man(Cli::command(), out.as_deref()).map(done),
         Command::Paper { out } => commands::paper::paper(&out),
         Command::Run { case } => commands::run::run(case),
+        Command::Fmu { scenario, out, library } => commands::fmu::fmu(&scenario, &out, library.as_deref()).map(done),
         Command::Compare { case } => commands::compare::compare(case),
         Command::Precision { args } => commands::precision::precision(args).map(done),
-        Command::Bench { out, light } => commands::bench::bench(&out, light).map(done),
+        Command::Bench { out, light, realtime } => commands::bench::bench(&out, light, realtime).map(done),
         Command::Sweep { scenario, out, shard, threads, listing } => {
             commands::sweep::sweep(&scenario, &out, shard.as_deref(), threads, &listing).map(done)
         }

@@ -12,7 +12,8 @@ fn light_bench_writes_a_complete_report() {
         Command::new(env!("CARGO_BIN_EXE_cdyn")).args(["bench", "--light", "--out"]).arg(dir.path()).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("bench.json")).unwrap()).unwrap();
-    assert_eq!(r["schema_version"].as_u64(), Some(2));
+    assert_eq!(r["schema_version"].as_u64(), Some(3));
+    assert_eq!(r["realtime"]["step_times"].as_array().unwrap().len(), 5);
     let e = &r["example1"];
     for key in ["cdyn_ns_per_step", "general_ns_per_step", "handwritten_ns_per_step", "overhead_ratio"] {
         assert!(e[key].as_f64().unwrap() > 0.0, "{key}");
@@ -119,4 +120,40 @@ fn light_bench_compares_robust_projection_and_rattle_with_cvsgf_energy() {
     assert!(table.contains("robust") && table.contains("projection") && table.contains("rattle"), "{table}");
     assert!(table.contains("generalized_alpha") && table.contains("flyball"), "{table}");
     assert!(table.contains("iter/step"), "{table}");
+}
+
+/// `cdyn bench --realtime --light`: every step timed on its own, by the
+/// wall clock and the thread's CPU clock, for an empty step, the chain at
+/// N = 10, 100, 1000 and the flyball, a co-simulation step beside a bare
+/// one; no step allocates, co-simulation's included (a changed input
+/// restarts the scheme without allocating). Timings are not asserted.
+#[test]
+fn light_realtime_bench_times_every_step_and_allocates_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cdyn"))
+        .args(["bench", "--realtime", "--light", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("realtime.json")).unwrap()).unwrap();
+    let runs: Vec<&Value> =
+        r["step_times"].as_array().unwrap().iter().chain(r["cosimulation"].as_array().unwrap()).collect();
+    let cases: Vec<&str> = runs.iter().map(|t| t["case"].as_str().unwrap()).collect();
+    assert!(cases[0].starts_with("empty step"), "{cases:?}");
+    assert!(
+        cases[1].starts_with("chain N = 10,")
+            && cases[3].starts_with("chain N = 1000,")
+            && cases[4].starts_with("flyball")
+    );
+    for t in runs {
+        for clock in ["wall", "cpu"] {
+            let p = |key: &str| t[clock][key].as_f64().unwrap();
+            assert!(0.0 <= p("median_us") && p("median_us") <= p("p999_us") && p("p999_us") <= p("max_us"), "{t}");
+            assert!(t[clock]["slowest_step"].as_u64().unwrap() < 200, "{t}");
+        }
+        assert_eq!(t["allocations"].as_u64(), Some(0), "{t}");
+        assert_eq!(t["steps"].as_u64(), Some(200));
+    }
+    assert!(r["cosimulation_ratio"].as_f64().unwrap() > 0.0);
 }

@@ -268,3 +268,116 @@ rest_length = 0.5
         );
     }
 }
+
+/// A pendulum turned by the input `tau` (the torque entry leaves its key out).
+const WITH_INPUT: &str = r#"
+[model]
+kind = "mechanism"
+gravity = [0.0, -9.81]
+[[inputs]]
+name = "tau"
+drives = "forces[0].torque"
+start = 0.0
+[[bodies]]
+name = "link"
+mass = 1.0
+inertia = 0.1
+position = [0.5, 0.0]
+[[joints]]
+kind = "revolute"
+a = "ground"
+b = "link"
+point_b = [-0.5, 0.0]
+[[forces]]
+kind = "torque"
+body = "link"
+[integrator]
+h = 1e-3
+t_end = 0.01
+"#;
+
+#[test]
+fn bad_inputs_and_outputs_get_one_line_naming_the_entry_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("good.toml");
+    std::fs::write(&path, WITH_INPUT).unwrap();
+    let out = cdyn(&["run"], Some(&path), &dir.path().join("out"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cases: Vec<(String, &[&str])> = vec![
+        (
+            WITH_INPUT.replace("body = \"link\"\n[integrator]", "body = \"link\"\ntorque = 1.0\n[integrator]"),
+            &["bad.toml: forces[0] (torque): torque is driven by the input \"tau\" (inputs[0]): leave the key out"],
+        ),
+        (
+            WITH_INPUT.replace("forces[0].torque", "forces[0].fx"),
+            &[
+                "bad.toml: forces[0] (torque): input \"tau\" on fx: a torque has no key an input drives by that name (it has: torque)",
+            ],
+        ),
+        (
+            WITH_INPUT.replace("forces[0].torque", "forces[2].torque"),
+            &["bad.toml: inputs[0] (tau): drives = \"forces[2].torque\": the scenario has 1 [[forces]] entries"],
+        ),
+        (
+            WITH_INPUT.replace("forces[0].torque", "torque"),
+            &["inputs[0] (tau): drives = \"torque\": expected an entry"],
+        ),
+        (WITH_INPUT.replace("start = 0.0\n", ""), &["bad.toml", "inputs[0]", "missing field start"]),
+        (WITH_INPUT.replace("start = 0.0", "start = 0.0\ngain = 2"), &["bad.toml", "inputs[0]", "gain"]),
+        (
+            WITH_INPUT.replace("t_end = 0.01", "t_end = 0.01\n[output]\nselect = [\"t\", \"angle\"]"),
+            &[
+                "bad.toml: [output] select: no output \"angle\"; the outputs are t, link.x, link.y, link.angle, phi, psi",
+            ],
+        ),
+        (
+            GOOD.to_string() + "[[inputs]]\nname = \"f\"\ndrives = \"forces[0].fx\"\nstart = 0.0\n",
+            &["bad.toml: [[inputs]] drive keys of a planar mechanism's entries"],
+        ),
+    ];
+    for (text, expected) in cases {
+        let (stderr, _) = error_of(&text);
+        for e in expected {
+            assert!(stderr.contains(e), "expected {e:?} in: {stderr}");
+        }
+    }
+}
+
+/// `cdyn fmu` reads a scenario as `cdyn run` does: a bad key is the same
+/// one line, and no FMU (nor a partial file) is left; a good one is a ZIP
+/// of the model description, the scenario and the library it was given.
+#[test]
+fn cdyn_fmu_refuses_what_cdyn_run_refuses_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let library = dir.path().join("libfake.so");
+    std::fs::write(&library, b"not a library: packed as it is").unwrap();
+    let fmu = |scenario: &Path, out: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_cdyn"))
+            .args([
+                "fmu",
+                scenario.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--library",
+                library.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap()
+    };
+    let bad = WITH_INPUT.replace("mass = 1.0", "mass = 1.0\nmas = 2.0");
+    let (run_error, bad_dir) = error_of(&bad);
+    let out = fmu(&bad_dir.join("bad.toml"), &dir.path().join("bad.fmu"));
+    assert!(!out.status.success());
+    assert_eq!(String::from_utf8_lossy(&out.stderr), run_error);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "only the library: no FMU, no partial file");
+    let good = dir.path().join("good.toml");
+    std::fs::write(&good, WITH_INPUT).unwrap();
+    let out = fmu(&good, &dir.path().join("pendulum.fmu"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let zip = std::fs::read(dir.path().join("pendulum.fmu")).unwrap();
+    for name in ["modelDescription.xml", "resources/scenario.toml", "binaries/linux64/pendulum.so"] {
+        assert!(zip.windows(name.len()).any(|w| w == name.as_bytes()), "{name} in the FMU");
+    }
+    let out = fmu(&good, &dir.path().join("2nd.fmu"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("model identifier"));
+}

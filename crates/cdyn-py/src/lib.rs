@@ -20,6 +20,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use std::path::PathBuf;
 
+mod stepping;
+
 create_exception!(_cdyn, Error, PyException, "Any error of cdyn; the message is the CLI's one line.");
 create_exception!(_cdyn, ScenarioError, Error, "A scenario that cannot be read or run as written.");
 create_exception!(_cdyn, SimulationError, Error, "A run that failed part-way (diverged, singular, ...).");
@@ -29,14 +31,14 @@ fn line(e: &anyhow::Error) -> String {
     format!("{e:#}").replace('\n', " ")
 }
 
-fn scenario_error(e: anyhow::Error) -> PyErr {
+pub(crate) fn scenario_error(e: anyhow::Error) -> PyErr {
     ScenarioError::new_err(line(&e))
 }
 
 /// A checked scenario, as read from a file, a TOML string or a dict.
 #[pyclass(frozen, module = "cdyn._cdyn")]
-struct Scenario {
-    parsed: scenario::Scenario,
+pub(crate) struct Scenario {
+    pub(crate) parsed: scenario::Scenario,
     table: toml::Table,
     /// What errors name: the path, `<string>` or `<dict>`.
     file: String,
@@ -67,7 +69,7 @@ impl Scenario {
 }
 
 impl Scenario {
-    fn path(&self) -> PathBuf {
+    pub(crate) fn path(&self) -> PathBuf {
         PathBuf::from(&self.file)
     }
 
@@ -344,6 +346,8 @@ fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ScenarioError", py.get_type::<ScenarioError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add_class::<Scenario>()?;
+    m.add_class::<stepping::Simulation>()?;
+    m.add_class::<stepping::SimulationState>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;
     m.add_function(wrap_pyfunction!(from_dict, m)?)?;

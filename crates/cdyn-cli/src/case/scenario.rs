@@ -2,6 +2,7 @@
 //! integrator and the output sampling, in TOML. Every mistake becomes one
 //! line naming the file and the key.
 
+use crate::case::inputs::{InputSpec, placeholders};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
 use cdyn::Scheme;
@@ -43,6 +44,10 @@ pub struct Scenario {
     pub forces: Vec<Element<String>>,
     /// Axes of a parameter sweep (`cdyn sweep`): key → values.
     pub sweep: Option<toml::Table>,
+    /// Inputs set between steps (`[[inputs]]`), each driving a key of a
+    /// mechanism's entry.
+    #[serde(default)]
+    pub inputs: Vec<InputSpec>,
     /// Momenta the model is declared to keep (`[[invariants]]`): checked
     /// and held like those a run finds, reported where the model breaks them.
     #[serde(default)]
@@ -252,6 +257,9 @@ pub struct OutputSpec {
     pub every: Option<i64>,
     /// Name of the case and its CSV file (default: the scenario file's stem).
     pub name: Option<String>,
+    /// The outputs of a stepped simulation (Python, C API, FMU), by their
+    /// CSV column names; default every column (`cdyn run` writes them all).
+    pub select: Option<Vec<String>>,
 }
 
 /// Reads and checks a scenario file.
@@ -326,7 +334,7 @@ pub fn from_table(table: toml::Table, file: &str) -> Result<(Scenario, toml::Tab
             .collect();
         (read(&rest, file)?, Some(read(&entries, file)?))
     } else {
-        (read(&table, file)?, None)
+        (read(&placeholders(&table, file)?, file)?, None)
     };
     scenario.spatial = entries;
     Ok((scenario, table))

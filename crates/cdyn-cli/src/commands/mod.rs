@@ -2,10 +2,11 @@
 //! the command line and which parts of the library (`cdyn_cli`) they call.
 //! Nothing here computes or draws; the library does.
 //!
-//! May import: `io`, `case`, `study`, `render` (the library's folders).
+//! May import: `io`, `case`, `study`, `render`, `export` (the library's folders).
 
 pub mod bench;
 pub mod compare;
+pub mod fmu;
 pub mod manual;
 pub mod paper;
 pub mod precision;

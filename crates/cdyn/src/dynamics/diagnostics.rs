@@ -44,6 +44,7 @@ impl Measures {
 }
 
 /// Buffers for measuring; one per model.
+#[derive(Clone)]
 pub struct Probe {
     /// Φ, Φ̇, Φ_t, γ and Φ_q of the last pass.
     constraints: ConstraintBuffers,

@@ -32,6 +32,7 @@ pub enum Failure {
 }
 
 /// Buffers of a projection: allocated once per model.
+#[derive(Clone)]
 pub(crate) struct Work {
     pub(crate) rows: Vec<f64>,
     /// A second right-hand side in the rows (the energy step's two projections).

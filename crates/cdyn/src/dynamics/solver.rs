@@ -9,6 +9,7 @@ use crate::model::Model;
 // The constant path's structure stays inline (no indirection in the hot
 // loops); there is one workspace per model, so its size does not matter.
 #[allow(clippy::large_enum_variant)]
+#[derive(Clone)]
 pub(super) enum Solver {
     /// Constant diagonal `M`: `S` assembled on the Jacobian's pattern.
     Constant(Schur),
@@ -31,6 +32,7 @@ pub const BLOCKS_FROM: usize = 16;
 /// reads a block reads all of it (the model checks), `J̃` and `M⁻¹ Φ_qᵀ`
 /// keep the pattern of `Φ_q`, and `S` is assembled and factored by the
 /// same sparse [`Schur`] as for a constant `M`.
+#[derive(Clone)]
 pub(super) struct Blocks {
     pub(super) mass: BlockMass,
     /// `Ψ_q = ∇V + ∂T/∂q` (`∂T/∂q` first, while it is summed).
@@ -139,6 +141,7 @@ impl Blocks {
 }
 
 /// The workspace of a configuration-dependent `M(q)`, allocated once.
+#[derive(Clone)]
 pub(super) struct General {
     pub(super) mass: DenseMass,
     /// `Ψ_q = ∇V + ∂T/∂q` (`∂T/∂q` first, while it is summed).

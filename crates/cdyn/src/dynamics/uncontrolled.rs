@@ -12,6 +12,7 @@ use crate::model::constraint::ConstraintBuffers;
 /// Workspace holding one evaluation of the dynamics. Allocated once per
 /// model; `evaluate` never allocates. The results are read through the
 /// accessors below, so only [`evaluate`](Self::evaluate) writes them.
+#[derive(Clone)]
 pub struct Dynamics {
     /// Φ, Φ̇, Φ_t, γ and Φ_q of the last pass.
     pub(super) constraints: ConstraintBuffers,

@@ -165,6 +165,15 @@ pub enum Error {
         /// Corrections taken before.
         iterations: u32,
     },
+    /// An input that does not exist, or a value it cannot take
+    /// ([`crate::model::input`]).
+    #[error("input {name:?}: {reason}")]
+    Input {
+        /// The input's name (`#3` for a position that has none).
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// Method keys that do not describe one method.
     #[error("{0}")]
     Method(#[from] KeyProblem),
@@ -214,7 +223,17 @@ impl From<Problem> for Error {
 /// A time as people write it: `step · h` rounded to 12 significant digits
 /// (`0.3`, not the `0.30000000000000004` of `3 × 0.1`), far below any step.
 pub fn tidy_time(t: f64) -> f64 {
-    format!("{t:.11e}").parse().unwrap_or(t)
+    // Written on the stack, not into a `String`: a co-simulation step reads
+    // its outputs (`t` among them) without allocating. 32 bytes hold the
+    // longest, `-1.23456789012e-308`.
+    use std::io::Write;
+    let mut text = [0_u8; 32];
+    let mut cursor = std::io::Cursor::new(&mut text[..]);
+    if write!(cursor, "{t:.11e}").is_err() {
+        return t;
+    }
+    let len = cursor.position() as usize;
+    std::str::from_utf8(&text[..len]).ok().and_then(|s| s.parse().ok()).unwrap_or(t)
 }
 
 /// A time in a message: [`tidy_time`], in plain decimals between 1e-4 and
@@ -266,5 +285,16 @@ mod tests {
         assert_eq!(Time(2.5e-6).to_string(), "2.5e-6");
         assert_eq!(Time(0.0).to_string(), "0");
         assert_eq!(Time(4766.0 * 0.001).to_string(), "4.766");
+    }
+
+    /// The stack-written rounding equals the `String` one it replaced, at the extremes too.
+    #[test]
+    fn tidy_time_rounds_as_through_a_string() {
+        for t in
+            [3.0 * 0.1, -f64::MAX, -f64::MIN_POSITIVE, 5e-324, 0.0, -0.0, f64::INFINITY, f64::NAN, 1234.5678901234567]
+        {
+            let through_string: f64 = format!("{t:.11e}").parse().unwrap();
+            assert_eq!(tidy_time(t).to_bits(), through_string.to_bits(), "{t}");
+        }
     }
 }

@@ -16,6 +16,16 @@ pub enum Problem {
         /// Why, e.g. "must be finite and positive".
         reason: &'static str,
     },
+    /// An input set to drive a key of an element that it cannot drive.
+    #[error("input {input:?} on {key}: {reason}")]
+    InputKey {
+        /// The input.
+        input: String,
+        /// The key it was to drive.
+        key: String,
+        /// Why it cannot.
+        reason: String,
+    },
     /// A time function with a non-finite coefficient.
     #[error("time function has a non-finite coefficient")]
     NonFiniteFunction,

@@ -8,6 +8,7 @@ use super::scheme::{Application, Formula, Scheme};
 
 /// Steps a state with one scheme and one way of applying the control.
 /// All buffers are allocated here, none in [`step`](Self::step).
+#[derive(Clone)]
 pub struct Integrator<B = Vec<f64>> {
     scheme: Scheme,
     application: Application,
@@ -60,6 +61,14 @@ impl<B: Buffer> Integrator<B> {
             scratch: zero,
             evaluated: false,
         }
+    }
+
+    /// Forgets the past evaluations: the next steps are the start-up
+    /// scheme's until the history is filled again (after an input changed
+    /// the right-hand side, whose past values no longer describe it).
+    pub fn restart(&mut self) {
+        self.filled = 0;
+        self.evaluated = false;
     }
 
     /// The scheme the next step uses: the start-up one until enough history exists.

@@ -135,6 +135,7 @@ fn dependent_pivot(
 /// every evaluation, densely, which is what small systems in angles need.
 /// Same pivot test ([`inverse_pivot`]) and handling of dependent rows as
 /// the sparse kernel.
+#[derive(Clone)]
 pub(crate) struct DenseLdl {
     m: usize,
     /// `S` on entry to [`factor`](Self::factor) (lower triangle read), then

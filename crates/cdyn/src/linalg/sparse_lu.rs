@@ -27,6 +27,23 @@ pub(crate) struct SparseLu {
     memory: MemBuffer,
 }
 
+impl Clone for SparseLu {
+    /// The same pattern and factors, with scratch memory of its own.
+    fn clone(&self) -> Self {
+        Self {
+            dim: self.dim,
+            col_ptr: self.col_ptr.clone(),
+            row_idx: self.row_idx.clone(),
+            slot: self.slot.clone(),
+            values: self.values.clone(),
+            symbolic: self.symbolic.clone(),
+            numeric: self.numeric.clone(),
+            factored: self.factored,
+            memory: MemBuffer::new(StackReq::new_aligned::<u8>(self.memory.len(), 64)),
+        }
+    }
+}
+
 /// The factorization found the matrix singular.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Singular;

@@ -7,6 +7,7 @@ use crate::linalg::mass::{DiagonalMass, MAX_BLOCK};
 use crate::model::angular::Generator;
 use crate::model::constraint::{Constraint, ConstraintBlock, ConstraintGroup};
 use crate::model::force::{Force, ForceBlock, ForceGroup, Potential, PotentialBlock, PotentialGroup};
+use crate::model::input::{Input, Inputs};
 use crate::model::invariant::{Declared, Invariant};
 use crate::model::kinetic::{ByMap, Kinetic, KineticBlock, KineticElement, KineticGroup, VelocityMap};
 use crate::model::nonholonomic::{Nonholonomic, NonholonomicGroup};
@@ -31,6 +32,7 @@ impl Model {
             rotations: Vec::new(),
             invariants: Vec::new(),
             names: None,
+            inputs: Inputs::default(),
             error: None,
         }
     }
@@ -72,6 +74,7 @@ pub struct ModelBuilder {
     rotations: Vec<Generator>,
     invariants: Vec<Declared>,
     names: Option<Vec<String>>,
+    inputs: Inputs,
     error: Option<Error>,
 }
 
@@ -115,6 +118,19 @@ impl ModelBuilder {
         self = self.constrain(UnitNorm, at);
         if self.error.is_none() {
             self.unit_vectors.push(UnitVector { row, coordinates: at.map(|c| c as u32).to_vec() });
+        }
+        self
+    }
+
+    /// Declares `input` (made with [`Input::new`], a name and a start
+    /// value) as one of the model's inputs, which a simulation sets by
+    /// name or position; the elements that read it hold clones of it. A
+    /// name declared twice or a start that is not finite fails the build.
+    pub fn input(mut self, input: &Input) -> Self {
+        if self.error.is_none()
+            && let Err(e) = self.inputs.declare(input.clone())
+        {
+            self.error = Some(e);
         }
         self
     }
@@ -315,6 +331,7 @@ impl ModelBuilder {
             rotations: self.rotations,
             invariants: self.invariants,
             names: self.names,
+            inputs: self.inputs,
         })
     }
 }

@@ -54,6 +54,7 @@ pub(crate) struct ConstraintValues<'a> {
 
 /// The outputs of constraint passes that a workspace keeps: `Φ`, `Φ̇`,
 /// `Φ_t`, `γ` and the Jacobian values (in [`Pattern`](crate::linalg::sparse::Pattern) order).
+#[derive(Clone)]
 pub(crate) struct ConstraintBuffers {
     pub phi: Vec<f64>,
     pub phi_dot: Vec<f64>,

@@ -7,6 +7,7 @@ use crate::linalg::mass::{BlockMass, DenseMass, DiagonalMass, MassMatrix};
 use crate::model::angular::Generator;
 use crate::model::constraint::{ConstraintBlock, ConstraintValues};
 use crate::model::force::{ForceBlock, PotentialBlock};
+use crate::model::input::Inputs;
 use crate::model::invariant::Declared;
 use crate::model::kinetic::KineticBlock;
 use crate::model::unit_vector::UnitVector;
@@ -51,6 +52,7 @@ pub struct Model {
     pub(super) rotations: Vec<Generator>,
     pub(super) invariants: Vec<Declared>,
     pub(super) names: Option<Vec<String>>,
+    pub(super) inputs: Inputs,
 }
 
 /// Where the kinetic energy comes from, decided when the model is built.
@@ -117,6 +119,12 @@ impl Model {
     /// The invariants declared with [`ModelBuilder::invariant`](crate::model::ModelBuilder::invariant).
     pub fn declared_invariants(&self) -> &[Declared] {
         &self.invariants
+    }
+
+    /// The inputs declared with [`ModelBuilder::input`](crate::model::ModelBuilder::input)
+    /// (see [`crate::model::input`]); their values are set through a simulation.
+    pub fn inputs(&self) -> &Inputs {
+        &self.inputs
     }
 
     /// The coordinates' names, where the builder gave them.

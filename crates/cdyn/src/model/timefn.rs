@@ -1,10 +1,18 @@
 //! Functions of time for drives and applied loads, written once for every
 //! scalar type so that `Φ_t`, `Φ_tt` come from the same dual passes as
-//! everything else.
+//! everything else; one may add an input's value, set from outside between
+//! steps (a controller's torque, a drive's target).
 
 use crate::ad::scalar::Scalar;
+use crate::model::input::Input;
 
-/// `f(t) = Σ_k c_k t^k + Σ_j a_j sin(ω_j t + φ_j)`.
+/// `f(t) = Σ_k c_k t^k + Σ_j a_j sin(ω_j t + φ_j) + g u`, `u` the current
+/// value of an [`Input`] and `g` its gain, where one is given.
+///
+/// The input's term is a constant within a step, with no time derivative:
+/// a drive whose target is an input holds `Φ_t = 0` between changes, and a
+/// change shows as a jump of `Φ` that the constraint stabilization (or the
+/// projection, or the scheme that holds `Φ = 0` itself) removes.
 #[derive(Debug, Clone, PartialEq, Default)]
 #[non_exhaustive]
 pub struct TimeFn {
@@ -12,6 +20,9 @@ pub struct TimeFn {
     pub polynomial: Vec<f64>,
     /// Sine terms `(amplitude, angular frequency, phase)`.
     pub sines: Vec<[f64; 3]>,
+    /// An input and its gain `g`. Not part of the scenario format: a
+    /// scenario's `[[inputs]]` put it in.
+    pub input: Option<(Input, f64)>,
 }
 
 crate::setters!(TimeFn {
@@ -19,6 +30,8 @@ crate::setters!(TimeFn {
     with_polynomial => polynomial: Vec<f64>,
     /// With these sine terms `(amplitude, angular frequency, phase)`.
     with_sines => sines: Vec<[f64; 3]>,
+    /// Plus this input times this gain.
+    with_input => input(Some): (Input, f64),
 });
 
 impl TimeFn {
@@ -34,12 +47,26 @@ impl TimeFn {
 
     /// `Σ_k c_k t^k` with these coefficients `c_0, c_1, …`.
     pub fn polynomial(coefficients: Vec<f64>) -> Self {
-        Self { polynomial: coefficients, sines: Vec::new() }
+        Self { polynomial: coefficients, sines: Vec::new(), input: None }
     }
 
     /// `a sin(ω t + φ)`.
     pub fn sine(amplitude: f64, omega: f64, phase: f64) -> Self {
-        Self { polynomial: Vec::new(), sines: vec![[amplitude, omega, phase]] }
+        Self { polynomial: Vec::new(), sines: vec![[amplitude, omega, phase]], input: None }
+    }
+
+    /// `f(t) = u`, the current value of `input`.
+    pub fn input(input: &Input) -> Self {
+        Self { polynomial: Vec::new(), sines: Vec::new(), input: Some((input.clone(), 1.0)) }
+    }
+
+    /// `−f(t)`.
+    pub fn negated(&self) -> Self {
+        Self {
+            polynomial: self.polynomial.iter().map(|c| -c).collect(),
+            sines: self.sines.iter().map(|&[a, w, phase]| [-a, w, phase]).collect(),
+            input: self.input.as_ref().map(|(u, g)| (u.clone(), -g)),
+        }
     }
 
     /// `f(t)`, for any scalar type (dual numbers give `ḟ`, `f̈`).
@@ -52,12 +79,16 @@ impl TimeFn {
         for &[a, w, phase] in &self.sines {
             p += (t * w + phase).sin() * a;
         }
+        if let Some((u, g)) = &self.input {
+            p += g * u.value();
+        }
         p
     }
 
-    /// Whether every coefficient is finite.
+    /// Whether every coefficient is finite (an input's value is checked when it is set).
     pub fn is_finite(&self) -> bool {
-        self.polynomial.iter().chain(self.sines.iter().flatten()).all(|c| c.is_finite())
+        let gain = self.input.as_ref().map(|(_, g)| *g);
+        self.polynomial.iter().chain(self.sines.iter().flatten()).chain(&gain).all(|c| c.is_finite())
     }
 }
 
@@ -108,7 +139,7 @@ mod serde_format {
                     "a function of time needs `polynomial` or `sine` terms (write 0.0 for f(t) = 0)",
                 ));
             }
-            Ok(TimeFn { polynomial, sines: sine })
+            Ok(TimeFn { polynomial, sines: sine, input: None })
         }
     }
 

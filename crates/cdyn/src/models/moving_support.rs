@@ -66,8 +66,8 @@ impl Default for MovingSupportParams {
             mass: 1.0,
             length: 1.0,
             gravity: 9.81,
-            support_x: TimeFn { polynomial: vec![0.0, 0.5, 1.0], sines: Vec::new() },
-            support_y: TimeFn { polynomial: vec![0.0, 0.0, 0.5], sines: Vec::new() },
+            support_x: TimeFn::polynomial(vec![0.0, 0.5, 1.0]),
+            support_y: TimeFn::polynomial(vec![0.0, 0.0, 0.5]),
             theta0: -FRAC_PI_2 + 0.5,
             omega0: 0.0,
         }
@@ -77,7 +77,7 @@ impl Default for MovingSupportParams {
 impl MovingSupportParams {
     /// A support oscillating as `x = ax sin(w t)`, `y = ay sin(w t)`.
     pub fn sinusoidal(ax: f64, ay: f64, w: f64) -> Self {
-        let sine = |amp: f64| TimeFn { polynomial: Vec::new(), sines: vec![[amp, w, 0.0]] };
+        let sine = |amp: f64| TimeFn::sine(amp, w, 0.0);
         Self { support_x: sine(ax), support_y: sine(ay), ..Self::default() }
     }
 
@@ -218,7 +218,7 @@ mod tests {
     use crate::models::parts::testing::{close, diff};
     #[test]
     fn time_derivatives_by_hand() {
-        let f = TimeFn { polynomial: vec![1.0, -2.0, 0.5, 0.25], sines: vec![[0.3, 2.0, 0.1], [-0.2, 5.0, -1.0]] };
+        let f = TimeFn::polynomial(vec![1.0, -2.0, 0.5, 0.25]).with_sines(vec![[0.3, 2.0, 0.1], [-0.2, 5.0, -1.0]]);
         for i in 0..20 {
             let t = 0.3 * f64::from(i) - 2.0;
             let [v, d1, d2] = time_derivatives(&f, t);
@@ -227,7 +227,7 @@ mod tests {
             close(d2, diff(|t| time_derivatives(&f, t)[1], t), 1e-8, "f''");
         }
         assert_eq!(uniform_acceleration(&f), None);
-        let quad = TimeFn { polynomial: vec![1.0, 2.0, 3.0, 0.0], sines: vec![] };
+        let quad = TimeFn::polynomial(vec![1.0, 2.0, 3.0, 0.0]);
         assert_eq!(uniform_acceleration(&quad), Some(6.0));
     }
 }

@@ -6,10 +6,12 @@ use super::body::{Body, BodyId};
 use super::constraints::{AnchoredRod, Distance, KnifeEdge, OnLine, PointRod, Prescribed, RelativeAngle, Revolute};
 use super::element::{Coordinate, Element};
 use super::ends::{End, idx_array, with_k};
+use super::inputs::wire;
 use super::loads::{Damper, Gravity, PointLoad, RotaryDamper, Spring, Torque, Torsion};
 use super::mechanism::Mechanism;
 use crate::error::{Error, Part, Problem, Result, finite, non_negative, positive};
 use crate::model::angular::Generator;
+use crate::model::input::Parameter;
 use crate::model::timefn::TimeFn;
 use crate::model::{Model, ModelBuilder};
 
@@ -74,10 +76,26 @@ impl Mechanism {
                 builder = builder.potential(Gravity { w }, [offsets[i], offsets[i] + 1]);
             }
         }
+        for (j, d) in self.inputs.iter().enumerate() {
+            if d.element >= self.elements.len() {
+                return Err(Problem::InputKey {
+                    input: d.input.name().into(),
+                    key: d.key.clone(),
+                    reason: format!("element {} does not exist", d.element),
+                }
+                .into());
+            }
+            if !self.inputs[..j].iter().any(|earlier| earlier.input == d.input) {
+                builder = builder.input(&d.input);
+            }
+        }
         let layout = Layout { bodies: &self.bodies, offsets: &offsets };
         let mut row_elements = Vec::new();
         for (k, e) in self.elements.iter().enumerate() {
-            builder = layout.add(builder, e).map_err(|why| why.at(Part::Element { index: k, kind: e.kind() }))?;
+            let driven: Vec<_> = self.inputs.iter().filter(|d| d.element == k).collect();
+            let at = || Part::Element { index: k, kind: e.kind() };
+            let (e, constant) = wire(e, &driven).map_err(|why| why.at(at()))?;
+            builder = layout.add(builder, &e, constant).map_err(|why| why.at(at()))?;
             row_elements.resize(builder.rows(), k);
         }
         Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements, drawing: self.drawing() })
@@ -92,8 +110,9 @@ struct Layout<'a> {
 }
 
 impl Layout<'_> {
-    /// Adds element `e` to the model.
-    fn add(&self, builder: ModelBuilder, e: &Element) -> Result<ModelBuilder> {
+    /// Adds element `e` to the model; `constant` is the input that takes
+    /// the place of its rest length or angle, if one does.
+    fn add(&self, builder: ModelBuilder, e: &Element, constant: Option<Parameter>) -> Result<ModelBuilder> {
         match *e {
             Element::Revolute { a, pa, b, pb } => self.revolute(builder, a, pa, b, pb),
             Element::Prismatic { a, pa, b, pb, axis } => self.prismatic(builder, a, pa, b, pb, axis),
@@ -109,15 +128,26 @@ impl Layout<'_> {
                 self.relative_angle(builder, a, b, f.clone())
             }
             Element::Spring { a, pa, b, pb, stiffness, rest_length } => {
-                let (k, l0) = (non_negative("stiffness", stiffness)?, non_negative("rest_length", rest_length)?);
+                let k = non_negative("stiffness", stiffness)?;
+                let l0 = match constant {
+                    Some(input) => input,
+                    None => Parameter::Fixed(non_negative("rest_length", rest_length)?),
+                };
                 let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
-                Ok(with_k!(idx, K, builder.potential(Spring::<K> { a: ea, b: eb, k, l0 }, idx_array(&idx))))
+                Ok(with_k!(idx, K, builder.potential(Spring::<K> { a: ea, b: eb, k, l0: l0.clone() }, idx_array(&idx))))
             }
             Element::TorsionSpring { a, b, stiffness, rest_angle } => {
                 let k = non_negative("stiffness", stiffness)?;
-                let rest = finite("rest_angle", rest_angle)?;
+                let rest = match constant {
+                    Some(input) => input,
+                    None => Parameter::Fixed(finite("rest_angle", rest_angle)?),
+                };
                 let (ia, ib, idx) = self.two_angles(a, b)?;
-                Ok(with_k!(idx, K, builder.potential(Torsion::<K> { a: ia, b: ib, k, rest }, idx_array(&idx))))
+                Ok(with_k!(
+                    idx,
+                    K,
+                    builder.potential(Torsion::<K> { a: ia, b: ib, k, rest: rest.clone() }, idx_array(&idx))
+                ))
             }
             Element::Damper { a, pa, b, pb, damping } => {
                 let c = non_negative("damping", damping)?;

@@ -189,7 +189,7 @@ pub enum Element<B = BodyId> {
         /// The turned body (a rigid body).
         body: B,
         /// The torque over time.
-        #[cfg_attr(feature = "serde", serde(rename = "torque"))]
+        #[cfg_attr(feature = "serde", serde(rename = "torque", default))]
         f: TimeFn,
     },
 }

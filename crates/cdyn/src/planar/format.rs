@@ -114,11 +114,7 @@ mod tests {
             ),
             (
                 "kind = 'coordinate'\nbody = 'bob'\ncoordinate = 'y'\nfunction = { sine = [[0.1, 2.0, 0.3]] }",
-                Element::DriveCoordinate {
-                    body: BOB,
-                    coordinate: Coordinate::Y,
-                    f: TimeFn { polynomial: vec![], sines: vec![[0.1, 2.0, 0.3]] },
-                },
+                Element::DriveCoordinate { body: BOB, coordinate: Coordinate::Y, f: TimeFn::sine(0.1, 2.0, 0.3) },
             ),
             (
                 "kind = 'relative_angle'\na = 'ground'\nb = 'crank'\nfunction = { polynomial = [0.2, 6.0] }",

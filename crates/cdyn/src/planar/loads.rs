@@ -3,6 +3,7 @@
 
 use super::ends::{End, angle_of};
 use crate::ad::scalar::Scalar;
+use crate::model::input::Parameter;
 use crate::model::timefn::TimeFn;
 use crate::{Force, Potential};
 
@@ -23,7 +24,7 @@ pub(super) struct Spring<const K: usize> {
     pub(super) a: End,
     pub(super) b: End,
     pub(super) k: f64,
-    pub(super) l0: f64,
+    pub(super) l0: Parameter,
 }
 
 impl<const K: usize> Potential<K> for Spring<K> {
@@ -31,7 +32,7 @@ impl<const K: usize> Potential<K> for Spring<K> {
     fn energy<D: Scalar>(&self, x: [D; K]) -> D {
         let (pa, pb) = (self.a.position(&x), self.b.position(&x));
         let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
-        let stretch = (dx * dx + dy * dy).sqrt() - self.l0;
+        let stretch = (dx * dx + dy * dy).sqrt() - self.l0.value();
         stretch * stretch * (0.5 * self.k)
     }
 }
@@ -41,13 +42,13 @@ pub(super) struct Torsion<const K: usize> {
     pub(super) a: Option<usize>,
     pub(super) b: Option<usize>,
     pub(super) k: f64,
-    pub(super) rest: f64,
+    pub(super) rest: Parameter,
 }
 
 impl<const K: usize> Potential<K> for Torsion<K> {
     #[inline(always)]
     fn energy<D: Scalar>(&self, x: [D; K]) -> D {
-        let turn = angle_of(self.b, &x) - angle_of(self.a, &x) - self.rest;
+        let turn = angle_of(self.b, &x) - angle_of(self.a, &x) - self.rest.value();
         turn * turn * (0.5 * self.k)
     }
 }

@@ -4,7 +4,9 @@
 
 use super::body::{Body, BodyId, GROUND};
 use super::element::Element;
+use super::inputs::Driven;
 use crate::error::{Part, Problem, Result};
+use crate::model::input::Input;
 
 /// A planar mechanism under construction; [`Mechanism::build`] turns it into a model.
 ///
@@ -34,6 +36,8 @@ pub struct Mechanism {
     pub elements: Vec<Element>,
     /// Gravitational acceleration, world axes.
     pub gravity: [f64; 2],
+    /// The inputs that drive keys of the elements ([`Mechanism::drive`]).
+    pub inputs: Vec<Driven>,
 }
 
 impl Mechanism {
@@ -61,6 +65,15 @@ impl Mechanism {
     /// Adds an element; it is checked by [`Mechanism::build`].
     pub fn add(&mut self, element: Element) -> &mut Self {
         self.elements.push(element);
+        self
+    }
+
+    /// Lets `input` drive the key `key` of element `element` (its position
+    /// in [`Mechanism::elements`]) in place of the key's value: see
+    /// [`Element::input_keys`] for the keys an element has. The model
+    /// declares the input; checked by [`Mechanism::build`].
+    pub fn drive(&mut self, element: usize, key: &str, input: &Input) -> &mut Self {
+        self.inputs.push(Driven { element, key: key.to_string(), input: input.clone() });
         self
     }
 

@@ -22,6 +22,7 @@ mod element;
 mod ends;
 #[cfg(feature = "serde")]
 pub mod format;
+mod inputs;
 mod loads;
 mod mechanism;
 
@@ -29,4 +30,5 @@ pub use body::{Body, BodyId, GROUND};
 pub use build::Built;
 pub use drawing::{Anchor, Drawing, Link, Shape};
 pub use element::{Coordinate, Element, Group};
+pub use inputs::{Driven, input_keys};
 pub use mechanism::Mechanism;

@@ -8,10 +8,13 @@
 //! `control`.
 
 pub mod generalized_alpha;
+mod inputs;
 pub mod rattle;
 mod settings;
+mod snapshot;
 mod stepper;
 pub mod system;
 
 pub use settings::*;
+pub use snapshot::Snapshot;
 pub use stepper::*;

@@ -56,6 +56,7 @@ pub(crate) enum Failure {
 }
 
 /// Buffers of the steps, allocated once per model.
+#[derive(Clone)]
 pub(crate) struct Work {
     v_half: Vec<f64>,
     rows: Vec<f64>,

@@ -17,6 +17,12 @@ use crate::simulate::system::{AlphaFailure, ControlledSystem, EvalError, RattleF
 
 /// A running simulation of any controlled [`System`]: the general
 /// [`Simulation`] of a [`Model`], or a [`SmallSimulation`](crate::small::SmallSimulation).
+///
+/// A clone is a snapshot: the state, the scheme's history, the gains and
+/// every buffer a step reads, so that stepping the clone repeats the run
+/// bit for bit (the model, with the values of its inputs, is shared: see
+/// [`Simulation::snapshot`]).
+#[derive(Clone)]
 pub struct Stepper<S: System> {
     system: S,
     integrator: Integrator<S::State>,
@@ -92,6 +98,28 @@ impl<'m> Simulation<'m> {
     /// The model simulated.
     pub fn model(&self) -> &'m Model {
         self.system.model()
+    }
+
+    /// Writes `(q, v, e)` into the state and restarts the scheme (see [`Simulation::set_state`]).
+    pub(super) fn replace_state(&mut self, q: &[f64], v: &[f64], e: f64) {
+        let (t, n) = (self.t(), self.system.n());
+        let x = self.x.as_mut_slice();
+        x[..n].copy_from_slice(q);
+        x[n..2 * n].copy_from_slice(v);
+        x[2 * n] = e;
+        self.integrator.restart();
+        self.system.restart(self.x.as_slice(), t);
+    }
+
+    /// Changes an input by `set` between steps, keeping `Ψ` and restarting
+    /// the scheme (see [`Simulation::set_input`]).
+    pub(super) fn change_input(&mut self, set: impl FnOnce()) -> std::result::Result<(), Failure> {
+        let (t, n) = (self.t(), self.system.n());
+        let shift = self.system.change_input(self.x.as_mut_slice(), t, set)?;
+        self.x.as_mut_slice()[2 * n] += shift;
+        self.integrator.restart();
+        self.system.restart(self.x.as_slice(), t);
+        Ok(())
     }
 }
 

@@ -57,8 +57,8 @@ impl Mechanism {
                         axis: axis_b.or(axis),
                         axis_b: axis_b.and(axis),
                         point_b: point_b.and(Some(point)),
-                        angle: angle.map(negated),
-                        displacement: displacement.map(negated),
+                        angle: angle.map(|f| f.negated()),
+                        displacement: displacement.map(|f| f.negated()),
                     }),
                     (None, None) => Err(Problem::SameBody { body: crate::planar::GROUND.to_string() }.at(at)),
                 }
@@ -94,13 +94,5 @@ impl Mechanism {
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(Self { bodies, joints, gravity, loads })
-    }
-}
-
-/// `−f(t)`: a drive seen from the other body.
-fn negated(f: crate::model::timefn::TimeFn) -> crate::model::timefn::TimeFn {
-    crate::model::timefn::TimeFn {
-        polynomial: f.polynomial.iter().map(|c| -c).collect(),
-        sines: f.sines.iter().map(|&[a, w, phase]| [-a, w, phase]).collect(),
     }
 }

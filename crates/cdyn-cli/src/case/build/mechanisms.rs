@@ -67,6 +67,15 @@ impl Scenario {
         Ok((mechanism, counts))
     }
 
+    /// The entries of one list.
+    pub(crate) fn element_list(&self, group: Group) -> &[Element<String>] {
+        match group {
+            Group::Joints => &self.joints,
+            Group::Drives => &self.drives,
+            _ => &self.forces,
+        }
+    }
+
     /// The element lists in the order the mechanism takes them.
     fn element_lists(&self) -> [(Group, &[Element<String>]); 3] {
         [(Group::Joints, &self.joints), (Group::Drives, &self.drives), (Group::Forces, &self.forces)]

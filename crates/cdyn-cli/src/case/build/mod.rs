@@ -140,6 +140,12 @@ impl Scenario {
                 );
             }
         }
+        if !self.inputs.is_empty() && self.model.kind != Kind::Mechanism {
+            bail!(
+                "{file}: [[inputs]] drive keys of a planar mechanism's entries: they need [model] kind = \"mechanism\""
+            );
+        }
+        crate::case::inputs::selected(self.output.select.as_deref(), &crate::case::runner::columns(&example), file)?;
         let every = match self.output.every {
             None => 1,
             Some(e) if e >= 1 => e as u64,
@@ -208,7 +214,10 @@ impl Scenario {
                     bail!("{file}: a mechanism needs at least one [[bodies]] entry");
                 }
                 let entries = self.entries();
-                let built = self.mechanism(gravity).and_then(|m| m.build());
+                let mut mechanism =
+                    self.mechanism(gravity).map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
+                crate::case::inputs::drive(&self.inputs, |g| self.element_list(g).len(), &mut mechanism, file)?;
+                let built = mechanism.build();
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
                 Ok((Example::from_mechanism(built, None), rows))

@@ -33,6 +33,9 @@
 //!   stable step; 4e-4 stops), ABM-4 and RATTLE at 1e-4 (theirs: 2e-4
 //!   stops ABM-4 and RATTLE is 1 m off there), generalized-α at 1e-3:
 //!   microseconds per step and milliseconds per simulated second.
+//! - Real-time figures (`realtime`): each step timed on its own over 1e5
+//!   steps — median, 99.9th percentile, maximum — for the chain at N = 10,
+//!   100, 1000 and the flyball, and a co-simulation step against a bare one.
 //! - Allocations per step, counted by the binary's global allocator.
 //!
 //! May import: `io`, `case`, and the rest of `study`.
@@ -49,6 +52,7 @@ mod chains;
 mod example1;
 mod flyball;
 mod method_costs;
+mod realtime;
 mod table;
 
 pub use chains::{ChainRun, SpatialBaseline};
@@ -59,13 +63,14 @@ pub use flyball::FlyballRun;
 use flyball::flyball_runs;
 use method_costs::method_comparisons;
 pub use method_costs::{METHODS, MethodComparison, MethodCost, PHI_EVERY};
-pub use table::table;
+pub use realtime::{Percentiles, Realtime, StepTimes, per_step, run_realtime};
+pub use table::{realtime_table, table};
 
 /// The layout of `bench.json` this code writes. 2: `schema_version`
 /// itself, `abm4_chain` and `rattle_chain` with their cost exponents, ABM-4
 /// and RATTLE on the flyball, and the methods' `iterations_per_step` (was
-/// `projection_iterations_per_step`).
-pub const SCHEMA_VERSION: u32 = 2;
+/// `projection_iterations_per_step`). 3: `realtime`.
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// What `bench.json` holds.
 #[derive(Debug, Serialize)]
@@ -104,6 +109,8 @@ pub struct Report {
     pub flyball: Vec<FlyballRun>,
     /// Over every run above, the methods' included.
     pub max_allocations_per_step: f64,
+    /// Each step timed on its own, and a co-simulation step.
+    pub realtime: Realtime,
 }
 
 /// Seconds for `runs` fresh runs of `steps` steps each (set-up untimed), and the allocations while stepping.
@@ -182,6 +189,7 @@ pub fn run(light: bool) -> Result<Report> {
         fitted_exponent(&points)
     };
     let methods = method_comparisons(light)?;
+    let realtime = run_realtime(light)?;
     let max_allocations_per_step = chain
         .iter()
         .chain(&spatial_chain)
@@ -210,5 +218,6 @@ pub fn run(light: bool) -> Result<Report> {
         rattle_chain,
         flyball,
         max_allocations_per_step,
+        realtime,
     })
 }

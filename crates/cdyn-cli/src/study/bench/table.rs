@@ -91,5 +91,32 @@ pub fn table(r: &Report) -> String {
         );
     }
     out += &format!("allocations per step (max): {}\n", r.max_allocations_per_step);
-    out
+    out + &realtime_table(&r.realtime)
+}
+
+/// The real-time rows: each step timed on its own, and a co-simulation step.
+pub fn realtime_table(r: &Realtime) -> String {
+    let mut out = "each step timed on its own (real time), µs; wall clock, then this thread's CPU time:\n".to_string();
+    out += &format!(
+        "  {:<52} {:>7} {:>8} {:>8} {:>9} {:>8} {:>8} {:>8} {:>7} {:>7} {:>6}\n",
+        "case", "steps", "median", "99.9%", "max", "cpu med", "cpu 99.9", "cpu max", "at step", "first", "allocs"
+    );
+    for t in r.step_times.iter().chain(&r.cosimulation) {
+        let (w, c) = (&t.wall, &t.cpu);
+        out += &format!(
+            "  {:<52} {:>7} {:>8.2} {:>8.2} {:>9.1} {:>8.2} {:>8.2} {:>8.1} {:>7} {:>7.1} {:>6}\n",
+            t.case,
+            t.steps,
+            w.median_us,
+            w.p999_us,
+            w.max_us,
+            c.median_us,
+            c.p999_us,
+            c.max_us,
+            c.slowest_step,
+            t.first_step_cpu_us,
+            t.allocations
+        );
+    }
+    out + &format!("co-simulation step / bare step (CPU medians): {:.2}×\n", r.cosimulation_ratio)
 }

@@ -89,6 +89,7 @@ pub(crate) fn products(pattern: &Pattern, n: usize) -> Vec<(usize, usize, usize,
 /// is solved in place, without a permuted copy. Indices are `u32`: the
 /// structure is read at every step, and half the bytes is half the memory
 /// traffic once it outgrows the caches.
+#[derive(Clone)]
 pub(crate) struct Schur {
     m: usize,
     /// `order[i]` is the original row eliminated `i`-th.

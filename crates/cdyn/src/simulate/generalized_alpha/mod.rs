@@ -194,6 +194,7 @@ pub(crate) enum Failure {
 }
 
 /// The scheme's state between steps and its buffers, allocated once per model.
+#[derive(Clone)]
 pub(crate) struct Work {
     settings: GeneralizedAlpha,
     /// Per constraint row: holonomic (its value is `Φ`) or not (`A v + b`).

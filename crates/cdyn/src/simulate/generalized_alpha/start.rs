@@ -87,6 +87,24 @@ impl Work {
         h: f64,
         evaluations: &mut u64,
     ) -> std::result::Result<(), Failure> {
+        self.restart(model, d, q, v, t, evaluations)?;
+        let Scaling { c_q, c_v, .. } = self.scaling(h);
+        newton_matrix(model, d, q, v, t, c_q, c_v, self);
+        self.lu.reserve(&self.values);
+        Ok(())
+    }
+
+    /// Starts again at `(q, v, t)` from the accelerations there, as after
+    /// an input changed the forces: `q̈`, `a`, `λ` and `Ė` of one evaluation.
+    pub(crate) fn restart(
+        &mut self,
+        model: &Model,
+        d: &mut Dynamics,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        evaluations: &mut u64,
+    ) -> std::result::Result<(), Failure> {
         *evaluations += 1;
         d.evaluate(model, q, v, t).map_err(|b| Failure::Breakdown(b, t))?;
         self.find_dropped(d);
@@ -96,9 +114,6 @@ impl Work {
         self.lambda_new.copy_from_slice(d.lambda());
         self.power = d.energy_input();
         self.started = true;
-        let Scaling { c_q, c_v, .. } = self.scaling(h);
-        newton_matrix(model, d, q, v, t, c_q, c_v, self);
-        self.lu.reserve(&self.values);
         Ok(())
     }
 

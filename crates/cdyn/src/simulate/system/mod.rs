@@ -115,6 +115,12 @@ pub trait System: Rhs<Error = EvalError> {
         let _ = (x, t, h);
         unreachable!("a system that does not offer generalized-α")
     }
+    /// Forgets what it kept of evaluations before the state `x` at time `t`
+    /// (an input changed the forces): RATTLE's evaluation at the state,
+    /// generalized-α's accelerations, which start again from `x`.
+    fn restart(&mut self, x: &[f64], t: f64) {
+        let _ = (x, t);
+    }
     /// The momenta the system keeps ([`crate::dynamics::momentum`]); none unless it finds them.
     fn symmetries(&self) -> &Symmetries {
         &NO_SYMMETRIES

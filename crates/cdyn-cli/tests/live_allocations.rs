@@ -1,0 +1,70 @@
+//! A co-simulation step allocates nothing after warm-up: the input set
+//! (changed, which restarts the scheme), a step, the outputs read — what
+//! `fmi2DoStep` with `fmi2SetReal`/`fmi2GetReal` and the C API do —
+//! counted by a global allocator, on the pendulum of
+//! `examples/pd_pendulum.toml` and that pendulum stepped by AB-3.
+
+use cdyn_cli::case::live::Live;
+use cdyn_cli::case::scenario;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::Path;
+
+struct Counting;
+
+thread_local! {
+    /// Allocations made by this thread: other threads of the test harness do not count.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn pendulum(scheme: &str) -> Live {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/pd_pendulum.toml");
+    let text = std::fs::read_to_string(&path).unwrap().replace("scheme = \"rk4\"", &format!("scheme = \"{scheme}\""));
+    let (parsed, _) = scenario::parse(&text, &path.display().to_string()).unwrap();
+    Live::from_scenario(&parsed, &path).unwrap()
+}
+
+#[test]
+fn a_cosimulation_step_allocates_nothing() {
+    for scheme in ["rk4", "ab3"] {
+        let mut live = pendulum(scheme);
+        let mut outputs = vec![0.0; live.output_names().len()];
+        let mut cosimulate = |k: usize, live: &mut Live| {
+            let before = count();
+            live.set_input(0, (k as f64 * 0.1).sin()).unwrap();
+            let set = count();
+            live.step(10).unwrap();
+            let stepped = count();
+            live.outputs(&mut outputs);
+            [set - before, stepped - set, count() - stepped]
+        };
+        for k in 0..50 {
+            assert_eq!(
+                cosimulate(k, &mut live),
+                [0, 0, 0],
+                "{scheme}: allocations by set_input, step, outputs at period {k}"
+            );
+        }
+    }
+}
