@@ -61,6 +61,20 @@ pub enum Problem {
         /// The missing body's position.
         index: usize,
     },
+    /// A coupling refers to a joint that does not exist.
+    #[error("joint {index} does not exist")]
+    NoSuchJoint {
+        /// The missing joint's position.
+        index: usize,
+    },
+    /// A joint without a coordinate of its own where one is needed.
+    #[error("joint {index} is {kind}: only revolute and prismatic joints have a coordinate to couple")]
+    NoCoordinate {
+        /// The joint's position.
+        index: usize,
+        /// Its kind.
+        kind: &'static str,
+    },
     /// An element names a body that is neither a body of the mechanism nor the ground.
     #[error("{key} = {name:?}: no body of that name (and not \"ground\")")]
     UnknownBody {

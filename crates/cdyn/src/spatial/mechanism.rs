@@ -2,15 +2,17 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
+use super::coordinate::{JointCoordinate, Mimic};
 use super::joint::{Joint, JointKind};
 use super::load::Load;
-use super::placing::{add_joint, add_load};
+use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
 use crate::ad::scalar::Scalar;
-use crate::error::{Part, Result};
-use crate::model::Model;
+use crate::error::{Part, Problem, Result};
 use crate::model::angular::Generator;
 use crate::model::force::Potential;
+use crate::model::{Model, ModelBuilder};
+use num_dual::Dual2_64;
 
 /// Bodies, joints and uniform gravity.
 ///
@@ -43,6 +45,31 @@ pub struct Mechanism {
     pub gravity: [f64; 3],
     /// Springs, dampers, forces and torques, placed at the initial pose.
     pub loads: Vec<Load>,
+    /// Joints whose coordinates are tied (URDF's `<mimic>`).
+    pub couplings: Vec<Coupling>,
+}
+
+/// A `<mimic>` coupling, one constraint row: joint `follower`'s coordinate
+/// kept at `multiplier ×` joint `leader`'s `+ offset` (both revolute or
+/// prismatic; coordinates as in [`Mechanism::joint_coordinates`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Coupling {
+    /// The joint that follows (an index into [`Mechanism::joints`]).
+    pub follower: usize,
+    /// The joint it follows.
+    pub leader: usize,
+    /// `m`
+    pub multiplier: f64,
+    /// `o`
+    pub offset: f64,
+}
+
+impl Coupling {
+    /// Joint `follower` kept at `multiplier ×` joint `leader`'s coordinate `+ offset`.
+    pub fn new(follower: usize, leader: usize, multiplier: f64, offset: f64) -> Self {
+        Self { follower, leader, multiplier, offset }
+    }
 }
 
 /// A mechanism's model, its initial state (as given, not yet projected
@@ -84,6 +111,8 @@ crate::setters!(Mechanism {
     with_gravity => gravity: [f64; 3],
     /// With these springs, dampers, forces and torques.
     with_loads => loads: Vec<Load>,
+    /// With these couplings of joint coordinates.
+    with_couplings => couplings: Vec<Coupling>,
 });
 
 impl Mechanism {
@@ -170,6 +199,93 @@ impl Mechanism {
             let at = Part::Element { index: self.joints.len() + k, kind: load.kind() };
             builder = add_load(builder, load, &poses).map_err(|e| e.at(at))?;
         }
+        for (k, coupling) in self.couplings.iter().enumerate() {
+            let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
+            builder = self.add_coupling(builder, coupling, &poses).map_err(|e| e.at(at.clone()))?;
+            rows.push(at);
+        }
         Ok(Built { model: builder.build()?, q0, v0, rows })
     }
+
+    /// Joint `index`'s coordinate and its sides, for a revolute or prismatic joint.
+    fn coordinate(&self, index: usize, poses: &[Pose]) -> Result<JointCoordinate> {
+        let joint = self.joints.get(index).ok_or(Problem::NoSuchJoint { index })?;
+        let rotary = match joint.kind {
+            JointKind::Revolute => true,
+            JointKind::Prismatic => false,
+            other => return Err(Problem::NoCoordinate { index, kind: other.name() }.into()),
+        };
+        let (a, b) = joint_frames(joint, &self.bodies, poses)?;
+        Ok(JointCoordinate { rotary, a, b })
+    }
+
+    fn add_coupling(&self, builder: ModelBuilder, c: &Coupling, poses: &[Pose]) -> Result<ModelBuilder> {
+        for (name, value) in [("multiplier", c.multiplier), ("offset", c.offset)] {
+            crate::error::finite(name, value)?;
+        }
+        let (follower, leader) = (self.coordinate(c.follower, poses)?, self.coordinate(c.leader, poses)?);
+        // The distinct bodies of both joints, and each side's slot among them.
+        let mut bodies: Vec<usize> = Vec::with_capacity(4);
+        let mut slot = |body: Option<usize>| {
+            body.map(|i| {
+                bodies.iter().position(|&b| b == i).unwrap_or_else(|| {
+                    bodies.push(i);
+                    bodies.len() - 1
+                })
+            })
+        };
+        let sides = |j: &Joint, slot: &mut dyn FnMut(Option<usize>) -> Option<usize>| [slot(Some(j.a)), slot(j.b)];
+        let (fj, lj) = (&self.joints[c.follower], &self.joints[c.leader]);
+        let follower = (follower, sides(fj, &mut slot));
+        let leader = (leader, sides(lj, &mut slot));
+        let mimic = Mimic { follower, leader, multiplier: c.multiplier, offset: c.offset };
+        let coordinates: Vec<usize> = bodies.iter().flat_map(|&b| SpatialBody::of(b).coordinates()).collect();
+        Ok(crate::with_const!(coordinates.len(), K, [7, 14, 21, 28], {
+            builder.constrain(mimic, <[usize; K]>::try_from(coordinates.as_slice()).expect("K coordinates"))
+        }))
+    }
+
+    /// The coordinate `θ` of every revolute and prismatic joint (`None` for
+    /// the others) at the state `(q, v)` with accelerations `a`: `(θ, θ̇, θ̈)`,
+    /// the angle of `a` relative to `b` about the axis (in `(−π, π]`) or
+    /// the displacement along it, from the initial pose, as URDF counts
+    /// them. One place for joint-space output and for tests against
+    /// joint-space dynamics.
+    pub fn joint_coordinates(&self, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Option<[f64; 3]>>> {
+        let poses = self.poses()?;
+        let n = 7 * self.bodies.len();
+        if q.len() != n || v.len() != n || a.len() != n {
+            let (positions, velocities) = (q.len(), v.len());
+            return Err(Problem::StateLength { positions, velocities, n }.into());
+        }
+        (0..self.joints.len())
+            .map(|k| {
+                let Ok(c) = self.coordinate(k, &poses) else { return Ok(None) };
+                let j = &self.joints[k];
+                let bodies: Vec<usize> = std::iter::once(j.a).chain(j.b).collect();
+                let path = |b: usize, i: usize| {
+                    let at = SpatialBody::of(b).first + i;
+                    Dual2_64::new(q[at], v[at], a[at])
+                };
+                let x: [Dual2_64; 14] = std::array::from_fn(|i| path(bodies[(i / 7).min(bodies.len() - 1)], i % 7));
+                let theta = c.at(&x, [Some(0), j.b.map(|_| 1)], Dual2_64::from(0.0));
+                Ok(Some([theta.re, theta.v1, theta.v2]))
+            })
+            .collect()
+    }
+
+    /// Each body's initial pose, its orientation checked.
+    fn poses(&self) -> Result<Vec<Pose>> {
+        self.bodies
+            .iter()
+            .enumerate()
+            .map(|(i, body)| {
+                let p = body.check().map_err(|e| e.at(Part::Body { index: i, name: body.name.clone() }))?;
+                Ok((body.position, p))
+            })
+            .collect()
+    }
 }
+
+/// A body's position and unit orientation.
+type Pose = ([f64; 3], [f64; 4]);

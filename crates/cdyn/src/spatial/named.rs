@@ -43,9 +43,11 @@ impl Mechanism {
                     Some(name) => resolve("b", name).map_err(|e| e.at(at.clone()))?,
                     None => None,
                 };
-                let Joint { kind, point, axis, axis_b, point_b, angle, displacement, .. } = j;
+                let Joint { kind, point, axis, axis_b, point_b, angle, displacement, damping, friction, .. } = j;
                 match (a, b) {
-                    (Some(a), b) => Ok(Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement }),
+                    (Some(a), b) => {
+                        Ok(Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement, damping, friction })
+                    }
                     // `a = "ground"`: the same joint seen from `b`, each
                     // side's point and axis going with its body, and the
                     // drives turned round.
@@ -59,6 +61,8 @@ impl Mechanism {
                         point_b: point_b.and(Some(point)),
                         angle: angle.map(negated),
                         displacement: displacement.map(negated),
+                        damping,
+                        friction,
                     }),
                     (None, None) => Err(Problem::SameBody { body: crate::planar::GROUND.to_string() }.at(at)),
                 }
@@ -93,7 +97,7 @@ impl Mechanism {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { bodies, joints, gravity, loads })
+        Ok(Self { bodies, joints, gravity, loads, couplings: Vec::new() })
     }
 }
 

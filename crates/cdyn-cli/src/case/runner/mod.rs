@@ -48,6 +48,9 @@ pub struct Case {
     /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
     /// where the model comes from entries; errors name it instead of the row.
     pub row_entries: Vec<String>,
+    /// What the model's files hold that is not modelled (a URDF's
+    /// collisions, transmissions), one line each, for the run to say.
+    pub notes: Vec<String>,
 }
 
 impl Case {
