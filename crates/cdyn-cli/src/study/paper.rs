@@ -33,6 +33,7 @@ pub fn cases() -> Result<Vec<Case>> {
                 assembly: None,
                 row_entries: Vec::new(),
                 notes: Vec::new(),
+                force_entries: Vec::new(),
             });
         }
     }

@@ -85,6 +85,10 @@ pub struct Built {
     pub v0: Vec<f64>,
     /// The part behind each constraint row.
     pub rows: Vec<Part>,
+    /// The part behind each force element, in the order the model counts
+    /// them ([`Model::most_dissipating`]): a joint's damping and friction,
+    /// a load.
+    pub forces: Vec<Part>,
 }
 
 /// How many ground joints' points the builder proposes rotations about.
@@ -143,7 +147,7 @@ impl Mechanism {
         for g in self.gravity {
             crate::error::finite("gravity", g)?;
         }
-        let mut rows = Vec::new();
+        let (mut rows, mut forces) = (Vec::new(), Vec::new());
         let names: Vec<String> = self.bodies.iter().flat_map(|b| coordinate_names(&b.name)).collect();
         let mut builder = Model::builder(mass).coordinate_names(names.clone());
         // The rigid translations: kept where nothing holds the mechanism in place.
@@ -192,19 +196,23 @@ impl Mechanism {
         }
         for (index, joint) in self.joints.iter().enumerate() {
             let at = Part::Element { index, kind: joint.kind.name() };
+            let before = builder.force_elements();
             builder = add_joint(builder, joint, &self.bodies, &poses).map_err(|e| e.at(at.clone()))?;
+            forces.extend(std::iter::repeat_n(at.clone(), builder.force_elements() - before));
             rows.extend(std::iter::repeat_n(at, joint.rows()));
         }
         for (k, load) in self.loads.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + k, kind: load.kind() };
-            builder = add_load(builder, load, &poses).map_err(|e| e.at(at))?;
+            let before = builder.force_elements();
+            builder = add_load(builder, load, &poses).map_err(|e| e.at(at.clone()))?;
+            forces.extend(std::iter::repeat_n(at, builder.force_elements() - before));
         }
         for (k, coupling) in self.couplings.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
             builder = self.add_coupling(builder, coupling, &poses).map_err(|e| e.at(at.clone()))?;
             rows.push(at);
         }
-        Ok(Built { model: builder.build()?, q0, v0, rows })
+        Ok(Built { model: builder.build()?, q0, v0, rows, forces })
     }
 
     /// Joint `index`'s coordinate and its sides, for a revolute or prismatic joint.

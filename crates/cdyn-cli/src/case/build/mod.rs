@@ -90,7 +90,7 @@ impl Scenario {
         if init.off_constraint {
             settings.consistency_tolerance = None;
         }
-        let (mut example, rows, notes) = self.example(file)?;
+        let (mut example, rows, notes, force_entries) = self.example(file)?;
         for (k, spec) in self.invariants.iter().enumerate() {
             spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
         }
@@ -150,13 +150,14 @@ impl Scenario {
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
             None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, notes })
+        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, notes, force_entries })
     }
 
     /// The model with its initial state, for mechanisms the entry
-    /// (`joints[2] (revolute)`) behind every constraint row, and what a
-    /// robot's file holds that is not modelled.
-    fn example(&self, file: &str) -> Result<(Example, Vec<String>, Vec<String>)> {
+    /// (`joints[2] (revolute)`) behind every constraint row, what a
+    /// robot's file holds that is not modelled, and the entry behind each
+    /// force element where known.
+    fn example(&self, file: &str) -> Result<(Example, Vec<String>, Vec<String>, Vec<String>)> {
         let m = &self.model;
         let mechanism_tables =
             !(self.bodies.is_empty() && self.joints.is_empty() && self.drives.is_empty() && self.forces.is_empty());
@@ -187,7 +188,7 @@ impl Scenario {
                         bail!("{file}: [model] gravity: the pendulum takes a magnitude (gravity acts along −Y)")
                     }
                 }
-                Ok((builtin(file, m.kind, "model", parameters)?, Vec::new(), Vec::new()))
+                Ok((builtin(file, m.kind, "model", parameters)?, Vec::new(), Vec::new(), Vec::new()))
             }
             Kind::Mechanism => {
                 let gravity = match m.gravity {
@@ -212,7 +213,7 @@ impl Scenario {
                 let built = self.mechanism(gravity).and_then(|m| m.build());
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
-                Ok((Example::from_mechanism(built, None), rows, Vec::new()))
+                Ok((Example::from_mechanism(built, None), rows, Vec::new(), Vec::new()))
             }
             Kind::Spatial => {
                 let gravity = match m.gravity {
@@ -231,14 +232,15 @@ impl Scenario {
                 })?;
                 let (mechanism, built) = built;
                 let rows = built.rows.iter().map(part).collect();
-                Ok((Example::from_spatial(&mechanism, built), rows, counts.notes))
+                let forces = built.forces.iter().map(part).collect();
+                Ok((Example::from_spatial(&mechanism, built), rows, counts.notes, forces))
             }
             built_in => {
                 if m.gravity.is_some() {
                     bail!("{file}: [model] gravity: this model takes its parameters in [model.parameters]");
                 }
                 let parameters = m.parameters.clone().unwrap_or_default();
-                Ok((builtin(file, built_in, "model.parameters", parameters)?, Vec::new(), Vec::new()))
+                Ok((builtin(file, built_in, "model.parameters", parameters)?, Vec::new(), Vec::new(), Vec::new()))
             }
         }
     }
