@@ -250,7 +250,9 @@ rest_length = 0.5
     // half that limit is at h ≤ 1.41e-2.
     let (line, _) = error_of(&spring("rk4", "0.05"));
     assert!(
-        line.contains("the springs are too stiff for the step: h ω = 5.000 is above rk4's stability limit on oscillations 2.828"),
+        line.contains(
+            "the springs are too stiff for the step: h ω = 5.000 is above rk4's stability limit on oscillations 2.828"
+        ),
         "{line}"
     );
     assert!(line.contains("scheme = \"generalized_alpha\" (no such limit), or h ≤ 1.41e-2"), "{line}");
@@ -275,10 +277,8 @@ fn a_robot_whose_joint_friction_is_too_stiff_for_the_default_step_is_refused_nam
     // The arm's wrist with 1 N m of friction: near rest a damper of
     // μ / s = 100 N m s on a hand of about 1e-3 kg m² about its axis.
     let arm = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/arm.urdf")).unwrap();
-    let rubbed = arm.replace(
-        "<axis xyz=\"0.6 0 0.8\"/>",
-        "<axis xyz=\"0.6 0 0.8\"/><dynamics damping=\"0\" friction=\"1\"/>",
-    );
+    let rubbed =
+        arm.replace("<axis xyz=\"0.6 0 0.8\"/>", "<axis xyz=\"0.6 0 0.8\"/><dynamics damping=\"0\" friction=\"1\"/>");
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("rubbed.urdf");
     std::fs::write(&path, rubbed).unwrap();
