@@ -263,6 +263,15 @@ fn bad_urdf_files_are_refused_naming_the_element() {
             "joint \"shoulder_pitch\": axis [0.0, 0.0, 0.0] has zero length",
         ),
     ];
+    let limited = |limit: &str| one_joint("revolute", "0 1 0", limit, "");
+    let (inverted, nan) = (
+        limited(r#"<limit lower="1" upper="-1" effort="1" velocity="1"/>"#),
+        limited(r#"<limit lower="nan" upper="1" effort="1" velocity="1"/>"#),
+    );
+    let cases = cases.into_iter().chain([
+        (&*inverted, "joint \"j\": limit lower = 1, upper = -1: lower is above upper"),
+        (&*nan, "joint \"j\": limit lower = NaN, upper = 1: a bound is not a number"),
+    ]);
     for (text, expected) in cases {
         let error = from_urdf(text, [0.0, 0.0, -G]).and_then(|m| m.build().map(|_| ())).unwrap_err().to_string();
         assert!(error.contains(expected), "{error:?} should contain {expected:?}");
@@ -399,4 +408,27 @@ fn a_mimic_joint_follows_its_leader_and_what_is_not_modelled_is_listed() {
         error.contains("joint \"k\": <mimic joint=\"nope\">: no revolute or prismatic joint of that name"),
         "{error}"
     );
+}
+
+#[test]
+fn a_urdf_limit_stops_its_joint_and_holds_it() {
+    // The block falls about y (θ grows), onto its upper limit at 0.5 rad,
+    // where its weight keeps it: one impact, held to the end.
+    let text = one_joint("revolute", "0 1 0", r#"<limit lower="-0.2" upper="0.5" effort="3" velocity="2"/>"#, "");
+    let robot = cdyn::spatial::read_urdf(&text, [0.0, 0.0, -G]).unwrap();
+    let limit = robot.mechanism.joints[0].limit.unwrap();
+    assert_eq!((limit.lower, limit.upper, limit.velocity, limit.effort), (-0.2, 0.5, 2.0, 3.0));
+    assert!(robot.notes.iter().any(|n| n.contains("limit of 1 joints")), "{:?}", robot.notes);
+    let (mechanism, built) = (&robot.mechanism, robot.mechanism.build().unwrap());
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust());
+    let mut last = [0.0; 3];
+    let events =
+        cdyn::stops::run_with_stops::<_, Error>(mechanism, settings, &built.q0, &built.v0, 1.0, 100, |_, q, v| {
+            last = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap();
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(events.len(), 1, "{events:?}");
+    assert!(matches!(events[0].change, cdyn::stops::Change::Impact { held: true, .. }));
+    assert!((last[0] - 0.5).abs() < 1e-9 && last[1].abs() < 1e-9, "{last:?}");
 }

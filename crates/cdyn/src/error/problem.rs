@@ -67,6 +67,22 @@ pub enum Problem {
         /// The missing joint's position.
         index: usize,
     },
+    /// A one-sided stop that cannot be met as asked.
+    #[error("{reason}")]
+    Stop {
+        /// Which stop and why.
+        reason: String,
+    },
+    /// A joint limit whose bounds are not numbers or not ordered.
+    #[error("limit lower = {lower}, upper = {upper}: {reason}")]
+    BadLimit {
+        /// The lower bound.
+        lower: f64,
+        /// The upper bound.
+        upper: f64,
+        /// What is wrong.
+        reason: &'static str,
+    },
     /// A joint without a coordinate of its own where one is needed.
     #[error("joint {index} is {kind}: only revolute and prismatic joints have a coordinate to couple")]
     NoCoordinate {

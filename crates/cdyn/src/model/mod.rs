@@ -10,6 +10,7 @@ pub mod angular;
 mod builder;
 pub mod constraint;
 mod definition;
+mod dissipation;
 pub mod force;
 pub mod invariant;
 pub mod kinetic;

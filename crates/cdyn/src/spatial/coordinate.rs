@@ -3,7 +3,7 @@
 //! (right-handed, in `(−π, π]`), or the displacement of `a` relative to `b`
 //! along a prismatic joint's axis, both from the initial pose (where the
 //! mechanism is assembled, `θ = 0`). It is what a `<mimic>` coupling ties
-//! ([`Mimic`]) and what joint-space output reports
+//! ([`Mimic`]), what a joint limit's stop holds ([`StopRow`]) and what joint-space output reports
 //! ([`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates));
 //! written once, generic over the scalar, so that its rate and
 //! acceleration come by dual numbers.
@@ -69,5 +69,22 @@ impl<const K: usize> Constraint<K, 1> for Mimic {
         let zero = D::from(0.0);
         let leader = self.leader.0.at(&x, self.leader.1, zero);
         [self.follower.0.at(&x, self.follower.1, leader * self.multiplier + self.offset)]
+    }
+}
+
+/// The row holding a joint at a stop of its limit: `g = s (θ − bound)`,
+/// `s = 1` at a lower bound and `−1` at an upper one (`g ≥ 0` allowed), on
+/// the coordinates of the joint's (one or two) bodies, `K = 7 ×` their number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct StopRow {
+    pub coordinate: JointCoordinate,
+    pub bound: f64,
+    pub sign: f64,
+}
+
+impl<const K: usize> Constraint<K, 1> for StopRow {
+    fn eval<D: Scalar>(&self, x: [D; K], _t: D) -> [D; 1] {
+        let b = (K == 14).then_some(1);
+        [self.coordinate.at(&x, [Some(0), b], D::from(self.bound)) * self.sign]
     }
 }

@@ -2,6 +2,7 @@
 //! between which bodies, where, and optionally driven; `joint_rows` writes
 //! its constraint rows.
 
+use super::limit::JointLimit;
 use crate::model::timefn::TimeFn;
 
 /// What a joint allows (its `kind` in scenario files).
@@ -110,6 +111,10 @@ pub struct Joint<B = usize> {
     /// an explicit step must resolve (a run checks it: see `docs/spatial.md`).
     #[cfg_attr(feature = "serde", serde(default))]
     pub friction: f64,
+    /// The range of a revolute or prismatic joint's coordinate, its ends
+    /// stops where a run halts the joint (see [`JointLimit`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub limit: Option<JointLimit>,
 }
 
 /// The slip rate of regularized joint friction ([`Joint::friction`]):
@@ -133,6 +138,7 @@ impl Joint {
             displacement: None,
             damping: 0.0,
             friction: 0.0,
+            limit: None,
         }
     }
 }
@@ -152,6 +158,8 @@ crate::setters!(impl<B> Joint<B> {
     with_damping => damping: f64,
     /// With Coulomb friction `μ`.
     with_friction => friction: f64,
+    /// With a limit.
+    with_limit => limit(Some): JointLimit,
 });
 
 impl<B> Joint<B> {
@@ -162,7 +170,20 @@ impl<B> Joint<B> {
 
     /// The same joint with its bodies passed through `f` (indices to names, say).
     pub fn map_bodies<C>(self, mut f: impl FnMut(B) -> C) -> Joint<C> {
-        let Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement, damping, friction } = self;
-        Joint { kind, a: f(a), b: b.map(f), point, axis, axis_b, point_b, angle, displacement, damping, friction }
+        let Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement, damping, friction, limit } = self;
+        Joint {
+            kind,
+            a: f(a),
+            b: b.map(f),
+            point,
+            axis,
+            axis_b,
+            point_b,
+            angle,
+            displacement,
+            damping,
+            friction,
+            limit,
+        }
     }
 }

@@ -2,8 +2,9 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
-use super::coordinate::{JointCoordinate, Mimic};
+use super::coordinate::{JointCoordinate, Mimic, StopRow};
 use super::joint::{Joint, JointKind};
+use super::limit::Stop;
 use super::load::Load;
 use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
@@ -129,6 +130,12 @@ impl Mechanism {
 
     /// The model, its initial state and the part behind each row.
     pub fn build(&self) -> Result<Built> {
+        self.build_holding(&[])
+    }
+
+    /// [`Mechanism::build`] with the stops `held` as rows `g = 0` after all
+    /// others, in that order (see [`Mechanism::stops`]).
+    pub fn build_holding(&self, held: &[Stop]) -> Result<Built> {
         let n = 7 * self.bodies.len();
         let mut mass = vec![0.0; n];
         let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
@@ -196,6 +203,10 @@ impl Mechanism {
         }
         for (index, joint) in self.joints.iter().enumerate() {
             let at = Part::Element { index, kind: joint.kind.name() };
+            if let Some(limit) = &joint.limit {
+                limit.check().map_err(|e| e.at(at.clone()))?;
+                self.coordinate(index, &poses).map_err(|e| e.at(at.clone()))?;
+            }
             let before = builder.force_elements();
             builder = add_joint(builder, joint, &self.bodies, &poses).map_err(|e| e.at(at.clone()))?;
             forces.extend(std::iter::repeat_n(at.clone(), builder.force_elements() - before));
@@ -212,6 +223,11 @@ impl Mechanism {
             builder = self.add_coupling(builder, coupling, &poses).map_err(|e| e.at(at.clone()))?;
             rows.push(at);
         }
+        for &stop in held {
+            let at = Part::Element { index: stop.joint, kind: "limit" };
+            builder = self.add_stop(builder, stop, &poses).map_err(|e| e.at(at.clone()))?;
+            rows.push(at);
+        }
         Ok(Built { model: builder.build()?, q0, v0, rows, forces })
     }
 
@@ -225,6 +241,21 @@ impl Mechanism {
         };
         let (a, b) = joint_frames(joint, &self.bodies, poses)?;
         Ok(JointCoordinate { rotary, a, b })
+    }
+
+    fn add_stop(&self, builder: ModelBuilder, stop: Stop, poses: &[Pose]) -> Result<ModelBuilder> {
+        let coordinate = self.coordinate(stop.joint, poses)?;
+        let (bound, sign, _) = self.stop_bound(stop);
+        let row = StopRow { coordinate, bound, sign };
+        let j = &self.joints[stop.joint];
+        let a = SpatialBody::of(j.a).coordinates();
+        Ok(match j.b {
+            None => builder.constrain(row, a),
+            Some(b) => {
+                let b = SpatialBody::of(b).coordinates();
+                builder.constrain(row, std::array::from_fn::<_, 14, _>(|i| if i < 7 { a[i] } else { b[i - 7] }))
+            }
+        })
     }
 
     fn add_coupling(&self, builder: ModelBuilder, c: &Coupling, poses: &[Pose]) -> Result<ModelBuilder> {
@@ -282,6 +313,47 @@ impl Mechanism {
             .collect()
     }
 
+    /// Every finite side of every joint's limit that the joint's coordinate
+    /// can meet (an angle is in `(−π, π]`: a bound at or beyond ±π is not
+    /// a stop), lower before upper, joints in order.
+    pub fn stops(&self) -> Vec<Stop> {
+        let mut out = Vec::new();
+        for (joint, j) in self.joints.iter().enumerate() {
+            let Some(l) = j.limit else { continue };
+            for (upper, bound) in [(false, l.lower), (true, l.upper)] {
+                if reachable(j.kind, bound) {
+                    out.push(Stop { joint, upper });
+                }
+            }
+        }
+        out
+    }
+
+    /// How many finite bounds no stop stands for: a revolute joint's at or beyond ±π.
+    pub fn unreachable_limits(&self) -> usize {
+        let bounds = self.joints.iter().filter_map(|j| j.limit.map(|l| (j.kind, [l.lower, l.upper])));
+        bounds.flat_map(|(kind, b)| b.map(|b| b.is_finite() && !reachable(kind, b))).filter(|&x| x).count()
+    }
+
+    /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
+    pub fn stop_bound(&self, stop: Stop) -> (f64, f64, f64) {
+        let l = self.joints[stop.joint].limit.expect("a stop's joint has a limit");
+        if stop.upper { (l.upper, -1.0, l.restitution) } else { (l.lower, 1.0, l.restitution) }
+    }
+
+    /// The gap `g = s (θ − bound)` and its rate `ġ` of each stop at `(q, v)`.
+    pub fn gaps(&self, stops: &[Stop], q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>> {
+        let theta = self.joint_coordinates(q, v, &vec![0.0; q.len()])?;
+        Ok(stops
+            .iter()
+            .map(|&s| {
+                let (bound, sign, _) = self.stop_bound(s);
+                let [x, rate, _] = theta[s.joint].expect("a stop's joint has a coordinate");
+                [sign * (x - bound), sign * rate]
+            })
+            .collect())
+    }
+
     /// Each body's initial pose, its orientation checked.
     fn poses(&self) -> Result<Vec<Pose>> {
         self.bodies
@@ -292,6 +364,13 @@ impl Mechanism {
                 Ok((body.position, p))
             })
             .collect()
+    }
+}
+
+fn reachable(kind: JointKind, bound: f64) -> bool {
+    match kind {
+        JointKind::Revolute => bound.abs() < std::f64::consts::PI,
+        _ => bound.is_finite(),
     }
 }
 

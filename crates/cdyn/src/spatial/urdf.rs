@@ -19,13 +19,17 @@
 //! `spherical` joints, a `<mimic>` of a joint that is not revolute or
 //! prismatic, a zero axis on a moving joint, and several root links.
 //!
+//! A revolute or prismatic joint's `<limit>` becomes its [`JointLimit`]
+//! (checked: NaN or inverted bounds are refused, naming the joint).
+//!
 //! Not modelled, and listed in [`UrdfRobot::notes`] (a run prints them on
 //! one line): collision and contact, transmissions, Gazebo extensions,
-//! safety controllers, calibration, and joint limits with their effort and
-//! velocity bounds.
+//! safety controllers, calibration; and the limits, which `cdyn run` does
+//! not enforce yet (the library's [`crate::stops`] does).
 
 use super::body::Body;
 use super::joint::{Joint, JointKind};
+use super::limit::JointLimit;
 use super::mechanism::{Coupling, Mechanism};
 use super::rotation::{about, compose, rotate, unrotate};
 use crate::error::{Error, Part, Problem, Result};
@@ -69,13 +73,12 @@ pub struct UrdfRobot {
 }
 
 /// The elements of a URDF file that cdyn reads past without modelling them.
-const NOT_MODELLED: [(&str, &str); 7] = [
+const NOT_MODELLED: [(&str, &str); 6] = [
     ("collision", "collision (no contact)"),
     ("transmission", "transmission"),
     ("gazebo", "gazebo"),
     ("safety_controller", "safety_controller"),
     ("calibration", "calibration"),
-    ("limit", "limit (joint limits, effort and velocity bounds)"),
     ("sensor", "sensor"),
 ];
 
@@ -131,6 +134,31 @@ fn merged(name: &str, parts: &[Body], axes: [f64; 4]) -> Option<Body> {
         }
     }
     Some(Body { inertia, position: c, orientation: axes, ..Body::new(name, mass, [1.0; 3]) })
+}
+
+/// The `<limit>` of a revolute or prismatic joint (`continuous` has none):
+/// its position range where `lower < upper` (URDF before 1.2 writes an
+/// omitted bound as 0, so `lower = upper` is no range), its velocity and
+/// effort bounds where positive (0 is URDF's "none").
+fn urdf_limit(j: &urdf_rs::Joint) -> Option<JointLimit> {
+    use urdf_rs::JointType as T;
+    if !matches!(j.joint_type, T::Revolute | T::Prismatic) {
+        return None;
+    }
+    let l = &j.limit;
+    let (lower, upper) = if l.lower == l.upper { (f64::NEG_INFINITY, f64::INFINITY) } else { (l.lower, l.upper) };
+    let bound = |x: f64| {
+        if x > 0.0 {
+            x
+        } else if x == 0.0 {
+            f64::INFINITY
+        } else {
+            x
+        }
+    };
+    let limit = JointLimit::new(lower, upper).with_velocity(bound(l.velocity)).with_effort(bound(l.effort));
+    let bounds = [limit.lower, limit.upper, limit.velocity, limit.effort];
+    (bounds.iter().any(|x| x.is_finite()) || bounds.iter().any(|x| x.is_nan())).then_some(limit)
 }
 
 /// [`from_urdf`], keeping the URDF joints' names for messages.
@@ -238,7 +266,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         notes.push(format!("{merges} massless or zero-inertia links merged into the links they are fixed to"));
     }
     let (mut joints, mut joint_names, mut mimics) = (Vec::new(), Vec::new(), Vec::new());
-    let mut still = 0;
+    let (mut still, mut limited) = (0, 0);
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
         let (damping, friction) = j.dynamics.as_ref().map_or((0.0, 0.0), |d| (d.damping, d.friction));
@@ -272,11 +300,21 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         if moves {
             joint = joint.with_damping(damping).with_friction(friction);
         }
+        if let Some(limit) = urdf_limit(j) {
+            limit.check().map_err(|e| refused("joint", &j.name, e.to_string().replace("invalid model: ", "")))?;
+            limited += 1;
+            joint = joint.with_limit(limit);
+        }
         if let Some(m) = j.mimic.as_ref().filter(|_| moves) {
             mimics.push((joints.len(), m.joint.clone(), m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0)));
         }
         joints.push(joint);
         joint_names.push(j.name.clone());
+    }
+    if limited > 0 {
+        notes.push(format!(
+            "limit of {limited} joints: checked, and held by the library's cdyn::stops, not yet by cdyn run; effort bounds (no actuators yet)"
+        ));
     }
     if still > 0 {
         notes.push(format!("<dynamics> or <mimic> of {still} fixed or floating joints (nothing to move)"));

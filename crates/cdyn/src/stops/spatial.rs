@@ -1,0 +1,32 @@
+//! A spatial mechanism's joint limits as stops: each finite side of a
+//! limit its joint can meet ([`Mechanism::stops`]).
+
+use super::run::Unilateral;
+use crate::error::Result;
+use crate::model::Model;
+use crate::spatial::Mechanism;
+
+impl Unilateral for Mechanism {
+    fn stops(&self) -> usize {
+        Mechanism::stops(self).len()
+    }
+
+    fn model_holding(&self, held: &[usize]) -> Result<Model> {
+        let stops = Mechanism::stops(self);
+        let held: Vec<_> = held.iter().map(|&k| stops[k]).collect();
+        Ok(self.build_holding(&held)?.model)
+    }
+
+    fn gaps(&self, q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>> {
+        Mechanism::gaps(self, &Mechanism::stops(self), q, v)
+    }
+
+    fn restitution(&self, stop: usize) -> f64 {
+        self.stop_bound(Mechanism::stops(self)[stop]).2
+    }
+
+    fn name(&self, stop: usize) -> String {
+        let s = Mechanism::stops(self)[stop];
+        format!("joint {}'s {} limit", s.joint, if s.upper { "upper" } else { "lower" })
+    }
+}
