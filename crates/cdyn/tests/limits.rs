@@ -73,7 +73,7 @@ fn run(scheme: Scheme, h: f64, limit: JointLimit, t_end: f64) -> (Vec<Event>, Ve
         Ok(())
     })
     .unwrap();
-    (events, samples)
+    (events.events, samples)
 }
 
 #[test]
@@ -144,11 +144,12 @@ fn a_stop_pulled_away_from_is_released() {
         .v0;
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
     let mut theta = Vec::new();
-    let events = run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 1.0, 1, |_, q, v| {
+    let report = run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 1.0, 1, |_, q, v| {
         theta.push(mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()[0]);
         Ok(())
     })
     .unwrap();
+    let events = report.events;
     let kinds: Vec<_> = events.iter().map(|e| matches!(e.change, Change::Impact { .. })).collect();
     assert_eq!(kinds[..2], [true, false], "{events:?}");
     assert_eq!(events[1].step, events[0].step + 1);

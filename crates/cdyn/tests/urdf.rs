@@ -422,13 +422,17 @@ fn a_urdf_limit_stops_its_joint_and_holds_it() {
     let (mechanism, built) = (&robot.mechanism, robot.mechanism.build().unwrap());
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust());
     let mut last = [0.0; 3];
-    let events =
+    let report =
         cdyn::stops::run_with_stops::<_, Error>(mechanism, settings, &built.q0, &built.v0, 1.0, 100, |_, q, v| {
             last = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap();
             Ok(())
         })
         .unwrap();
+    let events = &report.events;
     assert_eq!(events.len(), 1, "{events:?}");
     assert!(matches!(events[0].change, cdyn::stops::Change::Impact { held: true, .. }));
+    // Its velocity bound, 2 rad/s, is passed on the way down (reported, not enforced).
+    let [(0, ratio, t)] = report.overspeed[..] else { panic!("{:?}", report.overspeed) };
+    assert!(ratio > 1.0 && t < events[0].t, "{ratio} at {t}");
     assert!((last[0] - 0.5).abs() < 1e-9 && last[1].abs() < 1e-9, "{last:?}");
 }

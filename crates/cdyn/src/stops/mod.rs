@@ -18,6 +18,9 @@
 //! of `E₀ + ∫Ė` is the energy after the change (an impact's loss is not
 //! a violation for energy control to undo).
 //!
+//! Velocity bounds are watched, not enforced: [`Report::overspeed`] lists
+//! each coordinate that exceeded its bound, by how much and from when.
+//!
 //! The stops are seen at the end of a step: the impact is applied there
 //! (up to one step `h` late, the joint past its stop by at most `|ġ| h`,
 //! which the projection removes), and the crossing time the event reports
@@ -28,4 +31,4 @@
 mod run;
 mod spatial;
 
-pub use run::{Change, Event, Unilateral, run_with_stops};
+pub use run::{Change, Event, Report, Unilateral, run_with_stops};

@@ -19,8 +19,24 @@ pub trait Unilateral {
     fn gaps(&self, q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>>;
     /// Newton's coefficient of restitution of a stop.
     fn restitution(&self, stop: usize) -> f64;
-    /// How messages name a stop (`"joint 2 upper limit"`).
+    /// How messages name a stop (`"joint 2's upper limit"`).
     fn name(&self, stop: usize) -> String;
+    /// The coordinates moving faster than their velocity bound at `(q, v)`:
+    /// `(index, |rate| / bound)` with the ratio above 1. Reported, not enforced.
+    fn overspeed(&self, _q: &[f64], _v: &[f64]) -> Result<Vec<(usize, f64)>> {
+        Ok(Vec::new())
+    }
+}
+
+/// What a run with stops did besides its states.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub struct Report {
+    /// The stops hit and released, in order.
+    pub events: Vec<Event>,
+    /// Each coordinate that exceeded its velocity bound at a step's end:
+    /// `(index, largest |rate| / bound, first time)`, by index.
+    pub overspeed: Vec<(usize, f64, f64)>,
 }
 
 /// What happened at a stop.
@@ -64,7 +80,7 @@ pub struct Event {
 /// Steps `system` from `(q0, v0)` to `t_end` with `settings`, its stops
 /// hit, held and released as they come; `observe(t, q, v)` sees the
 /// start, every `every`-th step and the last (after a change made at that
-/// step). Returns the changes, in order.
+/// step). Returns the changes and the velocity bounds exceeded.
 pub fn run_with_stops<U: Unilateral, E: From<Error>>(
     system: &U,
     settings: Settings,
@@ -73,7 +89,7 @@ pub fn run_with_stops<U: Unilateral, E: From<Error>>(
     t_end: f64,
     every: u64,
     mut observe: impl FnMut(f64, &[f64], &[f64]) -> std::result::Result<(), E>,
-) -> std::result::Result<Vec<Event>, E> {
+) -> std::result::Result<Report, E> {
     let (steps, every, h) = (steps_to(t_end, settings.h)?, every.max(1), settings.h);
     let (mut q, mut v) = (q0.to_vec(), v0.to_vec());
     for (k, [g, _]) in system.gaps(&q, &v)?.into_iter().enumerate() {
@@ -83,6 +99,7 @@ pub fn run_with_stops<U: Unilateral, E: From<Error>>(
         }
     }
     let (mut held, mut events, mut step) = (Vec::<usize>::new(), Vec::new(), 0);
+    let mut overspeed: Vec<(usize, f64, f64)> = Vec::new();
     observe(0.0, &q, &v)?;
     while step < steps {
         let model = system.model_holding(&held)?;
@@ -97,6 +114,12 @@ pub fn run_with_stops<U: Unilateral, E: From<Error>>(
             let t = sim.t();
             (q, v) = (sim.q().to_vec(), sim.v().to_vec());
             let gaps = system.gaps(&q, &v)?;
+            for (index, ratio) in system.overspeed(&q, &v)? {
+                match overspeed.iter_mut().find(|o| o.0 == index) {
+                    Some(o) => o.1 = o.1.max(ratio),
+                    None => overspeed.push((index, ratio, t)),
+                }
+            }
             let hits: Vec<usize> = (0..gaps.len()).filter(|k| !held.contains(k) && gaps[*k][0] < 0.0).collect();
             let mut changed = !hits.is_empty();
             if hits.is_empty() && !held.is_empty() {
@@ -143,7 +166,8 @@ pub fn run_with_stops<U: Unilateral, E: From<Error>>(
             }
         }
     }
-    Ok(events)
+    overspeed.sort_by_key(|o| o.0);
+    Ok(Report { events, overspeed })
 }
 
 fn breakdown(b: Breakdown, step: u64, t: f64) -> Error {
