@@ -107,8 +107,8 @@ pub fn run_with_stops<U: Unilateral, E: From<Error>>(
         sim.resume_at(step);
         let mut dynamics = Dynamics::new(&model);
         let free_rows = model.m() - held.len();
+        let mut before = system.gaps(&q, &v)?;
         loop {
-            let before = system.gaps(sim.q(), sim.v())?;
             sim.step()?;
             step += 1;
             let t = sim.t();
@@ -164,6 +164,7 @@ pub fn run_with_stops<U: Unilateral, E: From<Error>>(
             if changed || step == steps {
                 break;
             }
+            before = gaps;
         }
     }
     overspeed.sort_by_key(|o| o.0);
