@@ -70,3 +70,9 @@ def run_precision(
     t_end: Optional[float] = None,
     light: bool = False,
 ) -> Tuple[str, str, str]: ...
+def urdf_joints(
+    path: str,
+    gravity: List[float],
+    q: List[List[float]],
+    v: List[List[float]],
+) -> Tuple[List[str], List[float], List[float], List[str], List[List[Tuple[float, float, float]]], float]: ...

@@ -191,16 +191,20 @@ fn shipped_examples_run() {
 }
 
 #[test]
-fn a_run_stopped_by_stiff_damping_names_generalized_alpha_and_a_stable_step() {
-    // The flyball governor at 1 kHz: RK-4 stops within a few steps.
+fn a_run_with_damping_too_stiff_for_its_step_is_refused_naming_the_element_generalized_alpha_and_a_stable_step() {
+    // The flyball governor at 1 kHz: RK-4 would diverge within a few steps;
+    // it does not start.
     let flyball = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/flyball_governor.toml"))
         .unwrap()
         .replace("h = 5e-5", "h = 1e-3");
     let (line, _) = error_of(&flyball);
-    assert!(line.contains("at step 4"), "{line}");
-    assert!(line.contains("scheme = \"generalized_alpha\" has no such limit"), "{line}");
     // h λ_d = 8.1 at 1e-3 and RK-4's limit 2.785: half of it at h ≤ 1.7e-4.
-    assert!(line.contains("rk4 needs h ≤ 1.71e-4"), "{line}");
+    assert!(
+        line.contains("the damping of forces[1] (spring) is too stiff for the step: h λ_d = 8.137 is above rk4's stability limit 2.785"),
+        "{line}"
+    );
+    assert!(line.contains("scheme = \"generalized_alpha\" (no such limit), or h ≤ 1.71e-4"), "{line}");
+    assert!(!line.contains("step 4"), "refused before the first step: {line}");
     // And generalized-α does run there (`tests/generalized_alpha` checks its accuracy).
     let alpha =
         flyball.replace("scheme = \"rk4\"", "scheme = \"generalized_alpha\"").replace("t_end = 2.0", "t_end = 0.05");
@@ -242,17 +246,16 @@ rest_length = 0.5
 "#
         )
     };
-    // h ω = 5, past RK-4's 2√2 on the imaginary axis: it diverges, and
+    // h ω = 5, past RK-4's 2√2 on the imaginary axis: it would diverge, and
     // half that limit is at h ≤ 1.41e-2.
     let (line, _) = error_of(&spring("rk4", "0.05"));
-    assert!(line.contains("diverged"), "{line}");
     assert!(
         line.contains(
-            "the springs are stiff against the step (h ω = 5.000; rk4's stability limit on oscillations is 2.828)"
+            "the springs are too stiff for the step: h ω = 5.000 is above rk4's stability limit on oscillations 2.828"
         ),
         "{line}"
     );
-    assert!(line.contains("scheme = \"generalized_alpha\" has no such limit, or rk4 needs h ≤ 1.41e-2"), "{line}");
+    assert!(line.contains("scheme = \"generalized_alpha\" (no such limit), or h ≤ 1.41e-2"), "{line}");
     // h ω = 2: stable, but past half the limit: a note; generalized-α runs at 0.05.
     for (scheme, h, note) in [("rk4", "0.02", true), ("rk4", "0.01", false), ("generalized_alpha", "0.05", false)] {
         let dir = tempfile::tempdir().unwrap();
@@ -380,4 +383,22 @@ fn cdyn_fmu_refuses_what_cdyn_run_refuses_and_writes_nothing() {
     }
     let out = fmu(&good, &dir.path().join("2nd.fmu"));
     assert!(String::from_utf8_lossy(&out.stderr).contains("model identifier"));
+}
+
+#[test]
+fn a_robot_whose_joint_friction_is_too_stiff_for_the_default_step_is_refused_naming_the_joint() {
+    // The arm's wrist with 1 N m of friction: near rest a damper of
+    // μ / s = 100 N m s on a hand of about 1e-3 kg m² about its axis.
+    let arm = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/arm.urdf")).unwrap();
+    let rubbed =
+        arm.replace("<axis xyz=\"0.6 0 0.8\"/>", "<axis xyz=\"0.6 0 0.8\"/><dynamics damping=\"0\" friction=\"1\"/>");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rubbed.urdf");
+    std::fs::write(&path, rubbed).unwrap();
+    let out = cdyn(&["run"], Some(&path), &dir.path().join("out"));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!out.status.success() && stderr.trim_end().lines().count() == 1, "{stderr}");
+    assert!(stderr.contains("the damping of urdf joint \"wrist\" (revolute) is too stiff for the step"), "{stderr}");
+    assert!(stderr.contains("above rk4's stability limit 2.785"), "{stderr}");
+    assert!(stderr.contains("scheme = \"generalized_alpha\""), "{stderr}");
 }

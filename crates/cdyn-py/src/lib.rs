@@ -20,6 +20,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use std::path::PathBuf;
 
+mod robot;
 mod stepping;
 
 create_exception!(_cdyn, Error, PyException, "Any error of cdyn; the message is the CLI's one line.");
@@ -357,6 +358,7 @@ fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(run_suite, m)?)?;
     m.add_function(wrap_pyfunction!(run_precision, m)?)?;
+    m.add_function(wrap_pyfunction!(robot::urdf_joints, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

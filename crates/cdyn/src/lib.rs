@@ -82,6 +82,7 @@ pub mod reference;
 pub mod simulate;
 pub mod small;
 pub mod spatial;
+pub mod stops;
 
 /// The flat paths of 0.1 (`cdyn::mass`, `cdyn::gains`, …), kept so that
 /// programs written against them still build; see `CHANGELOG.md`.

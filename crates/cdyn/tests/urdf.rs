@@ -178,7 +178,7 @@ fn the_urdf_arm_in_redundant_coordinates_follows_its_joint_space_dynamics() {
     let names: Vec<&str> = mechanism.bodies.iter().map(|b| b.name.as_str()).collect();
     assert_eq!(names, ["upper", "fore", "hand"], "the massless base and tool are no bodies");
     assert_eq!(mechanism.joints.len(), 3);
-    assert_eq!(mechanism.loads.len(), 1);
+    assert_eq!(mechanism.joints[1].damping, 0.1, "the elbow's damping is its joint's");
     let built = mechanism.build().unwrap();
     let joint_space = Model::builder(vec![0.0; 3])
         .kinetic(ArmKinetic, [0, 1, 2])
@@ -254,8 +254,9 @@ fn bad_urdf_files_are_refused_naming_the_element() {
         ("<robot name=\"x\"><link name=\"a\"/>", "not a valid URDF"),
         (&*ARM.replace("type=\"continuous\"", "type=\"planar\""), "joint \"wrist\": type planar is not supported"),
         (
-            &*ARM.replace("<dynamics damping=\"0.1\" friction=\"0\"/>", "<dynamics damping=\"0.1\" friction=\"0.5\"/>"),
-            "joint \"shoulder_pitch\": friction = 0.5",
+            &*ARM
+                .replace("<dynamics damping=\"0.1\" friction=\"0\"/>", "<dynamics damping=\"0.1\" friction=\"-0.5\"/>"),
+            "friction = -0.5",
         ),
         (
             &*ARM.replace("<child link=\"fore\"/>", "<child link=\"elbow\"/>"),
@@ -263,15 +264,15 @@ fn bad_urdf_files_are_refused_naming_the_element() {
         ),
         (
             &*ARM.replace("<mass value=\"0.8\"/>", "<mass value=\"0\"/>"),
-            "link \"hand\": has no mass but joint \"wrist\" moves it",
+            "link \"hand\": has no mass, nor has any link fixed to it, but joint \"wrist\" moves it",
         ),
-        (&*ARM.replace("<mass value=\"0.8\"/>", "<mass value=\"-0.8\"/>"), "body 2 (hand): mass = -0.8"),
+        (&*ARM.replace("<mass value=\"0.8\"/>", "<mass value=\"-0.8\"/>"), "link \"hand\": mass = -0.8"),
         (
             &*ARM.replace(
                 "ixx=\"0.001\" ixy=\"0\" ixz=\"0\" iyy=\"0.008\"",
                 "ixx=\"0.001\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\"",
             ),
-            "body 2 (hand): inertia is not physical",
+            "link \"hand\": inertia is not physical",
         ),
         (&*ARM.replace("</robot>", "<link name=\"spare\"/></robot>"), "2 root links (base_link, spare)"),
         (
@@ -279,9 +280,176 @@ fn bad_urdf_files_are_refused_naming_the_element() {
             "joint \"shoulder_pitch\": axis [0.0, 0.0, 0.0] has zero length",
         ),
     ];
+    let limited = |limit: &str| one_joint("revolute", "0 1 0", limit, "");
+    let (inverted, nan) = (
+        limited(r#"<limit lower="1" upper="-1" effort="1" velocity="1"/>"#),
+        limited(r#"<limit lower="nan" upper="1" effort="1" velocity="1"/>"#),
+    );
+    let cases = cases.into_iter().chain([
+        (&*inverted, "joint \"j\": limit lower = 1, upper = -1: lower is above upper"),
+        (&*nan, "joint \"j\": limit lower = NaN, upper = 1: a bound is not a number"),
+    ]);
     for (text, expected) in cases {
         let error = from_urdf(text, [0.0, 0.0, -G]).and_then(|m| m.build().map(|_| ())).unwrap_err().to_string();
         assert!(error.contains(expected), "{error:?} should contain {expected:?}");
         assert_eq!(error.lines().count(), 1, "{error:?}");
     }
+}
+
+/// A URDF of one link on a joint of `kind` along `axis` under the base,
+/// with `extra` inside the joint and `more` links after it.
+fn one_joint(kind: &str, axis: &str, extra: &str, more: &str) -> String {
+    format!(
+        r#"<robot name="one"><link name="base"/>
+        <joint name="j" type="{kind}"><parent link="base"/><child link="block"/>
+          <origin xyz="0 0 0.5"/><axis xyz="{axis}"/>{extra}</joint>
+        <link name="block"><inertial><origin xyz="0.2 0 0"/><mass value="2"/>
+          <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>{more}</robot>"#
+    )
+}
+
+/// The joint's coordinate and rate after `t_end` of RK-4 from rest.
+fn joint_after(text: &str, t_end: f64, h: f64) -> [f64; 3] {
+    let mechanism = from_urdf(text, [0.0, 0.0, -G]).unwrap();
+    let built = mechanism.build().unwrap();
+    let mut sim =
+        Simulation::new(&built.model, Settings::new(Scheme::RungeKutta4, h, methods::robust()), &built.q0, &built.v0)
+            .unwrap();
+    sim.run::<Error>(t_end, 1000, |_| Ok(())).unwrap();
+    let a = vec![0.0; built.model.n()];
+    mechanism.joint_coordinates(sim.q(), sim.v(), &a).unwrap()[0].unwrap()
+}
+
+#[test]
+fn a_prismatic_joint_slides_against_its_damping_and_its_regularized_friction() {
+    // A vertical slider of 2 kg under gravity (19.62 N). Damping c alone:
+    // the rate tends to −m g / c (the joint's coordinate is the
+    // displacement along +z). Friction μ above m g: it creeps at
+    // s m g / √(μ² − (m g)²), s the slip rate; below, it slides at the
+    // acceleration −(m g − μ) / m (to 0.5 % of μ once faster than 10 s).
+    let weight = 2.0 * G;
+    let damped = joint_after(&one_joint("prismatic", "0 0 1", r#"<dynamics damping="40"/>"#, ""), 1.0, 1e-3);
+    assert!((damped[1] + weight / 40.0).abs() < 1e-6 * weight / 40.0, "{damped:?}");
+    let mu = 25.0;
+    let held = joint_after(&one_joint("prismatic", "0 0 1", &format!(r#"<dynamics friction="{mu}"/>"#), ""), 1.0, 1e-4);
+    let creep = cdyn::spatial::FRICTION_SLIP * weight / (mu * mu - weight * weight).sqrt();
+    assert!((held[1] + creep).abs() < 1e-6 * creep, "{held:?} against {creep}");
+    let mu = 10.0;
+    let slides =
+        joint_after(&one_joint("prismatic", "0 0 1", &format!(r#"<dynamics friction="{mu}"/>"#), ""), 0.5, 1e-4);
+    let expected = -(weight - mu) / 2.0 * 0.5;
+    assert!((slides[1] - expected).abs() < 0.01 * expected.abs(), "{slides:?} against {expected}");
+}
+
+#[test]
+fn a_revolute_joints_friction_stops_a_swing_that_its_damping_only_slows() {
+    // The block's 0.2 m arm swings about y under gravity from horizontal.
+    let free = joint_after(&one_joint("revolute", "0 1 0", "", ""), 0.3, 1e-3);
+    let rubbed = joint_after(&one_joint("revolute", "0 1 0", r#"<dynamics friction="0.5"/>"#, ""), 0.3, 1e-4);
+    // The weight's torque at the start is m g 0.2 = 3.9 N m: 0.5 N m of
+    // friction slows it, and the rate stays of the free one's sign.
+    assert!(free[1] > 0.0 && rubbed[1] > 0.0 && rubbed[1] < free[1], "{free:?} {rubbed:?}");
+    // 5 N m holds the 3.9 N m weight to a creep at s τ / √(μ² − τ²).
+    let held = joint_after(&one_joint("revolute", "0 1 0", r#"<dynamics friction="5"/>"#, ""), 0.3, 1e-4);
+    let torque = 2.0 * G * 0.2;
+    let creep = cdyn::spatial::FRICTION_SLIP * torque / (25.0 - torque * torque).sqrt();
+    assert!((held[1] - creep).abs() < 1e-3 * creep, "{held:?} against {creep}");
+}
+
+#[test]
+fn links_without_mass_or_inertia_join_the_link_they_are_fixed_to_and_a_welds_zero_axis_is_ignored() {
+    // A point mass (zero inertia) and a massless frame fixed to the block,
+    // the frame's joint with a zero axis: one body, of the summed mass and
+    // inertia about the common centre of mass.
+    let more = r#"<joint name="tip" type="fixed"><parent link="block"/><child link="weight"/>
+          <origin xyz="0.4 0 0"/><axis xyz="0 0 0"/></joint>
+        <link name="weight"><inertial><mass value="1"/>
+          <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+        <joint name="frame" type="fixed"><parent link="weight"/><child link="camera"/><axis xyz="0 0 0"/></joint>
+        <link name="camera"/>"#;
+    let robot = cdyn::spatial::read_urdf(&one_joint("revolute", "0 1 0", "", more), [0.0, 0.0, -G]).unwrap();
+    let m = &robot.mechanism;
+    assert_eq!((m.bodies.len(), m.joints.len()), (1, 1), "{:?}", m.bodies);
+    let body = &m.bodies[0];
+    // Masses 2 at x = 0.2 and 1 at x = 0.4: centre at x = 0.8/3; the point
+    // adds m d² about y and z: 2 (0.2 − c)² + 1 (0.4 − c)².
+    let c = 0.8 / 3.0;
+    let parallel = 2.0 * (0.2f64 - c).powi(2) + (0.4f64 - c).powi(2);
+    assert_eq!(body.mass, 3.0);
+    assert!((body.position[0] - c).abs() < 1e-15 && (body.position[2] - 0.5).abs() < 1e-15, "{:?}", body.position);
+    for (k, own) in [0.01, 0.02 + parallel, 0.02 + parallel].into_iter().enumerate() {
+        assert!((body.inertia[k][k] - own).abs() < 1e-15, "{k}: {:?}", body.inertia);
+    }
+    assert!(robot.notes.iter().any(|n| n.contains("2 massless or zero-inertia links merged")), "{:?}", robot.notes);
+    m.build().unwrap();
+    // Moved by a joint, a point mass with nothing fixed to it is refused.
+    let point = one_joint("revolute", "0 1 0", "", "").replace(
+        r#"ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02""#,
+        r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0""#,
+    );
+    let error = from_urdf(&point, [0.0; 3]).unwrap_err().to_string();
+    assert!(error.contains("link \"block\": inertia must be positive definite, and joint \"j\" moves it"), "{error}");
+}
+
+#[test]
+fn a_mimic_joint_follows_its_leader_and_what_is_not_modelled_is_listed() {
+    // A second block on the first, its joint at half the first's angle plus 0.
+    let more = r#"<joint name="k" type="revolute"><parent link="block"/><child link="tip"/>
+          <origin xyz="0.4 0 0"/><axis xyz="0 1 0"/><mimic joint="j" multiplier="0.5"/>
+          <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+        <link name="tip"><inertial><origin xyz="0.1 0 0"/><mass value="1"/>
+          <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+          <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+        <transmission name="t"/>"#;
+    let text = one_joint("revolute", "0 1 0", "", more);
+    let robot = cdyn::spatial::read_urdf(&text, [0.0, 0.0, -G]).unwrap();
+    assert_eq!(robot.mechanism.couplings, [cdyn::spatial::Coupling::new(1, 0, 0.5, 0.0)]);
+    assert_eq!(robot.notes[..2], ["collision (no contact) (1 element)", "transmission (1 element)"]);
+    let built = robot.mechanism.build().unwrap();
+    let mut sim = Simulation::new(
+        &built.model,
+        Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust()),
+        &built.q0,
+        &built.v0,
+    )
+    .unwrap();
+    sim.run::<Error>(0.5, 100, |_| Ok(())).unwrap();
+    let a = vec![0.0; built.model.n()];
+    let theta = robot.mechanism.joint_coordinates(sim.q(), sim.v(), &a).unwrap();
+    let ([j, jd, _], [k, kd, _]) = (theta[0].unwrap(), theta[1].unwrap());
+    assert!(j.abs() > 0.5, "it swings: {j}");
+    assert!((k - 0.5 * j).abs() < 1e-9 && (kd - 0.5 * jd).abs() < 1e-9, "{theta:?}");
+    let bad = text.replace(r#"<mimic joint="j""#, r#"<mimic joint="nope""#);
+    let error = from_urdf(&bad, [0.0; 3]).unwrap_err().to_string();
+    assert!(
+        error.contains("joint \"k\": <mimic joint=\"nope\">: no revolute or prismatic joint of that name"),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_urdf_limit_stops_its_joint_and_holds_it() {
+    // The block falls about y (θ grows), onto its upper limit at 0.5 rad,
+    // where its weight keeps it: one impact, held to the end.
+    let text = one_joint("revolute", "0 1 0", r#"<limit lower="-0.2" upper="0.5" effort="3" velocity="2"/>"#, "");
+    let robot = cdyn::spatial::read_urdf(&text, [0.0, 0.0, -G]).unwrap();
+    let limit = robot.mechanism.joints[0].limit.unwrap();
+    assert_eq!((limit.lower, limit.upper, limit.velocity, limit.effort), (-0.2, 0.5, 2.0, 3.0));
+    assert!(robot.notes.iter().any(|n| n.contains("limit of 1 joints")), "{:?}", robot.notes);
+    let (mechanism, built) = (&robot.mechanism, robot.mechanism.build().unwrap());
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust());
+    let mut last = [0.0; 3];
+    let report =
+        cdyn::stops::run_with_stops::<_, Error>(mechanism, settings, &built.q0, &built.v0, 1.0, 100, |_, q, v| {
+            last = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap();
+            Ok(())
+        })
+        .unwrap();
+    let events = &report.events;
+    assert_eq!(events.len(), 1, "{events:?}");
+    assert!(matches!(events[0].change, cdyn::stops::Change::Impact { held: true, .. }));
+    // Its velocity bound, 2 rad/s, is passed on the way down (reported, not enforced).
+    let [(0, ratio, t)] = report.overspeed[..] else { panic!("{:?}", report.overspeed) };
+    assert!(ratio > 1.0 && t < events[0].t, "{ratio} at {t}");
+    assert!((last[0] - 0.5).abs() < 1e-9 && last[1].abs() < 1e-9, "{last:?}");
 }

@@ -15,6 +15,9 @@ pub fn run(args: CaseArgs) -> Result<Ended> {
     case.check().map_err(|e| anyhow::anyhow!("{}: {e}", scenario.display()))?;
     viewer.prepare(std::slice::from_mut(&mut case))?;
     runner::Estimate::of(std::slice::from_ref(&case)).check(&scenario.display().to_string(), case.every, force)?;
+    for note in &case.notes {
+        print(&format!("note: {note}\n"))?;
+    }
     if let Some(a) = &case.assembly {
         print(&format!("{}\n", report::assembly_line(a)))?;
     }

@@ -1,7 +1,7 @@
 //! What a set of cases leaves behind: `summary.json`, the figures, and a
 //! table on the terminal.
 
-use crate::case::runner::{Case, CaseResult, run_case};
+use crate::case::runner::{Case, CaseResult, run_case, stiffness};
 use crate::io::output;
 use crate::render::plot::{self, Figure, Scale};
 use crate::study::paper;
@@ -137,42 +137,16 @@ pub fn table(cases: &[CaseResult]) -> String {
     out
 }
 
-/// Damping or springs this close to an explicit scheme's stability limit
-/// (as a fraction of its interval) are named with the way out.
-const NEAR_STABILITY_LIMIT: f64 = 0.5;
-
 /// For a case of an explicit scheme (or RATTLE) whose damping or springs
 /// are stiff against its step — `h λ_d` beyond half the scheme's real
 /// stability interval, or `h ω` beyond half its interval on the imaginary
 /// axis — what to do: generalized-α, which has no such limit, or the
 /// explicit step that would be stable. The one nearer its limit is named.
 pub fn stiff_hint(c: &CaseResult) -> Option<String> {
-    use cdyn::control::gains::{imaginary_stability_interval, real_stability_interval};
-    let (t, scheme) = (c.tuning?, cdyn::Scheme::from_name(c.scheme)?);
-    if scheme == cdyn::Scheme::GeneralizedAlpha {
-        return None;
-    }
-    let candidates = [
-        ("the damping is", "h λ_d", t.dissipation_h, real_stability_interval(scheme), "stability limit"),
-        (
-            "the springs are",
-            "h ω",
-            t.oscillation_h,
-            imaginary_stability_interval(scheme),
-            "stability limit on oscillations",
-        ),
-    ];
-    // Euler and AB-2 grow on any oscillation, and an infinite h λ (a step
-    // of 1e308) has no step to name.
-    let (what, figure, x, limit, kind) = candidates
-        .into_iter()
-        .filter(|&(_, _, x, limit, _)| limit > 0.0 && x > NEAR_STABILITY_LIMIT * limit && x.is_finite())
-        .max_by(|a, b| (a.2 / a.3).total_cmp(&(b.2 / b.3)))?;
+    let s = stiffness::stiffest(cdyn::Scheme::from_name(c.scheme)?, c.h, &c.tuning?)?;
     Some(format!(
-        "{what} stiff against the step ({figure} = {x:.3}; {}'s {kind} is {limit:.3}): scheme = \"generalized_alpha\" has no such limit, or {} needs h ≤ {:.2e}",
-        c.scheme,
-        c.scheme,
-        NEAR_STABILITY_LIMIT * limit * c.h / x
+        "{} {} stiff against the step ({} = {:.3}; {}'s {} is {:.3}): scheme = \"generalized_alpha\" has no such limit, or {} needs h ≤ {:.2e}",
+        s.what, s.verb, s.figure, s.value, c.scheme, s.kind, s.limit, c.scheme, s.h_max
     ))
 }
 

@@ -32,6 +32,8 @@ pub fn cases() -> Result<Vec<Case>> {
                 every: 1,
                 assembly: None,
                 row_entries: Vec::new(),
+                notes: Vec::new(),
+                force_entries: Vec::new(),
             });
         }
     }

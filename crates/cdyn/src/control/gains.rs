@@ -66,6 +66,9 @@ pub struct Operators {
     /// `ω`, the fastest oscillation of the stiffness (`oscillation_frequency`
     /// in this module; 0 where it is not estimated).
     pub frequency: f64,
+    /// The force element (in the order the model's builder took them) that
+    /// dissipates most in the fastest damped motion, where known.
+    pub dissipating: Option<usize>,
 }
 
 /// What the automatic gains were chosen from, and the resulting rate × h.
@@ -91,6 +94,8 @@ pub struct Tuning {
     /// left out because that damping is stiff (`dissipation_h >
     /// STIFF_DISSIPATION_H`).
     pub energy_left_out: bool,
+    /// The force element behind `λ_d` ([`Operators::dissipating`]).
+    pub dissipating: Option<usize>,
 }
 
 /// The negative real stability interval `[−x, 0]` of a scheme: the largest
@@ -201,7 +206,16 @@ pub(crate) fn coupling<E: Evaluation>(d: &E, n: usize) -> f64 {
 /// projection onto `Φ_q w = 0` — by power iteration. 0 without
 /// velocity-dependent forces. Allocates: called once per simulation.
 pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, damping: impl FnMut(&[f64], &mut [f64])) -> f64 {
-    constrained_radius(d, n, damping)
+    constrained_mode(d, n, damping).0
+}
+
+/// [`dissipation_rate`] and its motion `w` (unit in the `M`-norm).
+pub(crate) fn dissipation_mode<E: Evaluation>(
+    d: &E,
+    n: usize,
+    damping: impl FnMut(&[f64], &mut [f64]),
+) -> (f64, Vec<f64>) {
+    constrained_mode(d, n, damping)
 }
 
 /// `ω`: the fastest oscillation of the motions the constraints allow —
@@ -210,12 +224,12 @@ pub(crate) fn dissipation_rate<E: Evaluation>(d: &E, n: usize, damping: impl FnM
 /// constraints' curvatures weighted by the multipliers) — by power
 /// iteration. Allocates: called once per simulation.
 pub(crate) fn oscillation_frequency<E: Evaluation>(d: &E, n: usize, stiffness: impl FnMut(&[f64], &mut [f64])) -> f64 {
-    constrained_radius(d, n, stiffness).sqrt()
+    constrained_mode(d, n, stiffness).0.sqrt()
 }
 
 /// The spectral radius of `P M⁻¹ A`, `A w` from `apply(w, out)`, by power
-/// iteration in the `M`-norm.
-fn constrained_radius<E: Evaluation>(d: &E, n: usize, mut apply: impl FnMut(&[f64], &mut [f64])) -> f64 {
+/// iteration in the `M`-norm, and the last iterate (its mode).
+fn constrained_mode<E: Evaluation>(d: &E, n: usize, mut apply: impl FnMut(&[f64], &mut [f64])) -> (f64, Vec<f64>) {
     let m = d.phi().len();
     let mass = d.mass();
     let (mut force, mut b, mut mw) = (vec![0.0; n], vec![0.0; m], vec![0.0; n]);
@@ -233,7 +247,7 @@ fn constrained_radius<E: Evaluation>(d: &E, n: usize, mut apply: impl FnMut(&[f6
         mass.mul(&w, &mut mw);
         let norm = w.iter().zip(&mw).map(|(a, b)| a * b).sum::<f64>().sqrt();
         if norm == 0.0 || !norm.is_finite() {
-            return rate;
+            return (rate, w);
         }
         w.iter_mut().for_each(|a| *a /= norm);
         apply(&w, &mut force);
@@ -246,13 +260,13 @@ fn constrained_radius<E: Evaluation>(d: &E, n: usize, mut apply: impl FnMut(&[f6
             break;
         }
     }
-    rate
+    (rate, w)
 }
 
 /// `control` with every automatic gain replaced by the chosen rate, and
 /// what they were chosen from.
 pub fn resolve(control: Control, scheme: Scheme, h: f64, operators: Operators) -> (Control, Tuning) {
-    let Operators { coupling, max_row_norm2, dissipation, frequency } = operators;
+    let Operators { coupling, max_row_norm2, dissipation, frequency, dissipating } = operators;
     let target = target(scheme, control.application);
     let mut c = control;
     let exact = |r: Rate| {
@@ -320,7 +334,7 @@ pub fn resolve(control: Control, scheme: Scheme, h: f64, operators: Operators) -
         e => e,
     };
     let oscillation_h = frequency * h;
-    (c, Tuning { coupling, rate_h: rate * h, target, dissipation_h, oscillation_h, energy_left_out })
+    (c, Tuning { coupling, rate_h: rate * h, target, dissipation_h, oscillation_h, energy_left_out, dissipating })
 }
 
 #[cfg(test)]

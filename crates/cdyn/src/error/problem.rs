@@ -71,6 +71,36 @@ pub enum Problem {
         /// The missing body's position.
         index: usize,
     },
+    /// A coupling refers to a joint that does not exist.
+    #[error("joint {index} does not exist")]
+    NoSuchJoint {
+        /// The missing joint's position.
+        index: usize,
+    },
+    /// A one-sided stop that cannot be met as asked.
+    #[error("{reason}")]
+    Stop {
+        /// Which stop and why.
+        reason: String,
+    },
+    /// A joint limit whose bounds are not numbers or not ordered.
+    #[error("limit lower = {lower}, upper = {upper}: {reason}")]
+    BadLimit {
+        /// The lower bound.
+        lower: f64,
+        /// The upper bound.
+        upper: f64,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// A joint without a coordinate of its own where one is needed.
+    #[error("joint {index} is {kind}: only revolute and prismatic joints have a coordinate to couple")]
+    NoCoordinate {
+        /// The joint's position.
+        index: usize,
+        /// Its kind.
+        kind: &'static str,
+    },
     /// An element names a body that is neither a body of the mechanism nor the ground.
     #[error("{key} = {name:?}: no body of that name (and not \"ground\")")]
     UnknownBody {

@@ -280,6 +280,11 @@ impl ModelBuilder {
         self
     }
 
+    /// Force elements added so far (the order [`Model::most_dissipating`] counts them in).
+    pub fn force_elements(&self) -> usize {
+        self.forces.iter().map(|b| b.elements().0).sum()
+    }
+
     /// Constraint rows added so far.
     pub fn rows(&self) -> usize {
         self.constraints.iter().map(|b| b.rows()).sum()

@@ -47,6 +47,8 @@ pub(crate) trait ForceBlock: Send + Sync {
     /// row-major) into `out` — one dual pass per coordinate, seeded in
     /// both — and returns the entries written.
     fn jacobians(&self, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, out: &mut [f64]) -> usize;
+    /// Its elements and the coordinates each reads.
+    fn elements(&self) -> (usize, usize);
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
@@ -164,6 +166,10 @@ impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
             }
         }
         self.items.len() * K * K
+    }
+
+    fn elements(&self) -> (usize, usize) {
+        (self.items.len(), K)
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {

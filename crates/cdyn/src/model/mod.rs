@@ -11,6 +11,7 @@ mod builder;
 pub mod constraint;
 mod declare;
 mod definition;
+mod dissipation;
 pub mod force;
 pub mod input;
 pub mod invariant;

@@ -242,6 +242,11 @@ impl<S: System> Stepper<S> {
     pub fn steps(&self) -> u64 {
         self.step
     }
+    /// Counts steps on from `step`, as a run restarted at `t = step · h`
+    /// with another model does ([`crate::stops`]).
+    pub(crate) fn resume_at(&mut self, step: u64) {
+        self.step = step;
+    }
     /// Current time, `step · h` (not accumulated, so it does not drift).
     pub fn t(&self) -> f64 {
         self.step as f64 * self.settings.h

@@ -171,6 +171,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
             dissipation: crate::control::gains::dissipation_rate(&self.d, N, damping),
             // Not estimated for the small systems (no stiffness hint).
             frequency: 0.0,
+            dissipating: None,
         })
     }
     fn set_control(&mut self, control: Control) {

@@ -2,6 +2,7 @@
 //! between which bodies, where, and optionally driven; `joint_rows` writes
 //! its constraint rows.
 
+use super::limit::JointLimit;
 use crate::model::timefn::TimeFn;
 
 /// What a joint allows (its `kind` in scenario files).
@@ -99,12 +100,46 @@ pub struct Joint<B = usize> {
     /// relative to `b` along the axis, from the initial pose.
     #[cfg_attr(feature = "serde", serde(default))]
     pub displacement: Option<TimeFn>,
+    /// Viscous damping of a revolute or prismatic joint: the torque (force)
+    /// `−c θ̇` between its bodies, `θ` the joint's coordinate: the angle of `a`
+    /// relative to `b` about the axis, or its displacement along it, from the initial pose.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub damping: f64,
+    /// Coulomb friction of a revolute or prismatic joint, regularized: the
+    /// torque (force) `−μ θ̇ / √(θ̇² + s²)` with the slip rate `s =`
+    /// [`FRICTION_SLIP`]. Below `s` it acts as a damper of `μ / s`, which
+    /// an explicit step must resolve (a run checks it: see `docs/spatial.md`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub friction: f64,
+    /// The range of a revolute or prismatic joint's coordinate, its ends
+    /// stops where a run halts the joint (see [`JointLimit`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub limit: Option<JointLimit>,
 }
+
+/// The slip rate of regularized joint friction ([`Joint::friction`]):
+/// 0.01 rad/s (m/s for a prismatic joint). A joint held by friction alone
+/// against a load `τ < μ` creeps at `s·τ/√(μ² − τ²)`; a sliding joint
+/// feels `μ` to 0.5 % from `10 s` on.
+pub const FRICTION_SLIP: f64 = 0.01;
 
 impl Joint {
     /// A joint of `kind` between `a` and `b` (`None`: the ground) at `point`, without axes.
     pub fn new(kind: JointKind, a: usize, b: Option<usize>, point: [f64; 3]) -> Self {
-        Self { kind, a, b, point, axis: None, axis_b: None, point_b: None, angle: None, displacement: None }
+        Self {
+            kind,
+            a,
+            b,
+            point,
+            axis: None,
+            axis_b: None,
+            point_b: None,
+            angle: None,
+            displacement: None,
+            damping: 0.0,
+            friction: 0.0,
+            limit: None,
+        }
     }
 }
 
@@ -119,6 +154,12 @@ crate::setters!(impl<B> Joint<B> {
     with_angle => angle(Some): TimeFn,
     /// Driven in displacement.
     with_displacement => displacement(Some): TimeFn,
+    /// With viscous damping `c`.
+    with_damping => damping: f64,
+    /// With Coulomb friction `μ`.
+    with_friction => friction: f64,
+    /// With a limit.
+    with_limit => limit(Some): JointLimit,
 });
 
 impl<B> Joint<B> {
@@ -129,7 +170,20 @@ impl<B> Joint<B> {
 
     /// The same joint with its bodies passed through `f` (indices to names, say).
     pub fn map_bodies<C>(self, mut f: impl FnMut(B) -> C) -> Joint<C> {
-        let Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement } = self;
-        Joint { kind, a: f(a), b: b.map(f), point, axis, axis_b, point_b, angle, displacement }
+        let Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement, damping, friction, limit } = self;
+        Joint {
+            kind,
+            a: f(a),
+            b: b.map(f),
+            point,
+            axis,
+            axis_b,
+            point_b,
+            angle,
+            displacement,
+            damping,
+            friction,
+            limit,
+        }
     }
 }

@@ -35,13 +35,13 @@ pub(crate) struct Frame {
 }
 
 /// What a joint's rows read of one side: its point and axes in space.
-trait Place<D> {
+pub(super) trait Place<D> {
     fn point(&self) -> [D; 3];
     fn axis(&self, k: usize) -> [D; 3];
 }
 
 /// One side of a joint at a state: a body's pose, or the ground.
-enum Side<'a, D> {
+pub(super) enum Side<'a, D> {
     Body { r: [D; 3], p: [D; 4], frame: &'a Frame },
     Ground(&'a Frame),
 }
@@ -109,13 +109,13 @@ impl<const N: usize> Place<JetN<N>> for Seeded<'_> {
     }
 }
 
-fn dot<D: Scalar>(a: [D; 3], b: [D; 3]) -> D {
+pub(super) fn dot<D: Scalar>(a: [D; 3], b: [D; 3]) -> D {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-const F: usize = 0;
-const G: usize = 1;
-const H: usize = 2;
+pub(super) const F: usize = 0;
+pub(super) const G: usize = 1;
+pub(super) const H: usize = 2;
 
 /// The rows of a joint of `R` rows, with its frames on both sides.
 #[derive(Debug, Clone, PartialEq)]
@@ -256,7 +256,7 @@ pub(crate) struct BodyToBody<const R: usize>(pub JointRows<R>);
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BodyToGround<const R: usize>(pub JointRows<R>);
 
-fn pose<D: Copy, const K: usize>(x: &[D; K], at: usize) -> ([D; 3], [D; 4]) {
+pub(super) fn pose<D: Copy, const K: usize>(x: &[D; K], at: usize) -> ([D; 3], [D; 4]) {
     (std::array::from_fn(|i| x[at + i]), std::array::from_fn(|i| x[at + 3 + i]))
 }
 

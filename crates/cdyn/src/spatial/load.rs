@@ -6,6 +6,7 @@
 //! are potentials (their energy is part of `V`); dampers, forces and
 //! torques are forces.
 
+use super::joint::FRICTION_SLIP;
 use super::rotation::{cross, rotate_fixed, space_rate as rate, torque_on_parameters as on_parameters};
 use crate::ad::scalar::Scalar;
 use crate::model::force::{Force, Potential};
@@ -206,11 +207,36 @@ impl Force<7> for LineDamper {
     }
 }
 
+/// A joint's resisting torque (force) at the relative rate `r`:
+/// `−c r − μ r / √(r² + s²)`, viscous damping and Coulomb friction
+/// regularized at the slip rate `s` ([`FRICTION_SLIP`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Law {
+    pub damping: f64,
+    pub friction: f64,
+}
+
+impl Law {
+    pub fn damper(damping: f64) -> Self {
+        Self { damping, friction: 0.0 }
+    }
+
+    #[inline(always)]
+    fn resist<D: Scalar>(&self, r: D) -> D {
+        let friction = if self.friction == 0.0 {
+            D::zero()
+        } else {
+            r / (r * r + FRICTION_SLIP * FRICTION_SLIP).sqrt() * self.friction
+        };
+        -(r * self.damping + friction)
+    }
+}
+
 /// A rotary damper between two bodies: reads `(p_a, p_b)`; the axis in `a`'s axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct BodyRotaryDamper {
     pub axis: [f64; 3],
-    pub c: f64,
+    pub law: Law,
 }
 
 impl Force<8> for BodyRotaryDamper {
@@ -220,7 +246,8 @@ impl Force<8> for BodyRotaryDamper {
         let h = rotate_fixed(pa, self.axis);
         let (wa, wb) = (rate(pa, va), rate(pb, vb));
         let rel = (0..3).fold(D::zero(), |s, i| s + (wb[i] - wa[i]) * h[i]);
-        let n: [D; 3] = std::array::from_fn(|i| -(rel * h[i]) * self.c);
+        let torque = self.law.resist(rel);
+        let n: [D; 3] = std::array::from_fn(|i| h[i] * torque);
         let (fa, fb) = (on_parameters(pa, n.map(|x| -x)), on_parameters(pb, n));
         std::array::from_fn(|i| if i < 4 { fa[i] } else { fb[i - 4] })
     }
@@ -230,14 +257,58 @@ impl Force<8> for BodyRotaryDamper {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct GroundRotaryDamper {
     pub axis: [f64; 3],
-    pub c: f64,
+    pub law: Law,
 }
 
 impl Force<4> for GroundRotaryDamper {
     fn force<D: Scalar>(&self, p: [D; 4], pd: [D; 4], _t: D) -> [D; 4] {
         let w = rate(p, pd);
         let rel = (0..3).fold(D::zero(), |s, i| s + w[i] * self.axis[i]);
-        on_parameters(p, self.axis.map(|h| -(rel * h) * self.c))
+        let torque = self.law.resist(rel);
+        on_parameters(p, self.axis.map(|h| torque * h))
+    }
+}
+
+/// A prismatic joint's damping and friction: the force `law(ṙ) h` on `b`
+/// at its point `sb` and its opposite on `a` at `sa`, `h` the axis carried
+/// by `a` (in its axes), `ṙ` the rate of `b`'s point relative to `a`'s
+/// along it — the joint coordinate's rate, with the sign turned, wherever
+/// the joint holds (the points then lie on the axis, which turns with both
+/// bodies alike). Between two bodies (`K = 14`) or a body and the ground
+/// (`K = 7`, `ground` set, `sb` in space).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Slide {
+    pub sa: [f64; 3],
+    pub sb: [f64; 3],
+    pub axis: [f64; 3],
+    pub ground: bool,
+    pub law: Law,
+}
+
+impl Slide {
+    fn forces<D: Scalar, const K: usize>(&self, x: [D; K], xd: [D; K]) -> [D; K] {
+        let a = body_end(&x, &xd, 0, self.sa);
+        let b = if self.ground { ground_end(self.sb) } else { body_end(&x, &xd, 7, self.sb) };
+        let h = rotate_fixed(std::array::from_fn(|i| x[3 + i]), self.axis);
+        let rel = (0..3).fold(D::zero(), |s, i| s + (b.velocity[i] - a.velocity[i]) * h[i]);
+        let f = self.law.resist(rel);
+        let on_b: [D; 3] = std::array::from_fn(|i| h[i] * f);
+        let mut out = [D::zero(); K];
+        apply(&a, on_b.map(|x| -x), &mut out, 0);
+        apply(&b, on_b, &mut out, 7);
+        out
+    }
+}
+
+impl Force<14> for Slide {
+    fn force<D: Scalar>(&self, x: [D; 14], xd: [D; 14], _t: D) -> [D; 14] {
+        self.forces(x, xd)
+    }
+}
+
+impl Force<7> for Slide {
+    fn force<D: Scalar>(&self, x: [D; 7], xd: [D; 7], _t: D) -> [D; 7] {
+        self.forces(x, xd)
     }
 }
 

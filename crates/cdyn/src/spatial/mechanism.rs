@@ -2,15 +2,18 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
+use super::coordinate::{JointCoordinate, Mimic, StopRow};
 use super::joint::{Joint, JointKind};
+use super::limit::Stop;
 use super::load::Load;
-use super::placing::{add_joint, add_load};
+use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
 use crate::ad::scalar::Scalar;
-use crate::error::{Part, Result};
-use crate::model::Model;
+use crate::error::{Part, Problem, Result};
 use crate::model::angular::Generator;
 use crate::model::force::Potential;
+use crate::model::{Model, ModelBuilder};
+use num_dual::Dual2_64;
 
 /// Bodies, joints and uniform gravity.
 ///
@@ -43,6 +46,31 @@ pub struct Mechanism {
     pub gravity: [f64; 3],
     /// Springs, dampers, forces and torques, placed at the initial pose.
     pub loads: Vec<Load>,
+    /// Joints whose coordinates are tied (URDF's `<mimic>`).
+    pub couplings: Vec<Coupling>,
+}
+
+/// A `<mimic>` coupling, one constraint row: joint `follower`'s coordinate
+/// kept at `multiplier ×` joint `leader`'s `+ offset` (both revolute or
+/// prismatic; coordinates as in [`Mechanism::joint_coordinates`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Coupling {
+    /// The joint that follows (an index into [`Mechanism::joints`]).
+    pub follower: usize,
+    /// The joint it follows.
+    pub leader: usize,
+    /// `m`
+    pub multiplier: f64,
+    /// `o`
+    pub offset: f64,
+}
+
+impl Coupling {
+    /// Joint `follower` kept at `multiplier ×` joint `leader`'s coordinate `+ offset`.
+    pub fn new(follower: usize, leader: usize, multiplier: f64, offset: f64) -> Self {
+        Self { follower, leader, multiplier, offset }
+    }
 }
 
 /// A mechanism's model, its initial state (as given, not yet projected
@@ -58,6 +86,10 @@ pub struct Built {
     pub v0: Vec<f64>,
     /// The part behind each constraint row.
     pub rows: Vec<Part>,
+    /// The part behind each force element, in the order the model counts
+    /// them ([`Model::most_dissipating`]): a joint's damping and friction,
+    /// a load.
+    pub forces: Vec<Part>,
 }
 
 /// How many ground joints' points the builder proposes rotations about.
@@ -84,6 +116,8 @@ crate::setters!(Mechanism {
     with_gravity => gravity: [f64; 3],
     /// With these springs, dampers, forces and torques.
     with_loads => loads: Vec<Load>,
+    /// With these couplings of joint coordinates.
+    with_couplings => couplings: Vec<Coupling>,
 });
 
 impl Mechanism {
@@ -96,6 +130,12 @@ impl Mechanism {
 
     /// The model, its initial state and the part behind each row.
     pub fn build(&self) -> Result<Built> {
+        self.build_holding(&[])
+    }
+
+    /// [`Mechanism::build`] with the stops `held` as rows `g = 0` after all
+    /// others, in that order (see [`Mechanism::stops`]).
+    pub fn build_holding(&self, held: &[Stop]) -> Result<Built> {
         let n = 7 * self.bodies.len();
         let mut mass = vec![0.0; n];
         let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
@@ -114,7 +154,7 @@ impl Mechanism {
         for g in self.gravity {
             crate::error::finite("gravity", g)?;
         }
-        let mut rows = Vec::new();
+        let (mut rows, mut forces) = (Vec::new(), Vec::new());
         let names: Vec<String> = self.bodies.iter().flat_map(|b| coordinate_names(&b.name)).collect();
         let mut builder = Model::builder(mass).coordinate_names(names.clone());
         // The rigid translations: kept where nothing holds the mechanism in place.
@@ -163,13 +203,176 @@ impl Mechanism {
         }
         for (index, joint) in self.joints.iter().enumerate() {
             let at = Part::Element { index, kind: joint.kind.name() };
+            if let Some(limit) = &joint.limit {
+                limit.check().map_err(|e| e.at(at.clone()))?;
+                self.coordinate(index, &poses).map_err(|e| e.at(at.clone()))?;
+            }
+            let before = builder.force_elements();
             builder = add_joint(builder, joint, &self.bodies, &poses).map_err(|e| e.at(at.clone()))?;
+            forces.extend(std::iter::repeat_n(at.clone(), builder.force_elements() - before));
             rows.extend(std::iter::repeat_n(at, joint.rows()));
         }
         for (k, load) in self.loads.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + k, kind: load.kind() };
-            builder = add_load(builder, load, &poses).map_err(|e| e.at(at))?;
+            let before = builder.force_elements();
+            builder = add_load(builder, load, &poses).map_err(|e| e.at(at.clone()))?;
+            forces.extend(std::iter::repeat_n(at, builder.force_elements() - before));
         }
-        Ok(Built { model: builder.build()?, q0, v0, rows })
+        for (k, coupling) in self.couplings.iter().enumerate() {
+            let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
+            builder = self.add_coupling(builder, coupling, &poses).map_err(|e| e.at(at.clone()))?;
+            rows.push(at);
+        }
+        for &stop in held {
+            let at = Part::Element { index: stop.joint, kind: "limit" };
+            builder = self.add_stop(builder, stop, &poses).map_err(|e| e.at(at.clone()))?;
+            rows.push(at);
+        }
+        Ok(Built { model: builder.build()?, q0, v0, rows, forces })
+    }
+
+    /// Joint `index`'s coordinate and its sides, for a revolute or prismatic joint.
+    fn coordinate(&self, index: usize, poses: &[Pose]) -> Result<JointCoordinate> {
+        let joint = self.joints.get(index).ok_or(Problem::NoSuchJoint { index })?;
+        let rotary = match joint.kind {
+            JointKind::Revolute => true,
+            JointKind::Prismatic => false,
+            other => return Err(Problem::NoCoordinate { index, kind: other.name() }.into()),
+        };
+        let (a, b) = joint_frames(joint, &self.bodies, poses)?;
+        Ok(JointCoordinate { rotary, a, b })
+    }
+
+    fn add_stop(&self, builder: ModelBuilder, stop: Stop, poses: &[Pose]) -> Result<ModelBuilder> {
+        let coordinate = self.coordinate(stop.joint, poses)?;
+        let (bound, sign, _) = self.stop_bound(stop);
+        let row = StopRow { coordinate, bound, sign };
+        let j = &self.joints[stop.joint];
+        let a = SpatialBody::of(j.a).coordinates();
+        Ok(match j.b {
+            None => builder.constrain(row, a),
+            Some(b) => {
+                let b = SpatialBody::of(b).coordinates();
+                builder.constrain(row, std::array::from_fn::<_, 14, _>(|i| if i < 7 { a[i] } else { b[i - 7] }))
+            }
+        })
+    }
+
+    fn add_coupling(&self, builder: ModelBuilder, c: &Coupling, poses: &[Pose]) -> Result<ModelBuilder> {
+        for (name, value) in [("multiplier", c.multiplier), ("offset", c.offset)] {
+            crate::error::finite(name, value)?;
+        }
+        let (follower, leader) = (self.coordinate(c.follower, poses)?, self.coordinate(c.leader, poses)?);
+        // The distinct bodies of both joints, and each side's slot among them.
+        let mut bodies: Vec<usize> = Vec::with_capacity(4);
+        let mut slot = |body: Option<usize>| {
+            body.map(|i| {
+                bodies.iter().position(|&b| b == i).unwrap_or_else(|| {
+                    bodies.push(i);
+                    bodies.len() - 1
+                })
+            })
+        };
+        let sides = |j: &Joint, slot: &mut dyn FnMut(Option<usize>) -> Option<usize>| [slot(Some(j.a)), slot(j.b)];
+        let (fj, lj) = (&self.joints[c.follower], &self.joints[c.leader]);
+        let follower = (follower, sides(fj, &mut slot));
+        let leader = (leader, sides(lj, &mut slot));
+        let mimic = Mimic { follower, leader, multiplier: c.multiplier, offset: c.offset };
+        let coordinates: Vec<usize> = bodies.iter().flat_map(|&b| SpatialBody::of(b).coordinates()).collect();
+        Ok(crate::with_const!(coordinates.len(), K, [7, 14, 21, 28], {
+            builder.constrain(mimic, <[usize; K]>::try_from(coordinates.as_slice()).expect("K coordinates"))
+        }))
+    }
+
+    /// The coordinate `θ` of every revolute and prismatic joint (`None` for
+    /// the others) at the state `(q, v)` with accelerations `a`: `(θ, θ̇, θ̈)`,
+    /// the angle of `a` relative to `b` about the axis (in `(−π, π]`) or
+    /// the displacement along it, from the initial pose, as URDF counts
+    /// them. One place for joint-space output and for tests against
+    /// joint-space dynamics.
+    pub fn joint_coordinates(&self, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Option<[f64; 3]>>> {
+        let poses = self.poses()?;
+        let n = 7 * self.bodies.len();
+        if q.len() != n || v.len() != n || a.len() != n {
+            let (positions, velocities) = (q.len(), v.len());
+            return Err(Problem::StateLength { positions, velocities, n }.into());
+        }
+        (0..self.joints.len())
+            .map(|k| {
+                let Ok(c) = self.coordinate(k, &poses) else { return Ok(None) };
+                let j = &self.joints[k];
+                let bodies: Vec<usize> = std::iter::once(j.a).chain(j.b).collect();
+                let path = |b: usize, i: usize| {
+                    let at = SpatialBody::of(b).first + i;
+                    Dual2_64::new(q[at], v[at], a[at])
+                };
+                let x: [Dual2_64; 14] = std::array::from_fn(|i| path(bodies[(i / 7).min(bodies.len() - 1)], i % 7));
+                let theta = c.at(&x, [Some(0), j.b.map(|_| 1)], Dual2_64::from(0.0));
+                Ok(Some([theta.re, theta.v1, theta.v2]))
+            })
+            .collect()
+    }
+
+    /// Every finite side of every joint's limit that the joint's coordinate
+    /// can meet (an angle is in `(−π, π]`: a bound at or beyond ±π is not
+    /// a stop), lower before upper, joints in order.
+    pub fn stops(&self) -> Vec<Stop> {
+        let mut out = Vec::new();
+        for (joint, j) in self.joints.iter().enumerate() {
+            let Some(l) = j.limit else { continue };
+            for (upper, bound) in [(false, l.lower), (true, l.upper)] {
+                if reachable(j.kind, bound) {
+                    out.push(Stop { joint, upper });
+                }
+            }
+        }
+        out
+    }
+
+    /// How many finite bounds no stop stands for: a revolute joint's at or beyond ±π.
+    pub fn unreachable_limits(&self) -> usize {
+        let bounds = self.joints.iter().filter_map(|j| j.limit.map(|l| (j.kind, [l.lower, l.upper])));
+        bounds.flat_map(|(kind, b)| b.map(|b| b.is_finite() && !reachable(kind, b))).filter(|&x| x).count()
+    }
+
+    /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
+    pub fn stop_bound(&self, stop: Stop) -> (f64, f64, f64) {
+        let l = self.joints[stop.joint].limit.expect("a stop's joint has a limit");
+        if stop.upper { (l.upper, -1.0, l.restitution) } else { (l.lower, 1.0, l.restitution) }
+    }
+
+    /// The gap `g = s (θ − bound)` and its rate `ġ` of each stop at `(q, v)`.
+    pub fn gaps(&self, stops: &[Stop], q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>> {
+        let theta = self.joint_coordinates(q, v, &vec![0.0; q.len()])?;
+        Ok(stops
+            .iter()
+            .map(|&s| {
+                let (bound, sign, _) = self.stop_bound(s);
+                let [x, rate, _] = theta[s.joint].expect("a stop's joint has a coordinate");
+                [sign * (x - bound), sign * rate]
+            })
+            .collect())
+    }
+
+    /// Each body's initial pose, its orientation checked.
+    fn poses(&self) -> Result<Vec<Pose>> {
+        self.bodies
+            .iter()
+            .enumerate()
+            .map(|(i, body)| {
+                let p = body.check().map_err(|e| e.at(Part::Body { index: i, name: body.name.clone() }))?;
+                Ok((body.position, p))
+            })
+            .collect()
     }
 }
+
+fn reachable(kind: JointKind, bound: f64) -> bool {
+    match kind {
+        JointKind::Revolute => bound.abs() < std::f64::consts::PI,
+        _ => bound.is_finite(),
+    }
+}
+
+/// A body's position and unit orientation.
+type Pose = ([f64; 3], [f64; 4]);

@@ -33,8 +33,10 @@
 
 mod body;
 mod chain;
+mod coordinate;
 mod joint;
 mod joint_rows;
+mod limit;
 mod load;
 mod mechanism;
 mod named;
@@ -47,9 +49,10 @@ mod visual;
 
 pub use body::{Body, Rotation, SpatialBody, coordinate_names};
 pub use chain::chain;
-pub use joint::{Joint, JointKind};
+pub use joint::{FRICTION_SLIP, Joint, JointKind};
+pub use limit::{JointLimit, Stop};
 pub use load::Load;
-pub use mechanism::{Built, Mechanism};
+pub use mechanism::{Built, Coupling, Mechanism};
 pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]
 pub use urdf::{UrdfRobot, from_urdf, read_urdf};

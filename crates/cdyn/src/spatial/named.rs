@@ -4,6 +4,7 @@
 
 use super::body::Body;
 use super::joint::Joint;
+use super::limit::JointLimit;
 use super::load::Load;
 use super::mechanism::Mechanism;
 use crate::error::{Error, Part, Problem, Result};
@@ -43,9 +44,22 @@ impl Mechanism {
                     Some(name) => resolve("b", name).map_err(|e| e.at(at.clone()))?,
                     None => None,
                 };
-                let Joint { kind, point, axis, axis_b, point_b, angle, displacement, .. } = j;
+                let Joint { kind, point, axis, axis_b, point_b, angle, displacement, damping, friction, limit, .. } = j;
                 match (a, b) {
-                    (Some(a), b) => Ok(Joint { kind, a, b, point, axis, axis_b, point_b, angle, displacement }),
+                    (Some(a), b) => Ok(Joint {
+                        kind,
+                        a,
+                        b,
+                        point,
+                        axis,
+                        axis_b,
+                        point_b,
+                        angle,
+                        displacement,
+                        damping,
+                        friction,
+                        limit,
+                    }),
                     // `a = "ground"`: the same joint seen from `b`, each
                     // side's point and axis going with its body, and the
                     // drives turned round.
@@ -59,6 +73,9 @@ impl Mechanism {
                         point_b: point_b.and(Some(point)),
                         angle: angle.map(|f| f.negated()),
                         displacement: displacement.map(|f| f.negated()),
+                        damping,
+                        friction,
+                        limit: limit.map(|l| JointLimit { lower: -l.upper, upper: -l.lower, ..l }),
                     }),
                     (None, None) => Err(Problem::SameBody { body: crate::planar::GROUND.to_string() }.at(at)),
                 }
@@ -93,6 +110,6 @@ impl Mechanism {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { bodies, joints, gravity, loads })
+        Ok(Self { bodies, joints, gravity, loads, couplings: Vec::new() })
     }
 }

@@ -5,7 +5,9 @@
 use super::body::{Body, SpatialBody};
 use super::joint::{Joint, JointKind};
 use super::joint_rows::{BodyToBody, BodyToGround, Frame, JointRows};
-use super::load::{BodyRotaryDamper, BodyTorque, GroundRotaryDamper, LineDamper, Load, PointForce, SpringEnergy};
+use super::load::{
+    BodyRotaryDamper, BodyTorque, GroundRotaryDamper, Law, LineDamper, Load, PointForce, Slide, SpringEnergy,
+};
 use super::rotation::{cross, unrotate};
 use crate::error::{Error, Problem, Result};
 use crate::model::ModelBuilder;
@@ -29,14 +31,11 @@ fn frame_about(h: [f64; 3]) -> [[f64; 3]; 3] {
     [f, cross(h, f), h]
 }
 
-/// Adds the rows of one joint, its points and axes carried into the
-/// bodies' frames at their initial `poses`.
-pub(super) fn add_joint(
-    builder: ModelBuilder,
-    joint: &Joint,
-    bodies: &[Body],
-    poses: &[([f64; 3], [f64; 4])],
-) -> Result<ModelBuilder> {
+/// The frames of one joint on its two sides, its points and axes carried
+/// into the bodies' axes at their initial `poses` (in space on the
+/// ground), checked: the keys its kind takes, finite points and drives,
+/// perpendicular axes of a universal joint.
+pub(super) fn joint_frames(joint: &Joint, bodies: &[Body], poses: &[([f64; 3], [f64; 4])]) -> Result<(Frame, Frame)> {
     let pose = |i: usize| poses.get(i).copied().ok_or(Error::from(Problem::NoSuchBody { index: i }));
     let (ra, pa) = pose(joint.a)?;
     if joint.b == Some(joint.a) {
@@ -93,6 +92,28 @@ pub(super) fn add_joint(
         _ => (z, z),
     };
     let point_b = joint.point_b.unwrap_or(joint.point);
+    let in_body = |(r, p): ([f64; 3], [f64; 4]), point: [f64; 3], axes: [[f64; 3]; 3]| Frame {
+        s: unrotate(p, std::array::from_fn(|i| point[i] - r[i])),
+        axes: axes.map(|x| unrotate(p, x)),
+    };
+    let fa = in_body((ra, pa), joint.point, axes_a);
+    let fb = match b {
+        Some(pose) => in_body(pose, point_b, axes_b),
+        None => Frame { s: point_b, axes: axes_b },
+    };
+    Ok((fa, fb))
+}
+
+/// Adds the rows of one joint, and its damping and friction, its points
+/// and axes carried into the bodies' frames at their initial `poses`.
+pub(super) fn add_joint(
+    builder: ModelBuilder,
+    joint: &Joint,
+    bodies: &[Body],
+    poses: &[([f64; 3], [f64; 4])],
+) -> Result<ModelBuilder> {
+    let (fa, fb) = joint_frames(joint, bodies, poses)?;
+    let point_b = joint.point_b.unwrap_or(joint.point);
     let d: [f64; 3] = std::array::from_fn(|i| point_b[i] - joint.point[i]);
     let length2 = d.iter().map(|x| x * x).sum::<f64>();
     if joint.kind == JointKind::Distance && length2 == 0.0 {
@@ -103,15 +124,6 @@ pub(super) fn add_joint(
         }
         .into());
     }
-    let in_body = |(r, p): ([f64; 3], [f64; 4]), point: [f64; 3], axes: [[f64; 3]; 3]| Frame {
-        s: unrotate(p, std::array::from_fn(|i| point[i] - r[i])),
-        axes: axes.map(|x| unrotate(p, x)),
-    };
-    let fa = in_body((ra, pa), joint.point, axes_a);
-    let fb = match b {
-        Some(pose) => in_body(pose, point_b, axes_b),
-        None => Frame { s: point_b, axes: axes_b },
-    };
     let a_at = SpatialBody::of(joint.a).coordinates();
     macro_rules! add {
         ($r:literal) => {{
@@ -133,12 +145,48 @@ pub(super) fn add_joint(
             }
         }};
     }
-    Ok(match joint.rows() {
+    let builder = match joint.rows() {
         1 => add!(1),
         3 => add!(3),
         4 => add!(4),
         5 => add!(5),
         _ => add!(6),
+    };
+    add_joint_law(builder, joint, fa, fb)
+}
+
+/// A revolute or prismatic joint's damping and friction, as a torque about
+/// (a force along) its axis, carried by `a`, between its bodies.
+fn add_joint_law(builder: ModelBuilder, joint: &Joint, fa: Frame, fb: Frame) -> Result<ModelBuilder> {
+    let law = Law {
+        damping: crate::error::non_negative("damping", joint.damping)?,
+        friction: crate::error::non_negative("friction", joint.friction)?,
+    };
+    if law.damping == 0.0 && law.friction == 0.0 {
+        return Ok(builder);
+    }
+    let (a_at, b_at) = (SpatialBody::of(joint.a), joint.b.map(SpatialBody::of));
+    Ok(match (joint.kind, b_at) {
+        (JointKind::Revolute, Some(b)) => {
+            let (pa, pb) = (a_at.euler_parameters(), b.euler_parameters());
+            let at: [usize; 8] = std::array::from_fn(|i| if i < 4 { pa[i] } else { pb[i - 4] });
+            builder.force(BodyRotaryDamper { axis: fa.axes[2], law }, at)
+        }
+        (JointKind::Revolute, None) => {
+            builder.force(GroundRotaryDamper { axis: fb.axes[2], law }, a_at.euler_parameters())
+        }
+        (JointKind::Prismatic, Some(b)) => {
+            let (ca, cb) = (a_at.coordinates(), b.coordinates());
+            let at: [usize; 14] = std::array::from_fn(|i| if i < 7 { ca[i] } else { cb[i - 7] });
+            builder.force(Slide { sa: fa.s, sb: fb.s, axis: fa.axes[2], ground: false, law }, at)
+        }
+        (JointKind::Prismatic, None) => {
+            builder.force(Slide { sa: fa.s, sb: fb.s, axis: fa.axes[2], ground: true, law }, a_at.coordinates())
+        }
+        (kind, _) => {
+            let key = if law.damping != 0.0 { "damping" } else { "friction" };
+            return Err(Problem::JointKey { key, kind: kind.name(), wanted: false }.into());
+        }
     })
 }
 
@@ -204,9 +252,9 @@ pub(super) fn add_load(builder: ModelBuilder, load: &Load, poses: &[([f64; 3], [
                     pose(b)?;
                     let b_at = SpatialBody::of(b).euler_parameters();
                     let at: [usize; 8] = std::array::from_fn(|i| if i < 4 { a_at[i] } else { b_at[i - 4] });
-                    builder.force(BodyRotaryDamper { axis: unrotate(pa, axis), c: damping }, at)
+                    builder.force(BodyRotaryDamper { axis: unrotate(pa, axis), law: Law::damper(damping) }, at)
                 }
-                None => builder.force(GroundRotaryDamper { axis, c: damping }, a_at),
+                None => builder.force(GroundRotaryDamper { axis, law: Law::damper(damping) }, a_at),
             }
         }
         Load::Force { body, force, point } => {

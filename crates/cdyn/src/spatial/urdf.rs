@@ -5,26 +5,36 @@
 //! where every joint is at 0. The root link is the ground (a fixed base).
 //! Joints become joints at their origin: `revolute` and `continuous` →
 //! revolute, `prismatic` → prismatic, `fixed` → fixed (a weld), `floating`
-//! → none (a free body). A massless link is allowed only behind `fixed`
-//! joints (a frame: what hangs on it hangs on its nearest massive
-//! ancestor). A revolute joint's `<dynamics damping>` becomes a rotary
-//! damper. A link's `<visual>` boxes, cylinders and spheres are what its
-//! body looks like in 3-D views (meshes are not read: a body without
-//! primitive visuals is drawn as the box of its inertia).
+//! → none (a free body); their `<dynamics damping friction>` become the
+//! joint's viscous damping and (regularized) Coulomb friction, and a
+//! `<mimic>` a [`Coupling`] of the two joints' coordinates. A link's
+//! `<visual>` boxes, cylinders and spheres are what its body looks like in
+//! 3-D views (meshes are not read: a body without primitive visuals is
+//! drawn as the box of its inertia).
 //!
-//! Refused, with the element named: `planar` and `spherical` URDF joints,
-//! `<mimic>`, Coulomb `friction`, damping on a prismatic joint, a massless
-//! link moved by a joint, and several root links. Not modelled (documented,
-//! not refused, since nearly every robot file has them): joint limits,
-//! effort and velocity bounds, safety controllers and calibration — cdyn
-//! simulates the free dynamics; loop closures, drives and limits are for
-//! the scenario to add.
+//! A link that cannot be a body on its own — no mass, or an inertia that
+//! is not positive definite and physical (a sensor frame, a point mass) —
+//! is merged into the link it is fixed to (its mass, centre of mass and
+//! inertia added to that link's), and a link moved by a joint takes in the
+//! links fixed to it while it cannot be a body alone. A link fixed to the
+//! root is part of the ground. Refused, with the element named: a moved
+//! link that has no mass or no usable inertia even then, `planar` and
+//! `spherical` joints, a `<mimic>` of a joint that is not revolute or
+//! prismatic, a zero axis on a moving joint, and several root links.
+//!
+//! A revolute or prismatic joint's `<limit>` becomes its [`JointLimit`]
+//! (checked: NaN or inverted bounds are refused, naming the joint).
+//!
+//! Not modelled, and listed in [`UrdfRobot::notes`] (a run prints them on
+//! one line): collision and contact, transmissions, Gazebo extensions,
+//! safety controllers, calibration; and the limits, which `cdyn run` does
+//! not enforce yet (the library's [`crate::stops`] does).
 
 use super::body::Body;
 use super::joint::{Joint, JointKind};
-use super::load::Load;
-use super::mechanism::Mechanism;
-use super::rotation::{about, compose, rotate};
+use super::limit::JointLimit;
+use super::mechanism::{Coupling, Mechanism};
+use super::rotation::{about, compose, rotate, unrotate};
 use super::visual::{Shape, Visual};
 use crate::error::{Error, Part, Problem, Result};
 use std::collections::HashMap;
@@ -55,13 +65,104 @@ pub fn from_urdf(text: &str, gravity: [f64; 3]) -> Result<Mechanism> {
 /// A URDF robot as a mechanism, with the URDF's names of its parts (the
 /// bodies carry their links' names themselves).
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct UrdfRobot {
     /// The mechanism.
     pub mechanism: Mechanism,
     /// The URDF joint behind each of the mechanism's joints.
     pub joint_names: Vec<String>,
-    /// The URDF joint whose damping each of the mechanism's loads is.
-    pub load_names: Vec<String>,
+    /// What the file holds that cdyn does not model, one phrase each
+    /// (`"collision (12 elements)"`), for a run to print.
+    pub notes: Vec<String>,
+}
+
+/// The elements of a URDF file that cdyn reads past without modelling them.
+const NOT_MODELLED: [(&str, &str); 6] = [
+    ("collision", "collision (no contact)"),
+    ("transmission", "transmission"),
+    ("gazebo", "gazebo"),
+    ("safety_controller", "safety_controller"),
+    ("calibration", "calibration"),
+    ("sensor", "sensor"),
+];
+
+/// How many elements `<tag …>` the text holds.
+fn count_elements(text: &str, tag: &str) -> usize {
+    let open = format!("<{tag}");
+    text.match_indices(&open)
+        .filter(|(at, _)| text[at + open.len()..].starts_with(|c: char| c.is_whitespace() || c == '>' || c == '/'))
+        .count()
+}
+
+/// A link's own body, if it has a mass: centre of mass, axes and inertia from its `<inertial>`.
+fn own_body(link: &urdf_rs::Link, pose: Pose) -> Option<Body> {
+    let inertial = &link.inertial;
+    if inertial.mass.value == 0.0 {
+        return None;
+    }
+    let (r, p) = then(pose, &inertial.origin);
+    let i = &inertial.inertia;
+    Some(Body {
+        inertia: [[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]],
+        position: r,
+        orientation: p,
+        ..Body::new(&link.name, inertial.mass.value, [1.0; 3])
+    })
+}
+
+/// The rigid body of several links' bodies, in the axes `axes`: total
+/// mass, centre of mass, and inertia about it (parallel-axis theorem).
+fn merged(name: &str, parts: &[Body], axes: [f64; 4]) -> Option<Body> {
+    let mass: f64 = parts.iter().map(|b| b.mass).sum();
+    if mass == 0.0 {
+        return None;
+    }
+    let c: [f64; 3] = std::array::from_fn(|k| parts.iter().map(|b| b.mass * b.position[k]).sum::<f64>() / mass);
+    let mut inertia = [[0.0; 3]; 3];
+    for b in parts {
+        // The part's inertia in `axes`: R Jᵢ Rᵀ with R from its axes to `axes`.
+        let columns: [[f64; 3]; 3] = std::array::from_fn(|k| {
+            let e = std::array::from_fn(|i| f64::from(u8::from(i == k)));
+            unrotate(axes, rotate(b.orientation, e))
+        });
+        let d = unrotate(axes, std::array::from_fn(|k| b.position[k] - c[k]));
+        let d2 = d.iter().map(|x| x * x).sum::<f64>();
+        for (i, row) in inertia.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                let turned: f64 = (0..3)
+                    .flat_map(|k| (0..3).map(move |l| (k, l)))
+                    .map(|(k, l)| columns[k][i] * b.inertia[k][l] * columns[l][j])
+                    .sum();
+                *x += turned + b.mass * (if i == j { d2 } else { 0.0 } - d[i] * d[j]);
+            }
+        }
+    }
+    Some(Body { inertia, position: c, orientation: axes, ..Body::new(name, mass, [1.0; 3]) })
+}
+
+/// The `<limit>` of a revolute or prismatic joint (`continuous` has none):
+/// its position range where `lower < upper` (URDF before 1.2 writes an
+/// omitted bound as 0, so `lower = upper` is no range), its velocity and
+/// effort bounds where positive (0 is URDF's "none").
+fn urdf_limit(j: &urdf_rs::Joint) -> Option<JointLimit> {
+    use urdf_rs::JointType as T;
+    if !matches!(j.joint_type, T::Revolute | T::Prismatic) {
+        return None;
+    }
+    let l = &j.limit;
+    let (lower, upper) = if l.lower == l.upper { (f64::NEG_INFINITY, f64::INFINITY) } else { (l.lower, l.upper) };
+    let bound = |x: f64| {
+        if x > 0.0 {
+            x
+        } else if x == 0.0 {
+            f64::INFINITY
+        } else {
+            x
+        }
+    };
+    let limit = JointLimit::new(lower, upper).with_velocity(bound(l.velocity)).with_effort(bound(l.effort));
+    let bounds = [limit.lower, limit.upper, limit.velocity, limit.effort];
+    (bounds.iter().any(|x| x.is_finite()) || bounds.iter().any(|x| x.is_nan())).then_some(limit)
 }
 
 /// [`from_urdf`], keeping the URDF joints' names for messages.
@@ -94,8 +195,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         }
     };
     // Link poses at zero joint positions, parents first.
-    let mut pose: Vec<Option<Pose>> = vec![None; robot.links.len()];
-    pose[root] = Some(([0.0; 3], [1.0, 0.0, 0.0, 0.0]));
+    let mut pose: Vec<Pose> = vec![([0.0; 3], [1.0, 0.0, 0.0, 0.0]); robot.links.len()];
     let mut order = vec![root];
     let mut next = 0;
     while next < order.len() {
@@ -103,7 +203,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         next += 1;
         for j in robot.joints.iter().filter(|j| link_index[j.parent.link.as_str()] == link) {
             let child = link_index[j.child.link.as_str()];
-            pose[child] = pose[link].map(|p| then(p, &j.origin));
+            pose[child] = then(pose[link], &j.origin);
             order.push(child);
         }
     }
@@ -113,46 +213,67 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         }
         .into());
     }
-    // Bodies: the massive links but the root.
-    let mut body_of: Vec<Option<usize>> = vec![None; robot.links.len()];
-    let mut bodies = Vec::new();
-    for &l in &order[1..] {
-        let link = &robot.links[l];
-        let inertial = &link.inertial;
-        if inertial.mass.value == 0.0 {
-            continue;
-        }
-        let (r, p) = then(pose[l].expect("every link reached"), &inertial.origin);
-        let i = &inertial.inertia;
-        body_of[l] = Some(bodies.len());
-        bodies.push(Body {
-            inertia: [[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]],
-            position: r,
-            orientation: p,
-            ..Body::new(&link.name, inertial.mass.value, [1.0; 3])
-        });
-    }
-    // What carries a link: itself if massive, else its parent's carrier through a fixed joint.
-    let mut carrier: Vec<Option<usize>> = vec![None; robot.links.len()];
-    let (mut joints, mut loads) = (Vec::new(), Vec::new());
-    let (mut joint_names, mut load_names) = (Vec::new(), Vec::new());
+    // Which link's body each link joins (`head`): its own, unless it is
+    // fixed to its parent and cannot be a body alone, or its parent's
+    // head cannot; the root's is the ground.
+    let own: Vec<Option<Body>> = robot.links.iter().zip(&pose).map(|(l, &p)| own_body(l, p)).collect();
+    let usable = |l: usize| own[l].as_ref().is_some_and(|b| b.check().is_ok());
+    let mut head: Vec<usize> = (0..robot.links.len()).collect();
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
-        let parent = carrier[link_index[j.parent.link.as_str()]];
-        let (origin, frame) = pose[l].expect("every link reached");
-        let axis = rotate(frame, j.axis.xyz.0);
-        let moves = !matches!(j.joint_type, urdf_rs::JointType::Fixed | urdf_rs::JointType::Floating);
-        let length = j.axis.xyz.0.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if moves && !(length > 0.0 && length.is_finite()) {
-            return Err(refused("joint", &j.name, format!("axis {:?} has zero length", j.axis.xyz.0)));
+        let up = head[link_index[j.parent.link.as_str()]];
+        // The ground takes what cannot be a body; a body what cannot be one, or all while it cannot.
+        let merge = !usable(l) || (up != root && !usable(up));
+        if j.joint_type == urdf_rs::JointType::Fixed && merge {
+            head[l] = up;
         }
-        if j.mimic.is_some() {
-            return Err(refused("joint", &j.name, "<mimic> is not supported".into()));
+    }
+    let mut bodies = Vec::new();
+    let mut body_of: Vec<Option<usize>> = vec![None; robot.links.len()];
+    let mut merges = 0;
+    for &h in order[1..].iter().filter(|&&l| head[l] == l) {
+        let members: Vec<usize> = order.iter().copied().filter(|&l| head[l] == h).collect();
+        merges += members.len() - 1;
+        let parts: Vec<Body> = members.iter().filter_map(|&l| own[l].clone()).collect();
+        let name = &robot.links[h].name;
+        let axes = own[h].as_ref().map_or(pose[h].1, |b| b.orientation);
+        let joint = &robot.joints[parent_joint[h].expect("not the root")].name;
+        let Some(body) = (if members.len() == 1 { own[h].clone() } else { merged(name, &parts, axes) }) else {
+            return Err(refused(
+                "link",
+                name,
+                format!(
+                    "has no mass, nor has any link fixed to it, but joint {joint:?} moves it: give it an <inertial>"
+                ),
+            ));
+        };
+        if let Err(e) = body.check() {
+            let e = match e {
+                Error::InvalidModel { problem, .. } => problem.to_string(),
+                Error::InvalidParameter { name, value, reason } => format!("{name} = {value}: {reason}"),
+                other => other.to_string(),
+            };
+            let with = if parts.len() > 1 { " (with the links fixed to it)" } else { "" };
+            return Err(refused("link", name, format!("{e}{with}, and joint {joint:?} moves it")));
         }
+        body_of[h] = Some(bodies.len());
+        bodies.push(body);
+    }
+    let mut notes: Vec<String> = NOT_MODELLED
+        .iter()
+        .filter_map(|&(tag, what)| match count_elements(text, tag) {
+            0 => None,
+            n => Some(format!("{what} ({n} element{})", if n == 1 { "" } else { "s" })),
+        })
+        .collect();
+    if merges > 0 {
+        notes.push(format!("{merges} massless or zero-inertia links merged into the links they are fixed to"));
+    }
+    let (mut joints, mut joint_names, mut mimics) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut still, mut limited) = (0, 0);
+    for &l in &order[1..] {
+        let j = &robot.joints[parent_joint[l].expect("not the root")];
         let (damping, friction) = j.dynamics.as_ref().map_or((0.0, 0.0), |d| (d.damping, d.friction));
-        if friction != 0.0 {
-            return Err(refused("joint", &j.name, format!("friction = {friction}: Coulomb friction is not supported")));
-        }
         use urdf_rs::JointType as T;
         let kind = match j.joint_type {
             T::Revolute | T::Continuous => Some(JointKind::Revolute),
@@ -167,38 +288,71 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
                 ));
             }
         };
-        if damping != 0.0 && kind != Some(JointKind::Revolute) {
-            return Err(refused("joint", &j.name, format!("damping = {damping} is supported on revolute joints only")));
+        let moves = matches!(kind, Some(JointKind::Revolute | JointKind::Prismatic));
+        still += usize::from(!moves && (damping != 0.0 || friction != 0.0 || j.mimic.is_some()));
+        let length = j.axis.xyz.0.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if moves && !(length > 0.0 && length.is_finite()) {
+            return Err(refused("joint", &j.name, format!("axis {:?} has zero length", j.axis.xyz.0)));
         }
-        let Some(child) = body_of[l] else {
-            if kind == Some(JointKind::Fixed) {
-                carrier[l] = parent;
-                continue;
-            }
-            return Err(refused(
-                "link",
-                &robot.links[l].name,
-                format!("has no mass but joint {:?} moves it: give it an <inertial>", j.name),
-            ));
-        };
-        carrier[l] = Some(child);
-        if let Some(kind) = kind {
-            let joint = Joint::new(kind, child, parent, origin);
-            joints.push(if kind == JointKind::Spherical { joint } else { joint.with_axis(axis) });
-            joint_names.push(j.name.clone());
+        let Some(child) = body_of[l] else { continue }; // merged into its parent's body
+        let parent = body_of[head[link_index[j.parent.link.as_str()]]];
+        let Some(kind) = kind else { continue }; // floating: a free body
+        let (origin, frame) = pose[l];
+        // A weld's axis only orients its frame: any will do (URDF's may be zero).
+        let axis = if moves { rotate(frame, j.axis.xyz.0) } else { [0.0, 0.0, 1.0] };
+        let mut joint = Joint::new(kind, child, parent, origin).with_axis(axis);
+        if moves {
+            joint = joint.with_damping(damping).with_friction(friction);
         }
-        if damping != 0.0 {
-            loads.push(Load::RotaryDamper { a: child, b: parent, axis, damping });
-            load_names.push(j.name.clone());
+        if let Some(limit) = urdf_limit(j) {
+            limit.check().map_err(|e| refused("joint", &j.name, e.to_string().replace("invalid model: ", "")))?;
+            limited += 1;
+            joint = joint.with_limit(limit);
         }
+        if let Some(m) = j.mimic.as_ref().filter(|_| moves) {
+            mimics.push((joints.len(), m.joint.clone(), m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0)));
+        }
+        joints.push(joint);
+        joint_names.push(j.name.clone());
     }
+    if limited > 0 {
+        notes.push(format!(
+            "limit of {limited} joints: checked, and held by the library's cdyn::stops, not yet by cdyn run; effort bounds (no actuators yet)"
+        ));
+    }
+    if still > 0 {
+        notes.push(format!("<dynamics> or <mimic> of {still} fixed or floating joints (nothing to move)"));
+    }
+    let couplings = mimics
+        .into_iter()
+        .map(|(follower, leader, multiplier, offset)| {
+            let at = joint_names.iter().position(|n| *n == leader);
+            match at.filter(|&k| joints[k].kind != JointKind::Fixed) {
+                Some(leader) => Ok(Coupling::new(follower, leader, multiplier, offset)),
+                None => Err(refused(
+                    "joint",
+                    &joint_names[follower],
+                    format!("<mimic joint={leader:?}>: no revolute or prismatic joint of that name"),
+                )),
+            }
+        })
+        .collect::<Result<Vec<_>>>()?;
+    // What each link looks like, on the body it joins (none on the ground's).
     for &l in &order[1..] {
-        if let (Some(b), Some(at)) = (carrier[l], pose[l]) {
+        if let Some(b) = body_of[head[l]] {
             let body = (bodies[b].position, bodies[b].orientation);
+            let at = pose[l];
             bodies[b].visuals.extend(visuals(&robot.links[l]).map(|(v, origin)| v.into_body(then(at, origin), body)));
         }
     }
-    Ok(UrdfRobot { mechanism: Mechanism { bodies, joints, gravity, loads }, joint_names, load_names })
+    let mechanism = Mechanism::new(gravity).with_bodies(bodies).with_joints(joints).with_couplings(couplings);
+    let unreachable = mechanism.unreachable_limits();
+    if unreachable > 0 {
+        notes.push(format!(
+            "{unreachable} revolute limit bounds at or beyond ±π (no stop: the angle is measured in (−π, π])"
+        ));
+    }
+    Ok(UrdfRobot { mechanism, joint_names, notes })
 }
 
 /// A link's `<visual>` boxes, cylinders and spheres (a capsule as the

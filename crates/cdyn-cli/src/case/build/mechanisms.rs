@@ -20,7 +20,7 @@ impl Scenario {
         gravity: [f64; 3],
     ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, Counts)> {
         let mut robot = cdyn::spatial::Mechanism::default();
-        let (mut joint_names, mut load_names) = (Vec::new(), Vec::new());
+        let (mut joint_names, mut notes) = (Vec::new(), Vec::new());
         match self.model.pendulum_keys.get("urdf") {
             None => {}
             Some(toml::Value::String(name)) => {
@@ -28,7 +28,15 @@ impl Scenario {
                 let text = read_bounded(&path).map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
                 let read = cdyn::spatial::read_urdf(&text, gravity)
                     .map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
-                (robot, joint_names, load_names) = (read.mechanism, read.joint_names, read.load_names);
+                (robot, joint_names) = (read.mechanism, read.joint_names);
+                if robot.bodies.is_empty() {
+                    bail!(
+                        "{file}: [model] urdf = {name:?}: no link but the root (the fixed base) has a mass: nothing moves"
+                    );
+                }
+                if !read.notes.is_empty() {
+                    notes.push(format!("{name}: not modelled: {}", read.notes.join(", ")));
+                }
             }
             Some(other) => bail!("{file}: [model] urdf = {other}: expected the path of a URDF file"),
         }
@@ -40,30 +48,26 @@ impl Scenario {
         let name = |i: usize| robot.bodies[i].name.clone();
         let mut joints: Vec<cdyn::spatial::Joint<String>> =
             robot.joints.iter().map(|j| j.clone().map_bodies(name)).collect();
-        let robot_loads: Vec<cdyn::spatial::Load<String>> = robot
-            .loads
-            .iter()
-            .map(|l| match l {
-                cdyn::spatial::Load::RotaryDamper { a, b, axis, damping } => cdyn::spatial::Load::RotaryDamper {
-                    a: name(*a),
-                    b: Some(b.map_or(cdyn::planar::GROUND.to_string(), name)),
-                    axis: *axis,
-                    damping: *damping,
-                },
-                other => unreachable!("a URDF gives rotary dampers only, not {}", other.kind()),
-            })
-            .collect();
+        let couplings = robot.couplings.clone();
         let counts = Counts {
             robot_bodies: robot.bodies.len(),
             joints: joints.len() + entries.joints.len(),
+            loads: entries.forces.len(),
+            couplings: couplings.iter().map(|c| joint_names[c.follower].clone()).collect(),
             robot_joints: joint_names,
-            robot_loads: load_names,
+            notes,
         };
+        if let Some(i) = entries.joints.iter().position(|j| j.limit.is_some()) {
+            bail!(
+                "{file}: joints[{i}] ({}): limit: joint limits are held by the library (cdyn::stops::run_with_stops), not yet by cdyn run",
+                entries.joints[i].kind.name()
+            );
+        }
         joints.extend(entries.joints);
         let mut bodies = robot.bodies;
         bodies.extend(entries.bodies);
-        let loads = robot_loads.into_iter().chain(entries.forces).collect();
-        let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, loads, gravity);
+        let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, entries.forces, gravity)
+            .map(|m| m.with_couplings(couplings));
         Ok((mechanism, counts))
     }
 
@@ -107,24 +111,28 @@ impl Scenario {
 }
 
 /// How many of a spatial mechanism's parts come from its URDF robot,
-/// which come first in each list: bodies, joints, then the loads (after
-/// every joint in the numbering of `Part::Element`).
+/// which come first in each list: bodies, joints; then, in the numbering of
+/// `Part::Element`, the scenario's loads and the robot's `<mimic>` couplings.
 pub(super) struct Counts {
     pub(super) robot_bodies: usize,
     /// Every joint, the robot's and the scenario's.
     pub(super) joints: usize,
-    /// The URDF joint behind each of the robot's joints, and behind each of
-    /// its loads (a joint's damping).
+    /// The scenario's loads.
+    pub(super) loads: usize,
+    /// The URDF joint behind each of the robot's joints, and each coupling's follower.
     pub(super) robot_joints: Vec<String>,
-    pub(super) robot_loads: Vec<String>,
+    pub(super) couplings: Vec<String>,
+    /// What the robot's file holds that is not modelled, for the run to say.
+    pub(super) notes: Vec<String>,
 }
 
 impl Counts {
     /// The part as the scenario or the robot names it: `bodies[0] (top)`,
     /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`,
-    /// `urdf joint "elbow" (revolute)`.
+    /// `urdf joint "elbow" (revolute)`, `urdf joint "finger2" <mimic>`.
     pub(super) fn entry(&self, part: &Part) -> String {
-        let (robot_joints, robot_loads) = (self.robot_joints.len(), self.robot_loads.len());
+        let robot_joints = self.robot_joints.len();
+        let couplings = self.joints + self.loads;
         match part {
             Part::Body { index, name } if *index < self.robot_bodies => format!("urdf link {name:?}"),
             Part::Body { index, name } => format!("bodies[{}] ({name})", index - self.robot_bodies),
@@ -134,10 +142,10 @@ impl Counts {
             Part::Element { index, kind } if *index < self.joints => {
                 format!("joints[{}] ({kind})", index - robot_joints)
             }
-            Part::Element { index, kind } if *index < self.joints + robot_loads => {
-                format!("urdf joint {:?} damping ({kind})", self.robot_loads[index - self.joints])
+            Part::Element { index, kind } if *index < couplings => format!("forces[{}] ({kind})", index - self.joints),
+            Part::Element { index, .. } if *index < couplings + self.couplings.len() => {
+                format!("urdf joint {:?} <mimic>", self.couplings[index - couplings])
             }
-            Part::Element { index, kind } => format!("forces[{}] ({kind})", index - self.joints - robot_loads),
             other => other.to_string(),
         }
     }
@@ -149,20 +157,22 @@ mod tests {
 
     #[test]
     fn a_robots_parts_are_named_as_its_urdf_names_them() {
-        // A robot of two links, joints "shoulder" and "elbow" (damped), then
-        // the scenario's one body, two joints and one force.
+        // A robot of two links, joints "shoulder" and "elbow" (which
+        // mimics the shoulder), then the scenario's one body, two joints and one force.
         let counts = Counts {
             robot_bodies: 2,
             joints: 4,
+            loads: 1,
             robot_joints: vec!["shoulder".into(), "elbow".into()],
-            robot_loads: vec!["elbow".into()],
+            couplings: vec!["elbow".into()],
+            notes: Vec::new(),
         };
         let element = |index, kind| counts.entry(&Part::Element { index, kind });
         assert_eq!(counts.entry(&Part::Body { index: 1, name: "fore".into() }), "urdf link \"fore\"");
         assert_eq!(counts.entry(&Part::Body { index: 2, name: "weight".into() }), "bodies[0] (weight)");
         assert_eq!(element(1, "revolute"), "urdf joint \"elbow\" (revolute)");
         assert_eq!(element(3, "distance"), "joints[1] (distance)");
-        assert_eq!(element(4, "rotary_damper"), "urdf joint \"elbow\" damping (rotary_damper)");
-        assert_eq!(element(5, "spring"), "forces[0] (spring)");
+        assert_eq!(element(4, "spring"), "forces[0] (spring)");
+        assert_eq!(element(5, "mimic"), "urdf joint \"elbow\" <mimic>");
     }
 }

@@ -90,7 +90,7 @@ impl Scenario {
         if init.off_constraint {
             settings.consistency_tolerance = None;
         }
-        let (mut example, rows) = self.example(file)?;
+        let Described { mut example, rows, notes, force_entries } = self.example(file)?;
         for (k, spec) in self.invariants.iter().enumerate() {
             spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
         }
@@ -156,12 +156,14 @@ impl Scenario {
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
             None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows })
+        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, notes, force_entries })
     }
 
-    /// The model with its initial state, and for mechanisms the entry
-    /// (`joints[2] (revolute)`) behind every constraint row.
-    fn example(&self, file: &str) -> Result<(Example, Vec<String>)> {
+    /// The model with its initial state, for mechanisms the entry
+    /// (`joints[2] (revolute)`) behind every constraint row, what a
+    /// robot's file holds that is not modelled, and the entry behind each
+    /// force element where known.
+    fn example(&self, file: &str) -> Result<Described> {
         let m = &self.model;
         let mechanism_tables =
             !(self.bodies.is_empty() && self.joints.is_empty() && self.drives.is_empty() && self.forces.is_empty());
@@ -192,7 +194,7 @@ impl Scenario {
                         bail!("{file}: [model] gravity: the pendulum takes a magnitude (gravity acts along −Y)")
                     }
                 }
-                Ok((builtin(file, m.kind, "model", parameters)?, Vec::new()))
+                Ok(Described::plain(builtin(file, m.kind, "model", parameters)?))
             }
             Kind::Mechanism => {
                 let gravity = match m.gravity {
@@ -220,7 +222,7 @@ impl Scenario {
                 let built = mechanism.build();
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
-                Ok((Example::from_mechanism(built, None), rows))
+                Ok(Described { rows, ..Described::plain(Example::from_mechanism(built, None)) })
             }
             Kind::Spatial => {
                 let gravity = match m.gravity {
@@ -239,16 +241,34 @@ impl Scenario {
                 })?;
                 let (mechanism, built) = built;
                 let rows = built.rows.iter().map(part).collect();
-                Ok((Example::from_spatial(&mechanism, built), rows))
+                let forces = built.forces.iter().map(part).collect();
+                let example = Example::from_spatial(&mechanism, built);
+                Ok(Described { example, rows, notes: counts.notes, force_entries: forces })
             }
             built_in => {
                 if m.gravity.is_some() {
                     bail!("{file}: [model] gravity: this model takes its parameters in [model.parameters]");
                 }
                 let parameters = m.parameters.clone().unwrap_or_default();
-                Ok((builtin(file, built_in, "model.parameters", parameters)?, Vec::new()))
+                Ok(Described::plain(builtin(file, built_in, "model.parameters", parameters)?))
             }
         }
+    }
+}
+
+/// A model with its initial state and, for mechanisms, the entries behind
+/// its rows and force elements, and what a robot's file holds that is not modelled.
+struct Described {
+    example: Example,
+    rows: Vec<String>,
+    notes: Vec<String>,
+    force_entries: Vec<String>,
+}
+
+impl Described {
+    /// A built-in model: no entries, nothing left out.
+    fn plain(example: Example) -> Self {
+        Self { example, rows: Vec::new(), notes: Vec::new(), force_entries: Vec::new() }
     }
 }
 

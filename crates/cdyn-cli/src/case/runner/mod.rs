@@ -11,6 +11,7 @@
 mod estimate;
 mod result;
 mod rows;
+pub mod stiffness;
 
 pub use estimate::{Estimate, OUTPUT_LIMIT, every_to_fit};
 pub use result::{CaseResult, NewtonReport};
@@ -48,12 +49,26 @@ pub struct Case {
     /// The scenario entry behind each constraint row (`joints[2] (revolute)`),
     /// where the model comes from entries; errors name it instead of the row.
     pub row_entries: Vec<String>,
+    /// What the model's files hold that is not modelled (a URDF's
+    /// collisions, transmissions), one line each, for the run to say.
+    pub notes: Vec<String>,
+    /// The scenario entry behind each force element of the model (a
+    /// joint's damping, a damper), where known: a step too long for it names it.
+    pub force_entries: Vec<String>,
 }
 
 impl Case {
-    /// Checks that the case can start: settings valid, initial state consistent.
-    pub fn check(&self) -> cdyn::Result<()> {
-        Simulation::new(&self.example.model, self.settings, &self.example.q0, &self.example.v0).map(|_| ())
+    /// Checks that the case can start: settings valid, initial state
+    /// consistent, and an explicit step within its scheme's stability limit
+    /// on the damping and springs ([`stiffness::refusal`]): past it, a run
+    /// diverges or, worse, ends with a wrong answer.
+    pub fn check(&self) -> Result<()> {
+        let sim = Simulation::new(&self.example.model, self.settings, &self.example.q0, &self.example.v0)?;
+        let (scheme, h) = (self.settings.scheme, self.settings.h);
+        if let Some(refusal) = stiffness::refusal(scheme, h, sim.tuning(), &self.force_entries) {
+            anyhow::bail!("case {}: {refusal}", self.name);
+        }
+        Ok(())
     }
 }
 

@@ -254,11 +254,13 @@ impl System for ControlledSystem<'_> {
                 out[r as usize] += k * w[c as usize];
             }
         };
+        let (dissipation, mode) = crate::control::gains::dissipation_mode(&d, n, damping);
         Ok(Operators {
             coupling: crate::control::gains::coupling(&d, n),
             max_row_norm2: rows.fold(0.0, f64::max),
-            dissipation: crate::control::gains::dissipation_rate(&d, n, damping),
+            dissipation,
             frequency: crate::control::gains::oscillation_frequency(&d, n, stiffness),
+            dissipating: (dissipation > 0.0).then(|| model.most_dissipating(q, v, &mode, t)).flatten(),
         })
     }
     fn set_control(&mut self, control: Control) {

@@ -1,0 +1,109 @@
+//! Joint limits: the range of a revolute or prismatic joint's coordinate
+//! `θ` ([`JointLimit`]), each finite side a one-sided stop ([`Stop`]) with
+//! its gap `g = θ − lower` or `upper − θ` (`g ≥ 0` allowed), and the row
+//! `g = 0` that holds a joint at a stop while it pushes into it.
+//!
+//! The mechanism says where the stops are ([`crate::spatial::Mechanism::stops`],
+//! [`crate::spatial::Mechanism::gaps`]) and builds its model with a given set of them held
+//! ([`crate::spatial::Mechanism::build_holding`]: the row is `StopRow` beside the other
+//! rows on joint coordinates); when a stop is hit, held and released is the
+//! run's business ([`crate::stops`]), as it changes which rows the model has.
+//!
+//! A revolute joint's coordinate is an angle in `(−π, π]`: a bound at or
+//! beyond ±π (URDF's ±2π of a multi-turn joint) cannot be met by it and
+//! makes no stop ([`crate::spatial::Mechanism::unreachable_limits`] counts them, for a run
+//! to say so).
+
+use crate::error::{Problem, Result};
+
+/// The range of a revolute or prismatic joint's coordinate (see
+/// [`crate::spatial::Mechanism::joint_coordinates`]): an angle in rad, a displacement in
+/// length units, from the initial pose. In a scenario file a joint's
+/// `limit = { lower = -1.0, upper = 1.0 }`; from URDF, `<limit>`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
+#[non_exhaustive]
+pub struct JointLimit {
+    /// The lowest coordinate (`−∞`: none).
+    #[cfg_attr(feature = "serde", serde(default = "minus_infinity"))]
+    pub lower: f64,
+    /// The highest coordinate (`+∞`: none).
+    #[cfg_attr(feature = "serde", serde(default = "infinity"))]
+    pub upper: f64,
+    /// Newton's coefficient of restitution at a stop: the joint's rate
+    /// after an impact is `−e` times the rate before; 0 (the default)
+    /// stops it there and holds it while it pushes.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub restitution: f64,
+    /// The largest `|θ̇|` (`+∞`: none): reported where exceeded, not enforced.
+    #[cfg_attr(feature = "serde", serde(default = "infinity"))]
+    pub velocity: f64,
+    /// The largest actuator torque (force) at the joint (`+∞`: none). cdyn
+    /// has no joint actuators yet: it is kept for them and not applied.
+    #[cfg_attr(feature = "serde", serde(default = "infinity"))]
+    pub effort: f64,
+}
+
+#[cfg(feature = "serde")]
+fn infinity() -> f64 {
+    f64::INFINITY
+}
+
+#[cfg(feature = "serde")]
+fn minus_infinity() -> f64 {
+    f64::NEG_INFINITY
+}
+
+impl JointLimit {
+    /// `lower ≤ θ ≤ upper`, stopped without rebound, no velocity or effort bound.
+    pub fn new(lower: f64, upper: f64) -> Self {
+        Self { lower, upper, restitution: 0.0, velocity: f64::INFINITY, effort: f64::INFINITY }
+    }
+
+    /// Refuses bounds that are NaN or in the wrong order, and a restitution
+    /// outside `[0, 1]` or velocity and effort bounds that are not positive.
+    pub fn check(&self) -> Result<()> {
+        let reason = if self.lower.is_nan() || self.upper.is_nan() {
+            Some("a bound is not a number")
+        } else if self.lower > self.upper {
+            Some("lower is above upper")
+        } else if self.lower == f64::INFINITY || self.upper == f64::NEG_INFINITY {
+            Some("the range is empty")
+        } else {
+            None
+        };
+        if let Some(reason) = reason {
+            return Err(Problem::BadLimit { lower: self.lower, upper: self.upper, reason }.into());
+        }
+        if !(0.0..=1.0).contains(&self.restitution) {
+            let value = self.restitution;
+            return Err(Problem::Parameter { name: "restitution", value, reason: "must be in [0, 1]" }.into());
+        }
+        crate::error::positive("velocity limit", self.velocity).or_else(|e| infinite_is_none(e, self.velocity))?;
+        crate::error::positive("effort limit", self.effort).or_else(|e| infinite_is_none(e, self.effort))?;
+        Ok(())
+    }
+}
+
+/// `+∞` is no bound, not an error.
+fn infinite_is_none(e: crate::Error, value: f64) -> Result<f64> {
+    if value == f64::INFINITY { Ok(value) } else { Err(e) }
+}
+
+crate::setters!(JointLimit {
+    /// With Newton's coefficient of restitution `e`.
+    with_restitution => restitution: f64,
+    /// With a velocity bound (reported where exceeded).
+    with_velocity => velocity: f64,
+    /// With an effort bound (for actuators to come).
+    with_effort => effort: f64,
+});
+
+/// One side of a joint's limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Stop {
+    /// The joint (an index into [`crate::spatial::Mechanism::joints`]).
+    pub joint: usize,
+    /// The upper bound (else the lower).
+    pub upper: bool,
+}

@@ -1,0 +1,34 @@
+//! One-sided constraints: stops that hold a coordinate on one side
+//! (`g(q) ≥ 0`), joint limits being the first. A stop is a row of the
+//! model only while it holds: the run steps the model of the stops held,
+//! and between two steps
+//!
+//! - a stop whose gap closed (`g < 0`) is hit: the positions are projected
+//!   onto `g = 0` and the other rows, the velocities by Newton's impact law
+//!   (the plastic correction in the kinetic-energy metric, which takes
+//!   exactly the kinetic energy of the velocity along the stop, scaled by
+//!   `1 + e` for restitution `e`), and with `e = 0` the stop is held;
+//! - a held stop whose multiplier turned to pulling (`λ > 0` for the row
+//!   `g = 0`, whose force is `−g_qᵀ λ`) is released.
+//!
+//! Either changes the model's rows, so the run restarts its scheme from
+//! the new state: a multistep scheme's history (AB-3, ABM-4) is of the
+//! old right-hand side and would make the first steps after a change
+//! first-order, so it starts afresh, as at `t = 0`; the energy reference
+//! of `E₀ + ∫Ė` is the energy after the change (an impact's loss is not
+//! a violation for energy control to undo).
+//!
+//! Velocity bounds are watched, not enforced: [`Report::overspeed`] lists
+//! each coordinate that exceeded its bound, by how much and from when.
+//!
+//! The stops are seen at the end of a step: the impact is applied there
+//! (up to one step `h` late, the joint past its stop by at most `|ġ| h`,
+//! which the projection removes), and the crossing time the event reports
+//! is the root of the cubic through `(g, ġ)` at the step's two ends.
+//!
+//! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`.
+
+mod run;
+mod spatial;
+
+pub use run::{Change, Event, Report, Unilateral, run_with_stops};
