@@ -11,10 +11,12 @@ pub mod generalized_alpha;
 mod inputs;
 pub mod rattle;
 mod settings;
+mod simulation;
 mod snapshot;
 mod stepper;
 pub mod system;
 
 pub use settings::*;
+pub use simulation::*;
 pub use snapshot::Snapshot;
 pub use stepper::*;

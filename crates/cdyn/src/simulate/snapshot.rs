@@ -40,7 +40,7 @@ impl Simulation<'_> {
     /// from there. Nothing is projected: a state off the constraints is
     /// pulled back by the control law, as any violation is.
     pub fn set_state(&mut self, q: &[f64], v: &[f64], e: f64) -> Result<()> {
-        crate::simulate::stepper::check_initial_state(self.model().n(), q, v)?;
+        crate::simulate::simulation::check_initial_state(self.model().n(), q, v)?;
         crate::error::finite("energy input", e)?;
         self.replace_state(q, v, e);
         Ok(())

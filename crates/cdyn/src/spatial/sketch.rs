@@ -66,7 +66,11 @@ impl Mechanism {
                 name: b.name.clone(),
                 at: SpatialBody::of(i),
                 points: Vec::new(),
-                shapes: if b.visuals.is_empty() { vec![Visual::of_inertia(b)] } else { b.visuals.clone() },
+                shapes: if b.visuals.is_empty() {
+                    vec![Visual::of_inertia(b.mass, &b.inertia)]
+                } else {
+                    b.visuals.clone()
+                },
                 shaped: !b.visuals.is_empty(),
             })
             .collect();

@@ -2,7 +2,6 @@
 //! in its axes — the primitive `<visual>` geometry of a URDF link, or, for
 //! a body without one, the box of uniform density that has its inertia.
 
-use super::body::Body;
 use super::rotation::{compose, rotate, unrotate};
 
 /// A primitive solid, centred on its own origin.
@@ -46,19 +45,19 @@ impl Visual {
         Self { shape, position, orientation }
     }
 
-    /// The box of uniform density with the mass and inertia of `body`,
+    /// The box of uniform density with a body's `mass` and `inertia` (about its centre, in its axes),
     /// along its principal axes: sides `a² = 6 (J₂ + J₃ − J₁) / m` and
     /// cyclically. Only the size a figure needs, so moments that are not
     /// physical give a side of 0 rather than an error.
-    pub fn of_inertia(body: &Body) -> Self {
-        let m = nalgebra::Matrix3::from_fn(|a, b| body.inertia[a][b]);
+    pub fn of_inertia(mass: f64, inertia: &[[f64; 3]; 3]) -> Self {
+        let m = nalgebra::Matrix3::from_fn(|a, b| inertia[a][b]);
         let eigen = m.symmetric_eigen();
         let mut axes = eigen.eigenvectors;
         if axes.determinant() < 0.0 {
             axes.column_mut(2).neg_mut();
         }
         let j = eigen.eigenvalues;
-        let side = |a: usize| (6.0 * (j[(a + 1) % 3] + j[(a + 2) % 3] - j[a]) / body.mass).max(0.0).sqrt();
+        let side = |a: usize| (6.0 * (j[(a + 1) % 3] + j[(a + 2) % 3] - j[a]) / mass).max(0.0).sqrt();
         let q = nalgebra::UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(axes));
         let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
         Self::new(Shape::Box { size: [side(0), side(1), side(2)].map(finite) }, [0.0; 3], [q.w, q.i, q.j, q.k])
@@ -89,7 +88,7 @@ mod tests {
         let cols = [r([1.0, 0.0, 0.0]), r([0.0, 1.0, 0.0]), r([0.0, 0.0, 1.0])];
         let inertia =
             std::array::from_fn(|i| std::array::from_fn(|k| (0..3).map(|l| cols[l][i] * d[l] * cols[l][k]).sum()));
-        let v = Visual::of_inertia(&Body::new("b", m, [1.0; 3]).with_inertia(inertia));
+        let v = Visual::of_inertia(m, &inertia);
         let Shape::Box { size } = v.shape else { panic!("{v:?}") };
         // Each side along the axis the body's box has it.
         for (side, axis) in size.iter().zip([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) {

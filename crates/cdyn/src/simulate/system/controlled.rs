@@ -1,6 +1,7 @@
 //! A general model with a control law: the right-hand side an integrator
 //! steps, and the steps of RATTLE and generalized-α on its model.
 
+use super::evaluated::Evaluated;
 use super::{AlphaFailure, EvalError, RattleFailure, System, split_state, split_state_mut};
 use crate::control::evaluation::Evaluation;
 use crate::control::gains::Operators;
@@ -12,7 +13,7 @@ use crate::dynamics::energy;
 use crate::dynamics::momentum::{self, Kind, Momenta, Symmetries};
 use crate::dynamics::{DependentRows, Dynamics, LinearSolver};
 use crate::integrate::Rhs;
-use crate::linalg::mass::{MassAt, MassMatrix};
+use crate::linalg::mass::MassAt;
 use crate::model::Model;
 use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
@@ -342,64 +343,5 @@ impl System for ControlledSystem<'_> {
         let (model, d) = (self.model, &mut self.dynamics);
         let (momenta, held) = (&mut self.momenta, &mut self.held);
         projection::invariants(model, d, momenta, held, q, v, t, target, h, settings, &mut self.projection)
-    }
-}
-
-/// One evaluation of a general model, as the control laws read it, with
-/// its mass matrix `M` (a kind, or [`MassAt`] where either will do).
-struct Evaluated<'a, M> {
-    model: &'a Model,
-    dynamics: &'a Dynamics,
-    mass: &'a M,
-    momenta: &'a Momenta,
-}
-
-impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
-    type Mass = M;
-    fn mass(&self) -> &M {
-        self.mass
-    }
-    fn phi(&self) -> &[f64] {
-        self.dynamics.phi()
-    }
-    fn phi_dot(&self) -> &[f64] {
-        self.dynamics.phi_dot()
-    }
-    fn grad_potential(&self) -> &[f64] {
-        self.dynamics.psi_q()
-    }
-    fn acc(&self) -> &[f64] {
-        self.dynamics.acc()
-    }
-    fn row(&self, r: usize) -> (&[f64], &[u32]) {
-        let (pattern, range) = (self.model.pattern(), self.model.pattern().row(r));
-        (&self.dynamics.jac()[range.clone()], &pattern.cols[range])
-    }
-    fn solve_many(&self, b: &mut [&mut [f64]]) {
-        self.dynamics.solve_many(b);
-    }
-    fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]) {
-        self.dynamics.add_weighted_jt(self.model, y, scale, out);
-    }
-    fn phi_t(&self) -> &[f64] {
-        self.dynamics.phi_t()
-    }
-    fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
-        self.dynamics.jac_mul(self.model, x, out);
-    }
-    fn add_weighted_jt_pair(&self, y: [&[f64]; 2], out: [&mut [f64]; 2]) {
-        self.dynamics.add_weighted_jt_pair(self.model, y, out);
-    }
-    fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
-        match self.dynamics.potential_rate() {
-            Some(rate) => out.copy_from_slice(rate),
-            None => self.dynamics.jac_mul(self.model, w, out),
-        }
-    }
-    fn unit_vectors(&self) -> &[crate::model::unit_vector::UnitVector] {
-        self.model.unit_vectors()
-    }
-    fn momenta(&self) -> &Momenta {
-        self.momenta
     }
 }

@@ -4,12 +4,14 @@
 //! Here the interface a [`Stepper`](crate::simulate::Stepper) steps — the
 //! [`System`] trait, its evaluation errors and the failures of the schemes
 //! that step a model — and the state's layout; `controlled` is the
-//! [`ControlledSystem`] of a general [`Model`](crate::model::Model).
+//! [`ControlledSystem`] of a general [`Model`](crate::model::Model), and
+//! `evaluated` what the control laws read of its evaluations.
 //!
 //! May import: `control`, `dynamics`, `integrate`, `linalg`, `model` (and
 //! `rattle`, `generalized_alpha` beside it).
 
 mod controlled;
+mod evaluated;
 
 pub use controlled::ControlledSystem;
 

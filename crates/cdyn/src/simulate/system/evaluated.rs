@@ -1,0 +1,67 @@
+//! One evaluation of a general model's dynamics as the control laws read
+//! it ([`Evaluation`]), with its mass matrix.
+
+use crate::control::evaluation::Evaluation;
+use crate::dynamics::Dynamics;
+use crate::dynamics::momentum::Momenta;
+use crate::linalg::mass::MassMatrix;
+use crate::model::Model;
+
+/// One evaluation of a general model, as the control laws read it, with
+/// its mass matrix `M` (a kind, or [`MassAt`] where either will do).
+pub(super) struct Evaluated<'a, M> {
+    pub(super) model: &'a Model,
+    pub(super) dynamics: &'a Dynamics,
+    pub(super) mass: &'a M,
+    pub(super) momenta: &'a Momenta,
+}
+
+impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
+    type Mass = M;
+    fn mass(&self) -> &M {
+        self.mass
+    }
+    fn phi(&self) -> &[f64] {
+        self.dynamics.phi()
+    }
+    fn phi_dot(&self) -> &[f64] {
+        self.dynamics.phi_dot()
+    }
+    fn grad_potential(&self) -> &[f64] {
+        self.dynamics.psi_q()
+    }
+    fn acc(&self) -> &[f64] {
+        self.dynamics.acc()
+    }
+    fn row(&self, r: usize) -> (&[f64], &[u32]) {
+        let (pattern, range) = (self.model.pattern(), self.model.pattern().row(r));
+        (&self.dynamics.jac()[range.clone()], &pattern.cols[range])
+    }
+    fn solve_many(&self, b: &mut [&mut [f64]]) {
+        self.dynamics.solve_many(b);
+    }
+    fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]) {
+        self.dynamics.add_weighted_jt(self.model, y, scale, out);
+    }
+    fn phi_t(&self) -> &[f64] {
+        self.dynamics.phi_t()
+    }
+    fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
+        self.dynamics.jac_mul(self.model, x, out);
+    }
+    fn add_weighted_jt_pair(&self, y: [&[f64]; 2], out: [&mut [f64]; 2]) {
+        self.dynamics.add_weighted_jt_pair(self.model, y, out);
+    }
+    fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
+        match self.dynamics.potential_rate() {
+            Some(rate) => out.copy_from_slice(rate),
+            None => self.dynamics.jac_mul(self.model, w, out),
+        }
+    }
+    fn unit_vectors(&self) -> &[crate::model::unit_vector::UnitVector] {
+        self.model.unit_vectors()
+    }
+    fn momenta(&self) -> &Momenta {
+        self.momenta
+    }
+}
