@@ -76,6 +76,7 @@ impl std::fmt::Debug for Input {
 /// A constant of an element that an input may set instead: a spring's
 /// rest length, say. Read as a plain `f64` while the element is evaluated.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Parameter {
     /// This value, always.
     Fixed(f64),
