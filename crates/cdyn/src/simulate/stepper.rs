@@ -15,12 +15,12 @@ use crate::simulate::settings::{Settings, steps_to};
 use crate::simulate::system::{AlphaFailure, EvalError, RattleFailure, System};
 
 /// A running simulation of any controlled [`System`]: the general
-/// [`Simulation`] of a [`Model`], or a [`SmallSimulation`](crate::small::SmallSimulation).
+/// [`Simulation`](crate::simulate::Simulation) of a [`Model`](crate::model::Model), or a [`SmallSimulation`](crate::small::SmallSimulation).
 ///
 /// A clone is a snapshot: the state, the scheme's history, the gains and
 /// every buffer a step reads, so that stepping the clone repeats the run
 /// bit for bit (the model, with the values of its inputs, is shared: see
-/// [`Simulation::snapshot`]).
+/// [`Simulation::snapshot`](crate::simulate::Simulation::snapshot)).
 #[derive(Clone)]
 pub struct Stepper<S: System> {
     pub(super) system: S,
