@@ -224,8 +224,10 @@ def main():
             check(abs(view1.get("yaw", 0) - math.radians(60)) < 1e-9 and view0.get("yaw") != view1.get("yaw"), f"3-D: the view turned from {view0} to {view1}")
             changed = scene_changes(a0, shot0, shot1)
             check(changed > 2000, f"3-D: {changed} pixels of the scene differ between two views of t = pos 0.5")
-            # Playing advances the frames (Chromium's virtual time runs the animation).
-            dom, _, _ = chromium("file://" + os.path.abspath(page), "--dump-dom")
+            # Playing advances the frames (Chromium's virtual time runs the
+            # animation; on a loaded machine 3 s of it gave as few as one
+            # animation frame, so this load gets 10 s: the last switch wins).
+            dom, _, _ = chromium("file://" + os.path.abspath(page), "--dump-dom", "--virtual-time-budget=10000")
             frame = int(body_attributes(dom).get("data-frame", "0"))
             check(frame > 0, f"3-D: playing, the animation reached frame {frame}")
 
