@@ -123,6 +123,7 @@ impl JointSpace {
     /// `(θ, θ̇, θ̈)` of the `i`-th joint read at the state `(q, v)` with
     /// accelerations `a` (all of the mechanism's length; see
     /// [`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates)).
+    /// Panics if `i` is not below [`JointSpace::joints`]' count or a slice is short.
     pub fn at(&self, i: usize, q: &[f64], v: &[f64], a: &[f64]) -> [f64; 3] {
         let r = &self.read[i];
         let body = |k: usize| SpatialBody::of(if k < 7 { r.a } else { r.b.unwrap_or(r.a) }).first + k % 7;
