@@ -2,7 +2,8 @@
 //! (changed, which restarts the scheme), a step, the outputs read — what
 //! `fmi2DoStep` with `fmi2SetReal`/`fmi2GetReal` and the C API do —
 //! counted by a global allocator, on the pendulum of
-//! `examples/pd_pendulum.toml` and that pendulum stepped by AB-3.
+//! `examples/pd_pendulum.toml` and that pendulum stepped by AB-3; and a
+//! robot's step and outputs (joint angles among them), on `examples/arm_tethered.toml`.
 
 use cdyn_cli::case::live::Live;
 use cdyn_cli::case::scenario;
@@ -66,5 +67,21 @@ fn a_cosimulation_step_allocates_nothing() {
                 "{scheme}: allocations by set_input, step, outputs at period {k}"
             );
         }
+    }
+}
+
+#[test]
+fn a_robots_step_and_outputs_with_its_joint_angles_allocate_nothing() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/arm_tethered.toml");
+    let (parsed, _) = scenario::parse(&std::fs::read_to_string(&path).unwrap(), &path.display().to_string()).unwrap();
+    let mut live = Live::from_scenario(&parsed, &path).unwrap();
+    assert!(live.output_names().iter().any(|n| n == "wrist.q"), "{:?}", live.output_names());
+    let mut outputs = vec![0.0; live.output_names().len()];
+    for k in 0..20 {
+        let before = count();
+        live.step(10).unwrap();
+        let stepped = count();
+        live.outputs(&mut outputs);
+        assert_eq!([stepped - before, count() - stepped], [0, 0], "allocations by step, outputs at period {k}");
     }
 }

@@ -269,6 +269,45 @@ fn a_urdf_robot_runs_alone_and_with_a_loop_closure_from_the_scenario() {
 }
 
 #[test]
+fn a_robots_csv_has_each_joints_angle_and_rate_under_its_urdf_name() {
+    // arm.urdf for 0.2 s, every step written (h = 1e-3).
+    let text = example("arm_tethered.toml").replace("t_end = 2.0", "t_end = 0.2").replace("every = 10", "every = 1");
+    let text = &text[..text.find("[[joints]]").unwrap()]; // the arm alone
+    let (dir, path) = scenario("arm.toml", text);
+    std::fs::write(dir.join("arm.urdf"), example("arm.urdf")).unwrap();
+    let out = dir.join("out");
+    let result = cdyn(&["run", path_str(&path), "--out", path_str(&out)]);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    let (header, rows) = table(&out.join("arm.csv"));
+    // After the three bodies' coordinates, the revolute and continuous
+    // joints (not the fixed tool_mount), in the URDF's order.
+    let joints = ["shoulder_yaw", "shoulder_pitch", "wrist"];
+    let expected: Vec<String> = joints.iter().flat_map(|j| [format!("{j}.q"), format!("{j}.v")]).collect();
+    assert_eq!(header[22..28], expected[..]);
+    assert_eq!(header[28..], ["phi", "psi"]);
+    // The yaw joint turns `upper` about the vertical from the ground:
+    // its angle is 2 atan2(e3, e0) of the body's Euler parameters.
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (e0, e3, yaw) = (col("upper.e0"), col("upper.e3"), col("shoulder_yaw.q"));
+    let wrap = |x: f64| (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    let yaw_error = rows.iter().map(|r| wrap(r[yaw] - 2.0 * r[e3].atan2(r[e0])).abs()).fold(0.0, f64::max);
+    let turned = rows.iter().map(|r| r[yaw].abs()).fold(0.0, f64::max);
+    assert!(yaw_error < 1e-12 && turned > 0.1, "yaw off by {yaw_error:e}, turned {turned}");
+    // Each rate is the derivative of its angle: a central difference over
+    // ±k rows agrees to O((k h)²), four times closer at k = 1 than at k = 2.
+    for j in joints {
+        let (q, v) = (col(&format!("{j}.q")), col(&format!("{j}.v")));
+        let difference = |k: usize| {
+            let at = |i: usize| (rows[i + k][q] - rows[i - k][q]) / (rows[i + k][0] - rows[i - k][0]) - rows[i][v];
+            (2..rows.len() - 2).map(|i| at(i).abs()).fold(0.0, f64::max)
+        };
+        let (fine, coarse) = (difference(1), difference(2));
+        let fastest = rows.iter().map(|r| r[v].abs()).fold(0.0, f64::max);
+        assert!(fine < 1e-4 * fastest && (3.5..4.5).contains(&(coarse / fine)), "{j}: {fine:e}, {coarse:e}, {fastest}");
+    }
+}
+
+#[test]
 fn bad_urdf_references_get_one_line_naming_the_file_and_element() {
     let arm = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/arm.urdf")).unwrap();
     let scenario_text = example("arm_tethered.toml");

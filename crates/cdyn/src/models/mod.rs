@@ -100,15 +100,43 @@ impl Example {
     }
 
     /// A spatial mechanism as an example whose observables are its
-    /// coordinates (`name.x` … `name.e3` for each body), without reference or drawing.
+    /// coordinates (`name.x` … `name.e3` for each body), then each revolute
+    /// and prismatic joint's coordinate and its rate (`joints[k].q`,
+    /// `joints[k].v`, `k` its index; see [`Mechanism::joint_coordinates`](crate::spatial::Mechanism::joint_coordinates)),
+    /// without reference or drawing.
     pub fn from_spatial(mechanism: &crate::spatial::Mechanism, built: crate::spatial::Built) -> Self {
+        Self::from_spatial_named(mechanism, built, |k| format!("joints[{k}]"))
+    }
+
+    /// The same, joint `k`'s columns named `{joint_name(k)}.q` and `.v`
+    /// (a URDF robot's joints by their names, say).
+    pub fn from_spatial_named(
+        mechanism: &crate::spatial::Mechanism,
+        built: crate::spatial::Built,
+        joint_name: impl Fn(usize) -> String,
+    ) -> Self {
         let n = built.model.n();
+        let mut observables: Vec<String> =
+            mechanism.bodies.iter().flat_map(|b| crate::spatial::coordinate_names(&b.name)).collect();
+        // A mechanism that builds has every joint's frames, so its joint space reads.
+        let joints = mechanism.joint_space().unwrap_or_default();
+        observables
+            .extend(joints.joints().flat_map(|k| [format!("{}.q", joint_name(k)), format!("{}.v", joint_name(k))]));
+        // No acceleration is reported: θ̈ is read with a = 0 and dropped.
+        let zero = vec![0.0; n];
+        let observe = move |q: &[f64], v: &[f64], out: &mut [f64]| {
+            out[..n].copy_from_slice(&q[..n]);
+            for (i, pair) in out[n..].chunks_exact_mut(2).enumerate() {
+                let [theta, rate, _] = joints.at(i, q, v, &zero);
+                pair.copy_from_slice(&[theta, rate]);
+            }
+        };
         Example {
             model: built.model,
             q0: built.q0,
             v0: built.v0,
-            observables: mechanism.bodies.iter().flat_map(|b| crate::spatial::coordinate_names(&b.name)).collect(),
-            observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
+            observables,
+            observe: Box::new(observe),
             reference: None,
             drawing: None,
             sketch: Some(mechanism.sketch()),

@@ -8,9 +8,11 @@
 //! written once, generic over the scalar, so that its rate and
 //! acceleration come by dual numbers.
 
+use super::body::SpatialBody;
 use super::joint_rows::{F, Frame, G, H, Place, Side, dot, pose};
 use crate::ad::scalar::Scalar;
 use crate::model::constraint::Constraint;
+use num_dual::Dual2_64;
 
 /// The coordinate of one revolute or prismatic joint, with its frames on
 /// both sides (as its rows have them).
@@ -86,5 +88,47 @@ impl<const K: usize> Constraint<K, 1> for StopRow {
     fn eval<D: Scalar>(&self, x: [D; K], _t: D) -> [D; 1] {
         let b = (K == 14).then_some(1);
         [self.coordinate.at(&x, [Some(0), b], D::from(self.bound)) * self.sign]
+    }
+}
+
+/// The coordinates of a mechanism's revolute and prismatic joints, read
+/// from a state without allocating (a recorder writes them at every
+/// sample): built once by [`Mechanism::joint_space`](super::Mechanism::joint_space).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointSpace {
+    read: Vec<Readable>,
+}
+
+/// One joint that has a coordinate: its index, its coordinate and its bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Readable {
+    joint: usize,
+    coordinate: JointCoordinate,
+    a: usize,
+    b: Option<usize>,
+}
+
+impl JointSpace {
+    /// From `(joint index, its coordinate, body a, body b)` for each joint that has one.
+    pub(super) fn new(read: impl IntoIterator<Item = (usize, JointCoordinate, usize, Option<usize>)>) -> Self {
+        let read = read.into_iter().map(|(joint, coordinate, a, b)| Readable { joint, coordinate, a, b }).collect();
+        Self { read }
+    }
+
+    /// The index in [`Mechanism::joints`](super::Mechanism::joints) of each joint read, in order.
+    pub fn joints(&self) -> impl ExactSizeIterator<Item = usize> + '_ {
+        self.read.iter().map(|r| r.joint)
+    }
+
+    /// `(θ, θ̇, θ̈)` of the `i`-th joint read at the state `(q, v)` with
+    /// accelerations `a` (all of the mechanism's length; see
+    /// [`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates)).
+    /// Panics if `i` is not below [`JointSpace::joints`]' count or a slice is short.
+    pub fn at(&self, i: usize, q: &[f64], v: &[f64], a: &[f64]) -> [f64; 3] {
+        let r = &self.read[i];
+        let body = |k: usize| SpatialBody::of(if k < 7 { r.a } else { r.b.unwrap_or(r.a) }).first + k % 7;
+        let x: [Dual2_64; 14] = std::array::from_fn(|k| Dual2_64::new(q[body(k)], v[body(k)], a[body(k)]));
+        let theta = r.coordinate.at(&x, [Some(0), r.b.map(|_| 1)], Dual2_64::from(0.0));
+        [theta.re, theta.v1, theta.v2]
     }
 }

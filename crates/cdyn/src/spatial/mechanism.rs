@@ -2,7 +2,7 @@
 //! [`Model`] and its initial state.
 
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
-use super::coordinate::{JointCoordinate, Mimic, StopRow};
+use super::coordinate::{JointCoordinate, JointSpace, Mimic, StopRow};
 use super::joint::{Joint, JointKind};
 use super::limit::Stop;
 use super::load::Load;
@@ -13,7 +13,6 @@ use crate::error::{Part, Problem, Result};
 use crate::model::angular::Generator;
 use crate::model::force::Potential;
 use crate::model::{Model, ModelBuilder};
-use num_dual::Dual2_64;
 
 /// Bodies, joints and uniform gravity.
 ///
@@ -291,26 +290,28 @@ impl Mechanism {
     /// them. One place for joint-space output and for tests against
     /// joint-space dynamics.
     pub fn joint_coordinates(&self, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Option<[f64; 3]>>> {
-        let poses = self.poses()?;
         let n = 7 * self.bodies.len();
         if q.len() != n || v.len() != n || a.len() != n {
             let (positions, velocities) = (q.len(), v.len());
             return Err(Problem::StateLength { positions, velocities, n }.into());
         }
-        (0..self.joints.len())
-            .map(|k| {
-                let Ok(c) = self.coordinate(k, &poses) else { return Ok(None) };
-                let j = &self.joints[k];
-                let bodies: Vec<usize> = std::iter::once(j.a).chain(j.b).collect();
-                let path = |b: usize, i: usize| {
-                    let at = SpatialBody::of(b).first + i;
-                    Dual2_64::new(q[at], v[at], a[at])
-                };
-                let x: [Dual2_64; 14] = std::array::from_fn(|i| path(bodies[(i / 7).min(bodies.len() - 1)], i % 7));
-                let theta = c.at(&x, [Some(0), j.b.map(|_| 1)], Dual2_64::from(0.0));
-                Ok(Some([theta.re, theta.v1, theta.v2]))
-            })
-            .collect()
+        let space = self.joint_space()?;
+        let mut out = vec![None; self.joints.len()];
+        for (i, joint) in space.joints().enumerate() {
+            out[joint] = Some(space.at(i, q, v, a));
+        }
+        Ok(out)
+    }
+
+    /// The reader of every revolute and prismatic joint's coordinate (see
+    /// [`Mechanism::joint_coordinates`]), for reading them at many states.
+    pub fn joint_space(&self) -> Result<JointSpace> {
+        let poses = self.poses()?;
+        let read = (0..self.joints.len()).filter_map(|k| {
+            let c = self.coordinate(k, &poses).ok()?;
+            Some((k, c, self.joints[k].a, self.joints[k].b))
+        });
+        Ok(JointSpace::new(read))
     }
 
     /// Every finite side of every joint's limit that the joint's coordinate

@@ -49,6 +49,7 @@ mod visual;
 
 pub use body::{Body, Rotation, SpatialBody, coordinate_names};
 pub use chain::chain;
+pub use coordinate::JointSpace;
 pub use joint::{FRICTION_SLIP, Joint, JointKind};
 pub use limit::{JointLimit, Stop};
 pub use load::Load;

@@ -127,6 +127,13 @@ pub(super) struct Counts {
 }
 
 impl Counts {
+    /// Joint `k` as its output columns name it: a robot's by its URDF name,
+    /// the scenario's as `joints[i]`, counting them from 0 (as errors do).
+    pub(super) fn joint_name(&self, k: usize) -> String {
+        let robot_joints = self.robot_joints.len();
+        self.robot_joints.get(k).cloned().unwrap_or_else(|| format!("joints[{}]", k - robot_joints))
+    }
+
     /// The part as the scenario or the robot names it: `bodies[0] (top)`,
     /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`,
     /// `urdf joint "elbow" (revolute)`, `urdf joint "finger2" <mimic>`.

@@ -242,7 +242,7 @@ impl Scenario {
                 let (mechanism, built) = built;
                 let rows = built.rows.iter().map(part).collect();
                 let forces = built.forces.iter().map(part).collect();
-                let example = Example::from_spatial(&mechanism, built);
+                let example = Example::from_spatial_named(&mechanism, built, |k| counts.joint_name(k));
                 Ok(Described { example, rows, notes: counts.notes, force_entries: forces })
             }
             built_in => {
