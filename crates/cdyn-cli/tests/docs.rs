@@ -206,6 +206,7 @@ fn every_key_the_scenario_accepts_is_in_the_reference() {
         ("[model] of a spatial mechanism".into(), vec!["urdf".to_string()]),
         ("spatial [[bodies]]".into(), probe::<cdyn::spatial::Body>(UNKNOWN)),
         ("spatial [[joints]]".into(), probe::<cdyn::spatial::Joint<String>>(UNKNOWN)),
+        ("spatial [[actuators]]".into(), probe::<cdyn::spatial::Actuator<String>>(UNKNOWN)),
         ("spatial joint kinds".into(), probe::<Value<cdyn::spatial::JointKind>>("v = \"zzz\"")),
         ("spatial load kinds".into(), probe::<cdyn::spatial::Load<String>>(&tagged("zzz"))),
     ];

@@ -335,7 +335,7 @@ fn bad_inputs_and_outputs_get_one_line_naming_the_entry_and_key() {
         ),
         (
             GOOD.to_string() + "[[inputs]]\nname = \"f\"\ndrives = \"forces[0].fx\"\nstart = 0.0\n",
-            &["bad.toml: [[inputs]] drive keys of a planar mechanism's entries"],
+            &["bad.toml: [[inputs]] drive keys of a mechanism's entries"],
         ),
     ];
     for (text, expected) in cases {

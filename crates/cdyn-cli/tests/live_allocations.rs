@@ -3,7 +3,8 @@
 //! `fmi2DoStep` with `fmi2SetReal`/`fmi2GetReal` and the C API do —
 //! counted by a global allocator, on the pendulum of
 //! `examples/pd_pendulum.toml` and that pendulum stepped by AB-3; and a
-//! robot's step and outputs (joint angles among them), on `examples/arm_tethered.toml`.
+//! robot's step and outputs (joint angles among them), on `examples/arm_tethered.toml`,
+//! and with actuators (their torques among the outputs) on `examples/arm_pd.toml`.
 
 use cdyn_cli::case::live::Live;
 use cdyn_cli::case::scenario;
@@ -76,6 +77,22 @@ fn a_robots_step_and_outputs_with_its_joint_angles_allocate_nothing() {
     let (parsed, _) = scenario::parse(&std::fs::read_to_string(&path).unwrap(), &path.display().to_string()).unwrap();
     let mut live = Live::from_scenario(&parsed, &path).unwrap();
     assert!(live.output_names().iter().any(|n| n == "wrist.q"), "{:?}", live.output_names());
+    let mut outputs = vec![0.0; live.output_names().len()];
+    for k in 0..20 {
+        let before = count();
+        live.step(10).unwrap();
+        let stepped = count();
+        live.outputs(&mut outputs);
+        assert_eq!([stepped - before, count() - stepped], [0, 0], "allocations by step, outputs at period {k}");
+    }
+}
+
+#[test]
+fn an_actuated_robots_step_and_its_torque_outputs_allocate_nothing() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/arm_pd.toml");
+    let (parsed, _) = scenario::parse(&std::fs::read_to_string(&path).unwrap(), &path.display().to_string()).unwrap();
+    let mut live = Live::from_scenario(&parsed, &path).unwrap();
+    assert!(live.output_names().iter().any(|n| n == "shoulder_pitch.tau"), "{:?}", live.output_names());
     let mut outputs = vec![0.0; live.output_names().len()];
     for k in 0..20 {
         let before = count();

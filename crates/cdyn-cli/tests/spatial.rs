@@ -445,3 +445,133 @@ fn driven_joints_springs_and_torques_run_from_a_scenario() {
         }
     }
 }
+
+/// arm.urdf started at given joint angles and rates, with a PD servo
+/// (clamped at the URDF's effort), a torque ramp and a servo whose target
+/// is an input.
+const ACTUATED_ARM: &str = r#"
+[model]
+kind = "spatial"
+urdf = "arm.urdf"
+gravity = [0.0, 0.0, -9.81]
+
+[integrator]
+scheme = "rk4"
+h = 1e-3
+t_end = 0.1
+
+[output]
+every = 10
+
+[initial]
+joints = { shoulder_pitch = 0.4, wrist = -0.3 }
+rates = { shoulder_yaw = 0.2 }
+
+[[actuators]]
+joint = "shoulder_pitch"
+target = 0.9
+kp = 200.0
+kd = 5.0
+
+[[actuators]]
+joint = "wrist"
+torque = { polynomial = [0.5, 1.0] }
+
+[[actuators]]
+joint = "shoulder_yaw"
+kd = 2.0
+
+[[inputs]]
+name = "yaw_target"
+drives = "actuators[2].target"
+start = 0.0
+"#;
+
+/// Runs `text` beside arm.urdf; the CSV's header and rows, or the error line.
+fn run_arm(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
+    let (dir, path) = scenario("arm.toml", text);
+    std::fs::write(dir.join("arm.urdf"), example("arm.urdf")).unwrap();
+    let out = dir.join("out");
+    let result = cdyn(&["run", path_str(&path), "--out", path_str(&out)]);
+    if !result.status.success() {
+        return Err(one_error_line(&result));
+    }
+    Ok(table(&out.join("arm.csv")))
+}
+
+#[test]
+fn an_arm_starts_at_its_initial_joint_angles_and_writes_each_actuators_torque() {
+    let (header, rows) = run_arm(ACTUATED_ARM).unwrap();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
+    let first = &rows[0];
+    // The t = 0 row reads the given joint values back (the assembly's
+    // projection of an exact pose moves it by round-off only).
+    for (name, value) in [
+        ("shoulder_pitch.q", 0.4),
+        ("wrist.q", -0.3),
+        ("shoulder_yaw.q", 0.0),
+        ("shoulder_yaw.v", 0.2),
+        ("shoulder_pitch.v", 0.0),
+        ("wrist.v", 0.0),
+    ] {
+        assert!((first[col(name)] - value).abs() < 1e-12, "{name} = {} at t = 0", first[col(name)]);
+    }
+    // After the joint columns, one torque column per actuator: the servo
+    // asks 200 · 0.5 = 100 N m and gets the URDF's effort, 30; the wrist's
+    // ramp 0.5 + t; the yaw servo to the input's 0 is a damper, 2 · (0 − 0.2).
+    assert_eq!(header[28..31], ["shoulder_pitch.tau", "wrist.tau", "shoulder_yaw.tau"]);
+    assert_eq!(first[col("shoulder_pitch.tau")], 30.0);
+    assert_eq!(first[col("wrist.tau")], 0.5);
+    assert!((first[col("shoulder_yaw.tau")] + 0.4).abs() < 1e-12, "{}", first[col("shoulder_yaw.tau")]);
+    let last = rows.last().unwrap();
+    assert!((last[0] - 0.1).abs() < 1e-12 && (last[col("wrist.tau")] - 0.6).abs() < 1e-12, "{last:?}");
+    // The clamped servo drives the pitch up towards its target.
+    assert!(last[col("shoulder_pitch.q")] > 0.45, "{}", last[col("shoulder_pitch.q")]);
+}
+
+#[test]
+fn bad_actuators_and_initial_joints_get_one_line_naming_the_entry() {
+    let cases: [(String, &[&str]); 9] = [
+        (ACTUATED_ARM.replace("kd = 5.0", "kd = 5.0\ngain = 1.0"), &["arm.toml", "actuators[0]", "gain"]),
+        (
+            ACTUATED_ARM.replace("joint = \"wrist\"", "joint = \"elbow\""),
+            &["arm.toml: actuators[1]: joint = \"elbow\": no joint of that name; the joints are shoulder_yaw"],
+        ),
+        (
+            ACTUATED_ARM.replace("target = 0.9", "target = 0.9\ntorque = 1.0"),
+            &["arm.toml: actuators[0]: torque and target: give one"],
+        ),
+        (
+            ACTUATED_ARM.replace("kp = 200.0", "kp = -200.0"),
+            &["arm.toml: actuators[0]: kp = -200 must be finite and not negative"],
+        ),
+        (
+            ACTUATED_ARM.replace("joint = \"wrist\"", "joint = \"shoulder_pitch\""),
+            &["arm.toml: actuators[1]: joint = \"shoulder_pitch\": actuators[0] drives it already"],
+        ),
+        (
+            ACTUATED_ARM.replace("kd = 2.0\n", "kd = 2.0\ntarget = 0.1\n"),
+            &["arm.toml: actuators[2]: target is driven by the input \"yaw_target\" (inputs[0]): leave the key out"],
+        ),
+        (
+            ACTUATED_ARM.replace("actuators[2].target", "actuators[5].target"),
+            &["inputs[0] (yaw_target): drives = \"actuators[5].target\": the scenario has 3 [[actuators]] entries"],
+        ),
+        (
+            ACTUATED_ARM.replace("wrist = -0.3", "elbow = -0.3"),
+            &[
+                "arm.toml: [initial] joints: no revolute or prismatic joint \"elbow\"; the joints are shoulder_yaw, shoulder_pitch, wrist",
+            ],
+        ),
+        (
+            ACTUATED_ARM.replace("[initial]\n", "[initial]\nq = [0.0]\n"),
+            &["arm.toml: [initial] joints and q exclude each other"],
+        ),
+    ];
+    for (text, expected) in cases {
+        let line = run_arm(&text).unwrap_err();
+        for e in expected {
+            assert!(line.contains(e), "expected {e:?} in: {line}");
+        }
+    }
+}

@@ -120,7 +120,7 @@ fn run(ex: &Example, h: f64, control: Control, t_end: f64) -> Vec<([f64; 2], f64
     let mut out = Vec::new();
     let every = (SAMPLE / h).round() as u64;
     sim.run::<Error>(t_end, every, |s| {
-        let o = ex.observe(s.q(), s.v());
+        let o = ex.observe(s.t(), s.q(), s.v());
         out.push(([o[0], o[1]], s.measure().psi.abs()));
         Ok(())
     })
@@ -237,7 +237,7 @@ fn against_reference(ex: &Example, h: f64, t_end: f64, k: usize) -> (f64, Vec<Ve
     sim.run::<Error>(t_end, every, |s| {
         let reference = ex.reference.as_ref().unwrap();
         reference(s.t(), &mut qr, &mut vr);
-        let (at, exact) = (ex.observe(s.q(), s.v()), ex.observe(&qr, &vr));
+        let (at, exact) = (ex.observe(s.t(), s.q(), s.v()), ex.observe(s.t(), &qr, &vr));
         worst = (0..k).map(|j| (at[j] - exact[j]).abs()).fold(worst, f64::max);
         samples.push(at);
         Ok(())

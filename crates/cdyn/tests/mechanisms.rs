@@ -702,7 +702,7 @@ fn every_model_starts_on_its_constraints() {
         let mut sim = rk4(&ex, 1e-3);
         let m = sim.measure();
         assert!(m.phi.abs() < 1e-12 && m.phi_dot < 1e-12, "{name}: |Φ| = {:e}, |Φ̇| = {:e}", m.phi, m.phi_dot);
-        assert_eq!(ex.observables.len(), ex.observe(&ex.q0, &ex.v0).len(), "{name}");
+        assert_eq!(ex.observables.len(), ex.observe(0.0, &ex.q0, &ex.v0).len(), "{name}");
     }
 }
 

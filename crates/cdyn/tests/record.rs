@@ -88,7 +88,7 @@ fn statistics_are_the_largest_over_the_samples() {
         while check.steps() < s.step {
             check.step().unwrap();
         }
-        assert_eq!(s.observables, ex.observe(check.q(), check.v()));
+        assert_eq!(s.observables, ex.observe(check.t(), check.q(), check.v()));
         assert_eq!(s.error, ex.error(check.q(), check.v(), s.t));
         let m = check.measure();
         assert_eq!((s.phi, s.psi, s.coupling), (m.phi, m.psi, m.coupling));

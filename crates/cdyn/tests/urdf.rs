@@ -453,3 +453,34 @@ fn a_urdf_limit_stops_its_joint_and_holds_it() {
     assert!(ratio > 1.0 && t < events[0].t, "{ratio} at {t}");
     assert!((last[0] - 0.5).abs() < 1e-9 && last[1].abs() < 1e-9, "{last:?}");
 }
+
+#[test]
+fn the_arm_started_at_given_joint_angles_and_rates_reads_them_back() {
+    // Forward kinematics over the joint tree places the links exactly: the
+    // joints read back the given values to round-off, and every constraint
+    // row holds (Φ and Φ̇ = Φ_q v at round-off), so no assembly is needed.
+    let mechanism = from_urdf(ARM, [0.0, 0.0, -G]).unwrap();
+    let angles = [(0, 0.7), (1, -1.1), (2, 2.5)];
+    let rates = [(0, -0.4), (1, 1.3), (2, 0.9)];
+    let (q, v) = mechanism.state_at_joints(&angles, &rates).unwrap();
+    let read = mechanism.joint_coordinates(&q, &v, &vec![0.0; q.len()]).unwrap();
+    for ((joint, angle), (_, rate)) in angles.iter().zip(&rates) {
+        let [theta, theta_dot, _] = read[*joint].unwrap();
+        assert!((theta - angle).abs() < 1e-14 && (theta_dot - rate).abs() < 1e-14, "{joint}: {theta} {theta_dot}");
+    }
+    let built = mechanism.build().unwrap();
+    let mut phi = vec![0.0; built.model.m()];
+    built.model.constraint_values(&q, 0.0, &mut phi);
+    let phi_dot = {
+        let h = 1e-7;
+        let ahead: Vec<f64> = q.iter().zip(&v).map(|(q, v)| q + h * v).collect();
+        let mut next = vec![0.0; built.model.m()];
+        built.model.constraint_values(&ahead, h, &mut next);
+        next.iter().zip(&phi).fold(0.0_f64, |m, (b, a)| m.max(((b - a) / h).abs()))
+    };
+    let worst = phi.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    assert!(worst < 1e-14 && phi_dot < 1e-6, "|Φ| {worst:e}, |Φ̇| {phi_dot:e}");
+    // A joint that does not exist is refused.
+    let error = mechanism.state_at_joints(&[(mechanism.joints.len(), 0.1)], &[]).unwrap_err().to_string();
+    assert!(error.contains("joint"), "{error}");
+}

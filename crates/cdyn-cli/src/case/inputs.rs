@@ -5,11 +5,15 @@
 //! column names (default: every column).
 //!
 //! An input takes the place of the key it drives: the entry leaves that
-//! key out (a required one, as a drive's `function`, included).
+//! key out (a required one, as a drive's `function`, included). In a
+//! spatial mechanism an input drives an actuator's `torque` or `target`
+//! (`drives = "actuators[0].torque"`).
 
 use anyhow::{Result, anyhow, bail};
 use cdyn::model::input::Input;
+use cdyn::model::timefn::TimeFn;
 use cdyn::planar::{Group, Mechanism};
+use cdyn::spatial::Actuator;
 use serde::Deserialize;
 
 /// `[[inputs]]`: an input of the scenario.
@@ -102,19 +106,61 @@ pub(crate) fn drive(
             Group::Drives => entries(Group::Joints),
             _ => entries(Group::Joints) + entries(Group::Drives),
         };
-        let input = match mechanism.inputs.iter().find(|d| d.input.name() == spec.name) {
-            Some(d) if d.input.start() != spec.start => {
-                bail!(
-                    "{file}: inputs[{k}] ({}): start = {}: the input has start = {} already",
-                    spec.name,
-                    spec.start,
-                    d.input.start()
-                )
-            }
-            Some(d) => d.input.clone(),
-            None => Input::new(&spec.name, spec.start),
-        };
+        let earlier = mechanism.inputs.iter().map(|d| &d.input).find(|u| u.name() == spec.name);
+        let input = spec.input(k, file, earlier)?;
         mechanism.drive(before + target.index, target.key, &input);
+    }
+    Ok(())
+}
+
+impl InputSpec {
+    /// The input: the one of the same name declared `earlier`, if any
+    /// (inputs of one name are one input, of one start value), else a new one.
+    fn input(&self, k: usize, file: &str, earlier: Option<&Input>) -> Result<Input> {
+        match earlier {
+            Some(u) if u.start() != self.start => bail!(
+                "{file}: inputs[{k}] ({}): start = {}: the input has start = {} already",
+                self.name,
+                self.start,
+                u.start()
+            ),
+            Some(u) => Ok(u.clone()),
+            None => Ok(Input::new(&self.name, self.start)),
+        }
+    }
+}
+
+/// Lets each input of `specs` drive the `torque` or `target` of a spatial
+/// mechanism's actuator (`drives = "actuators[0].torque"`), a function of
+/// time that is the input's value; the entry leaves that key out.
+pub(crate) fn drive_actuators(specs: &[InputSpec], actuators: &mut [Actuator<String>], file: &str) -> Result<()> {
+    let mut made: Vec<Input> = Vec::new();
+    for (k, spec) in specs.iter().enumerate() {
+        let at = || format!("{file}: inputs[{k}] ({}): drives = {:?}", spec.name, spec.drives);
+        let parsed = spec.drives.split_once('.').and_then(|(entry, key)| {
+            Some((entry.strip_prefix("actuators[")?.strip_suffix(']')?.parse::<usize>().ok()?, key))
+        });
+        let Some((index, key)) = parsed else {
+            bail!("{}: expected an actuator and its key, actuators[0].torque or actuators[0].target", at());
+        };
+        let count = actuators.len();
+        let Some(actuator) = actuators.get_mut(index) else {
+            bail!("{}: the scenario has {count} [[actuators]] entries", at());
+        };
+        let slot = match key {
+            "torque" => &mut actuator.torque,
+            "target" => &mut actuator.target,
+            other => bail!("{}: an actuator's input drives its torque or target, not {other}", at()),
+        };
+        if slot.is_some() {
+            bail!(
+                "{file}: actuators[{index}]: {key} is driven by the input {:?} (inputs[{k}]): leave the key out",
+                spec.name
+            );
+        }
+        let input = spec.input(k, file, made.iter().find(|u| u.name() == spec.name))?;
+        *slot = Some(TimeFn::input(&input));
+        made.push(input);
     }
     Ok(())
 }

@@ -169,7 +169,7 @@ impl Live {
         let (sim, o, ex) = (&mut self.sim, &mut self.outputs, &self.case.example);
         let measures = sim.measure();
         let t = sim.t();
-        (ex.observe)(sim.q(), sim.v(), &mut o.observed);
+        (ex.observe)(t, sim.q(), sim.v(), &mut o.observed);
         let (qr, vr, at_ref) = &mut o.reference;
         let first = o.observed.first().copied().unwrap_or(0.0);
         let error = ex.error_of(first, t, qr, vr, at_ref);

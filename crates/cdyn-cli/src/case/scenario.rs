@@ -103,6 +103,9 @@ pub struct SpatialEntries {
     /// `[[forces]]`.
     #[serde(default)]
     pub forces: Vec<cdyn::spatial::Load<String>>,
+    /// `[[actuators]]`, each naming its joint as the output columns do.
+    #[serde(default)]
+    pub actuators: Vec<cdyn::spatial::Actuator<String>>,
 }
 
 /// `gravity`: a magnitude for the pendulums, a vector for mechanisms
@@ -164,6 +167,11 @@ pub struct InitialSpec {
     pub q: Option<Vec<f64>>,
     /// The initial velocities, overriding the model's.
     pub v: Option<Vec<f64>>,
+    /// A spatial mechanism's initial joint coordinates by their output
+    /// names (`shoulder = 0.3`, `"joints[1]" = -0.2`), placed by forward kinematics.
+    pub joints: Option<std::collections::BTreeMap<String, f64>>,
+    /// A spatial mechanism's initial joint rates by the same names.
+    pub rates: Option<std::collections::BTreeMap<String, f64>>,
     /// Start even if the initial state violates the constraints.
     #[serde(default)]
     pub off_constraint: bool,
@@ -328,7 +336,7 @@ pub fn from_table(table: toml::Table, file: &str) -> Result<(Scenario, toml::Tab
     }
     let (mut scenario, entries): (Scenario, Option<SpatialEntries>) = if spatial {
         let mut rest = table.clone();
-        let entries: toml::Table = ["bodies", "joints", "forces"]
+        let entries: toml::Table = ["bodies", "joints", "forces", "actuators"]
             .into_iter()
             .filter_map(|key| rest.remove(key).map(|v| (key.to_string(), v)))
             .collect();

@@ -201,6 +201,18 @@ pub enum Problem {
         /// Whether the kind needs it.
         wanted: bool,
     },
+    /// A joint actuator whose keys make no one law, and why.
+    #[error("{reason}")]
+    Actuator {
+        /// Why.
+        reason: &'static str,
+    },
+    /// Joint values a mechanism cannot be placed at, and why.
+    #[error("{reason}")]
+    Posing {
+        /// Which joint and why.
+        reason: String,
+    },
     /// A URDF file that cdyn cannot take, and why.
     #[error("{reason}")]
     Urdf {

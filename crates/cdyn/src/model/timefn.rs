@@ -69,6 +69,16 @@ impl TimeFn {
         }
     }
 
+    /// `ḟ(t)` as a function of its own: the polynomial and sine terms
+    /// differentiated; the input's term, constant between steps, drops out
+    /// (as it does from a drive's `Φ_t`).
+    pub fn derivative(&self) -> Self {
+        let polynomial = self.polynomial.iter().enumerate().skip(1).map(|(k, c)| k as f64 * c).collect();
+        let quarter = std::f64::consts::FRAC_PI_2;
+        let sines = self.sines.iter().map(|&[a, w, phase]| [a * w, w, phase + quarter]).collect();
+        Self { polynomial, sines, input: None }
+    }
+
     /// `f(t)`, for any scalar type (dual numbers give `ḟ`, `f̈`).
     pub fn eval<D: Scalar>(&self, t: D) -> D {
         // Horner for the polynomial.

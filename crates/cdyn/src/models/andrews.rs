@@ -186,7 +186,7 @@ pub fn andrews() -> Result<Example> {
         q0: built.q0,
         v0: built.v0,
         observables: ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"].map(String::from).to_vec(),
-        observe: Box::new(|q, _v, out| out.copy_from_slice(&test_set_angles(body_angles(q)))),
+        observe: Box::new(|_t, q, _v, out| out.copy_from_slice(&test_set_angles(body_angles(q)))),
         reference: None,
         drawing: Some(built.drawing),
         sketch: None,

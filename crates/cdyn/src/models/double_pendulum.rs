@@ -187,7 +187,7 @@ pub fn double_pendulum_angles(p: DoublePendulumParams) -> Result<Example> {
         q0: vec![p.theta1, p.theta2],
         v0: vec![p.omega1, p.omega2],
         observables: ["bob2.x", "bob2.y", "theta1", "theta2", "q0", "q1"].map(String::from).to_vec(),
-        observe: Box::new(move |q, _v, out| {
+        observe: Box::new(move |_t, q, _v, out| {
             let tip = add(add([0.0, 0.0], l1, hanging(q[0])), l2, hanging(q[1]));
             out.copy_from_slice(&[tip[0], tip[1], wrap(q[0]), wrap(q[1]), q[0], q[1]]);
         }),

@@ -56,8 +56,9 @@ pub use slider_crank::{SliderCrankParams, slider_crank};
 /// `(q, v)` of the exact solution at time `t`, in the model's coordinates.
 pub type Reference = Box<dyn Fn(f64, &mut [f64], &mut [f64]) + Send + Sync>;
 
-/// Maps a state `(q, v)` to named observable quantities.
-pub type Observe = Box<dyn Fn(&[f64], &[f64], &mut [f64]) + Send + Sync>;
+/// Maps a state `(q, v)` at time `t` to named observable quantities
+/// (the time for what depends on it, as an actuator's torque).
+pub type Observe = Box<dyn Fn(f64, &[f64], &[f64], &mut [f64]) + Send + Sync>;
 
 /// A built-in system ready to simulate.
 pub struct Example {
@@ -92,7 +93,7 @@ impl Example {
             q0: built.q0,
             v0: built.v0,
             observables: built.names,
-            observe: Box::new(move |q, _v, out| out.copy_from_slice(&q[..n])),
+            observe: Box::new(move |_t, q, _v, out| out.copy_from_slice(&q[..n])),
             reference,
             drawing: Some(built.drawing),
             sketch: None,
@@ -103,13 +104,14 @@ impl Example {
     /// coordinates (`name.x` … `name.e3` for each body), then each revolute
     /// and prismatic joint's coordinate and its rate (`joints[k].q`,
     /// `joints[k].v`, `k` its index; see [`Mechanism::joint_coordinates`](crate::spatial::Mechanism::joint_coordinates)),
-    /// without reference or drawing.
+    /// then the torque (force) each actuator applies (`joints[k].tau`, `k`
+    /// its joint), without reference or drawing.
     pub fn from_spatial(mechanism: &crate::spatial::Mechanism, built: crate::spatial::Built) -> Self {
         Self::from_spatial_named(mechanism, built, |k| format!("joints[{k}]"))
     }
 
-    /// The same, joint `k`'s columns named `{joint_name(k)}.q` and `.v`
-    /// (a URDF robot's joints by their names, say).
+    /// The same, joint `k`'s columns named `{joint_name(k)}.q`, `.v` and
+    /// `.tau` (a URDF robot's joints by their names, say).
     pub fn from_spatial_named(
         mechanism: &crate::spatial::Mechanism,
         built: crate::spatial::Built,
@@ -118,17 +120,24 @@ impl Example {
         let n = built.model.n();
         let mut observables: Vec<String> =
             mechanism.bodies.iter().flat_map(|b| crate::spatial::coordinate_names(&b.name)).collect();
-        // A mechanism that builds has every joint's frames, so its joint space reads.
+        // A mechanism that builds has every joint's frames and every
+        // actuator's law, so its joint space and its torques read.
         let joints = mechanism.joint_space().unwrap_or_default();
+        let torques = mechanism.actuator_torques().unwrap_or_default();
         observables
             .extend(joints.joints().flat_map(|k| [format!("{}.q", joint_name(k)), format!("{}.v", joint_name(k))]));
+        observables.extend(torques.joints().map(|k| format!("{}.tau", joint_name(k))));
+        let pairs = 2 * joints.joints().len();
         // No acceleration is reported: θ̈ is read with a = 0 and dropped.
         let zero = vec![0.0; n];
-        let observe = move |q: &[f64], v: &[f64], out: &mut [f64]| {
+        let observe = move |t: f64, q: &[f64], v: &[f64], out: &mut [f64]| {
             out[..n].copy_from_slice(&q[..n]);
-            for (i, pair) in out[n..].chunks_exact_mut(2).enumerate() {
+            for (i, pair) in out[n..n + pairs].chunks_exact_mut(2).enumerate() {
                 let [theta, rate, _] = joints.at(i, q, v, &zero);
                 pair.copy_from_slice(&[theta, rate]);
+            }
+            for (i, tau) in out[n + pairs..].iter_mut().enumerate() {
+                *tau = torques.at(i, q, v, t);
             }
         };
         Example {
@@ -143,10 +152,10 @@ impl Example {
         }
     }
 
-    /// The observables of the state `(q, v)`.
-    pub fn observe(&self, q: &[f64], v: &[f64]) -> Vec<f64> {
+    /// The observables of the state `(q, v)` at time `t`.
+    pub fn observe(&self, t: f64, q: &[f64], v: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.observables.len()];
-        (self.observe)(q, v, &mut out);
+        (self.observe)(t, q, v, &mut out);
         out
     }
 
@@ -154,7 +163,7 @@ impl Example {
     pub fn error(&self, q: &[f64], v: &[f64], t: f64) -> Option<f64> {
         let n = self.model.n();
         let (mut qr, mut vr, mut at_ref) = (vec![0.0; n], vec![0.0; n], vec![0.0; self.observables.len()]);
-        self.error_of(self.observe(q, v)[0], t, &mut qr, &mut vr, &mut at_ref)
+        self.error_of(self.observe(t, q, v)[0], t, &mut qr, &mut vr, &mut at_ref)
     }
 
     /// The error of `first`, the first observable of a state, against the
@@ -164,7 +173,7 @@ impl Example {
     pub fn error_of(&self, first: f64, t: f64, qr: &mut [f64], vr: &mut [f64], at_ref: &mut [f64]) -> Option<f64> {
         let reference = self.reference.as_ref()?;
         reference(t, qr, vr);
-        (self.observe)(qr, vr, at_ref);
+        (self.observe)(t, qr, vr, at_ref);
         Some(first - at_ref[0])
     }
 }

@@ -61,7 +61,7 @@ pub(super) fn example(
     let n = built.model.n();
     let mut observables: Vec<String> = first.iter().map(|s| s.to_string()).collect();
     observables.extend(built.names);
-    let observe: Observe = Box::new(move |q, v, out| {
+    let observe: Observe = Box::new(move |_t, q, v, out| {
         observe_first(q, v, &mut out[..k]);
         out[k..k + n].copy_from_slice(&q[..n]);
     });

@@ -229,7 +229,7 @@ impl<'a, K: Sink> Recorder<'a, K> {
         let (observables, error) = match &mut self.observed {
             Observed::Coordinates => (q, None),
             Observed::Example { example, values, reference } => {
-                (example.observe)(q, v, values);
+                (example.observe)(t, q, v, values);
                 let error =
                     reference.as_mut().and_then(|(qr, vr, at_ref)| example.error_of(values[0], t, qr, vr, at_ref));
                 (&values[..], error)

@@ -38,8 +38,8 @@ pub struct JointLimit {
     /// The largest `|θ̇|` (`+∞`: none): reported where exceeded, not enforced.
     #[cfg_attr(feature = "serde", serde(default = "infinity"))]
     pub velocity: f64,
-    /// The largest actuator torque (force) at the joint (`+∞`: none). cdyn
-    /// has no joint actuators yet: it is kept for them and not applied.
+    /// The largest actuator torque (force) at the joint (`+∞`: none): the
+    /// joint's [`Actuator`](super::Actuator) is clamped to `±effort`.
     #[cfg_attr(feature = "serde", serde(default = "infinity"))]
     pub effort: f64,
 }
@@ -95,7 +95,7 @@ crate::setters!(JointLimit {
     with_restitution => restitution: f64,
     /// With a velocity bound (reported where exceeded).
     with_velocity => velocity: f64,
-    /// With an effort bound (for actuators to come).
+    /// With an effort bound (which clamps the joint's actuator).
     with_effort => effort: f64,
 });
 

@@ -91,15 +91,15 @@ impl<B> Load<B> {
 
 /// One end of a two-point load at a state: a body point (its arm `A s`
 /// from the centre of mass) or a ground point.
-struct End<D> {
+pub(super) struct End<D> {
     at: [D; 3],
-    velocity: [D; 3],
+    pub(super) velocity: [D; 3],
     /// `(r, p, A s)` of a body end.
     body: Option<([D; 4], [D; 3])>,
 }
 
 /// The end at body point `s` of the body whose `(r, p)` start at `x[at]`.
-fn body_end<D: Scalar, const K: usize>(x: &[D; K], xd: &[D; K], at: usize, s: [f64; 3]) -> End<D> {
+pub(super) fn body_end<D: Scalar, const K: usize>(x: &[D; K], xd: &[D; K], at: usize, s: [f64; 3]) -> End<D> {
     let p: [D; 4] = std::array::from_fn(|i| x[at + 3 + i]);
     let arm = rotate_fixed(p, s);
     let w = rate(p, std::array::from_fn(|i| xd[at + 3 + i]));
@@ -111,12 +111,12 @@ fn body_end<D: Scalar, const K: usize>(x: &[D; K], xd: &[D; K], at: usize, s: [f
     }
 }
 
-fn ground_end<D: Scalar>(point: [f64; 3]) -> End<D> {
+pub(super) fn ground_end<D: Scalar>(point: [f64; 3]) -> End<D> {
     End { at: point.map(D::from), velocity: [D::zero(); 3], body: None }
 }
 
 /// The generalized force of `f` at `end` into `out[at..at + 7]`.
-fn apply<D: Scalar>(end: &End<D>, f: [D; 3], out: &mut [D], at: usize) {
+pub(super) fn apply<D: Scalar>(end: &End<D>, f: [D; 3], out: &mut [D], at: usize) {
     if let Some((p, arm)) = end.body {
         let q = on_parameters(p, cross(arm, f));
         for i in 0..3 {

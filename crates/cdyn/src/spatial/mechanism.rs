@@ -1,6 +1,7 @@
 //! A spatial mechanism — bodies, joints and gravity — turned into a
 //! [`Model`] and its initial state.
 
+use super::actuator::Actuator;
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
 use super::coordinate::{JointCoordinate, JointSpace, Mimic, StopRow};
 use super::joint::{Joint, JointKind};
@@ -47,6 +48,8 @@ pub struct Mechanism {
     pub loads: Vec<Load>,
     /// Joints whose coordinates are tied (URDF's `<mimic>`).
     pub couplings: Vec<Coupling>,
+    /// Torques (forces) on revolute (prismatic) joints.
+    pub actuators: Vec<Actuator>,
 }
 
 /// A `<mimic>` coupling, one constraint row: joint `follower`'s coordinate
@@ -117,6 +120,8 @@ crate::setters!(Mechanism {
     with_loads => loads: Vec<Load>,
     /// With these couplings of joint coordinates.
     with_couplings => couplings: Vec<Coupling>,
+    /// With these joint actuators.
+    with_actuators => actuators: Vec<Actuator>,
 });
 
 impl Mechanism {
@@ -222,6 +227,7 @@ impl Mechanism {
             builder = self.add_coupling(builder, coupling, &poses).map_err(|e| e.at(at.clone()))?;
             rows.push(at);
         }
+        builder = self.add_actuators(builder, &poses, &mut forces)?;
         for &stop in held {
             let at = Part::Element { index: stop.joint, kind: "limit" };
             builder = self.add_stop(builder, stop, &poses).map_err(|e| e.at(at.clone()))?;
@@ -231,7 +237,7 @@ impl Mechanism {
     }
 
     /// Joint `index`'s coordinate and its sides, for a revolute or prismatic joint.
-    fn coordinate(&self, index: usize, poses: &[Pose]) -> Result<JointCoordinate> {
+    pub(super) fn coordinate(&self, index: usize, poses: &[Pose]) -> Result<JointCoordinate> {
         let joint = self.joints.get(index).ok_or(Problem::NoSuchJoint { index })?;
         let rotary = match joint.kind {
             JointKind::Revolute => true,
@@ -246,14 +252,9 @@ impl Mechanism {
         let coordinate = self.coordinate(stop.joint, poses)?;
         let (bound, sign, _) = self.stop_bound(stop);
         let row = StopRow { coordinate, bound, sign };
-        let j = &self.joints[stop.joint];
-        let a = SpatialBody::of(j.a).coordinates();
-        Ok(match j.b {
-            None => builder.constrain(row, a),
-            Some(b) => {
-                let b = SpatialBody::of(b).coordinates();
-                builder.constrain(row, std::array::from_fn::<_, 14, _>(|i| if i < 7 { a[i] } else { b[i - 7] }))
-            }
+        Ok(match reads(&self.joints[stop.joint]) {
+            Reads::Ground(at) => builder.constrain(row, at),
+            Reads::Bodies(at) => builder.constrain(row, at),
         })
     }
 
@@ -356,7 +357,7 @@ impl Mechanism {
     }
 
     /// Each body's initial pose, its orientation checked.
-    fn poses(&self) -> Result<Vec<Pose>> {
+    pub(super) fn poses(&self) -> Result<Vec<Pose>> {
         self.bodies
             .iter()
             .enumerate()
@@ -368,6 +369,23 @@ impl Mechanism {
     }
 }
 
+/// The coordinates an element on one joint reads: its body `a`'s, or `a`'s then `b`'s.
+pub(super) enum Reads {
+    Ground([usize; 7]),
+    Bodies([usize; 14]),
+}
+
+pub(super) fn reads(j: &Joint) -> Reads {
+    let a = SpatialBody::of(j.a).coordinates();
+    match j.b {
+        None => Reads::Ground(a),
+        Some(b) => {
+            let b = SpatialBody::of(b).coordinates();
+            Reads::Bodies(std::array::from_fn(|i| if i < 7 { a[i] } else { b[i - 7] }))
+        }
+    }
+}
+
 fn reachable(kind: JointKind, bound: f64) -> bool {
     match kind {
         JointKind::Revolute => bound.abs() < std::f64::consts::PI,
@@ -376,4 +394,4 @@ fn reachable(kind: JointKind, bound: f64) -> bool {
 }
 
 /// A body's position and unit orientation.
-type Pose = ([f64; 3], [f64; 4]);
+pub(super) type Pose = ([f64; 3], [f64; 4]);

@@ -25,12 +25,17 @@
 //! optionally driven) and loads ([`Load`]: spring-dampers, rotary dampers,
 //! forces, torques) are placed by points and axes in space at the initial
 //! pose, and carried into each body's frame there, so that a mechanism is
-//! always assembled where it is defined. `from_urdf` (feature `urdf`)
+//! always assembled where it is defined. [`Actuator`]s drive revolute and
+//! prismatic joints by a torque (force) of time or a PD servo, and
+//! [`Mechanism::state_at_joints`] starts a mechanism at given joint
+//! coordinates. `from_urdf` (feature `urdf`)
 //! reads a robot; [`Sketch`] is what figures draw, bodies as their
 //! [`Visual`]s.
 //!
 //! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `planar`.
 
+mod actuated;
+mod actuator;
 mod body;
 mod chain;
 mod coordinate;
@@ -41,12 +46,14 @@ mod load;
 mod mechanism;
 mod named;
 mod placing;
+mod posing;
 pub mod rotation;
 mod sketch;
 #[cfg(feature = "urdf")]
 mod urdf;
 mod visual;
 
+pub use actuator::{Actuator, ActuatorTorques};
 pub use body::{Body, Rotation, SpatialBody, coordinate_names};
 pub use chain::chain;
 pub use coordinate::JointSpace;

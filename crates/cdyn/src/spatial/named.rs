@@ -110,6 +110,6 @@ impl Mechanism {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { bodies, joints, gravity, loads, couplings: Vec::new() })
+        Ok(Self { bodies, joints, gravity, loads, couplings: Vec::new(), actuators: Vec::new() })
     }
 }

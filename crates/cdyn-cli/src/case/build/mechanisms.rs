@@ -6,6 +6,7 @@ use crate::case::scenario::{Scenario, SpatialEntries, read_bounded};
 use anyhow::{Result, anyhow, bail};
 use cdyn::error::Part;
 use cdyn::planar::{Element, Group, Mechanism};
+use cdyn::spatial::{Actuator, JointKind};
 use std::path::Path;
 
 impl Scenario {
@@ -64,10 +65,11 @@ impl Scenario {
             );
         }
         joints.extend(entries.joints);
+        let actuators = counts.actuated_joints(&entries.actuators, &joints, file)?;
         let mut bodies = robot.bodies;
         bodies.extend(entries.bodies);
         let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, entries.forces, gravity)
-            .map(|m| m.with_couplings(couplings));
+            .map(|m| m.with_couplings(couplings).with_actuators(actuators));
         Ok((mechanism, counts))
     }
 
@@ -134,6 +136,38 @@ impl Counts {
         self.robot_joints.get(k).cloned().unwrap_or_else(|| format!("joints[{}]", k - robot_joints))
     }
 
+    /// Each `[[actuators]]` entry on the joint it names as the output
+    /// columns do (`shoulder`, `joints[2]`): a revolute or prismatic one,
+    /// at most one actuator each (one `NAME.tau` column).
+    fn actuated_joints(
+        &self,
+        actuators: &[Actuator<String>],
+        joints: &[cdyn::spatial::Joint<String>],
+        file: &str,
+    ) -> Result<Vec<Actuator>> {
+        let names: Vec<String> = (0..joints.len()).map(|k| self.joint_name(k)).collect();
+        let mut taken: Vec<usize> = Vec::new();
+        actuators
+            .iter()
+            .enumerate()
+            .map(|(i, actuator)| {
+                let at = format!("{file}: actuators[{i}]: joint = {:?}", actuator.joint);
+                let Some(k) = names.iter().position(|n| *n == actuator.joint) else {
+                    bail!("{at}: no joint of that name; the joints are {}", names.join(", "));
+                };
+                let kind = joints[k].kind;
+                if !matches!(kind, JointKind::Revolute | JointKind::Prismatic) {
+                    bail!("{at}: a {} joint: an actuator drives a revolute or prismatic joint", kind.name());
+                }
+                if let Some(earlier) = taken.iter().position(|&j| j == k) {
+                    bail!("{at}: actuators[{earlier}] drives it already: give a joint one actuator");
+                }
+                taken.push(k);
+                Ok(actuator.clone().map_joint(|_| k))
+            })
+            .collect()
+    }
+
     /// The part as the scenario or the robot names it: `bodies[0] (top)`,
     /// `joints[2] (revolute)`, `forces[1] (spring)`, `urdf link "hand"`,
     /// `urdf joint "elbow" (revolute)`, `urdf joint "finger2" <mimic>`.
@@ -152,6 +186,9 @@ impl Counts {
             Part::Element { index, kind } if *index < couplings => format!("forces[{}] ({kind})", index - self.joints),
             Part::Element { index, .. } if *index < couplings + self.couplings.len() => {
                 format!("urdf joint {:?} <mimic>", self.couplings[index - couplings])
+            }
+            Part::Element { index, kind: "actuator" } => {
+                format!("actuators[{}]", index - couplings - self.couplings.len())
             }
             other => other.to_string(),
         }

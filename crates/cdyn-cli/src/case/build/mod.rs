@@ -90,6 +90,20 @@ impl Scenario {
         if init.off_constraint {
             settings.consistency_tolerance = None;
         }
+        let joint_keys = [
+            ("joints", init.joints.is_some(), "q", init.q.is_some()),
+            ("rates", init.rates.is_some(), "v", init.v.is_some()),
+        ];
+        for (key, given, state, overridden) in joint_keys {
+            if given && self.model.kind != Kind::Spatial {
+                bail!("{file}: [initial] {key}: joint coordinates are for kind = \"spatial\" mechanisms");
+            }
+            if given && overridden {
+                bail!(
+                    "{file}: [initial] {key} and {state} exclude each other: give the joints' values or the coordinates"
+                );
+            }
+        }
         let Described { mut example, rows, notes, force_entries } = self.example(file)?;
         for (k, spec) in self.invariants.iter().enumerate() {
             spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
@@ -140,9 +154,9 @@ impl Scenario {
                 );
             }
         }
-        if !self.inputs.is_empty() && self.model.kind != Kind::Mechanism {
+        if !self.inputs.is_empty() && !matches!(self.model.kind, Kind::Mechanism | Kind::Spatial) {
             bail!(
-                "{file}: [[inputs]] drive keys of a planar mechanism's entries: they need [model] kind = \"mechanism\""
+                "{file}: [[inputs]] drive keys of a mechanism's entries: they need [model] kind = \"mechanism\" or \"spatial\""
             );
         }
         crate::case::inputs::selected(self.output.select.as_deref(), &crate::case::runner::columns(&example), file)?;
@@ -230,7 +244,8 @@ impl Scenario {
                     Some(GravitySpec::Vector3(g)) if g.iter().all(|x| x.is_finite()) => g,
                     _ => bail!("{file}: [model] gravity: a spatial mechanism takes a finite vector [gx, gy, gz]"),
                 };
-                let entries = self.spatial.clone().unwrap_or_default();
+                let mut entries = self.spatial.clone().unwrap_or_default();
+                crate::case::inputs::drive_actuators(&self.inputs, &mut entries.actuators, file)?;
                 let (mechanism, counts) = self.spatial_mechanism(file, entries, gravity)?;
                 let part = |part: &Part| counts.entry(part);
                 let built = mechanism.and_then(|m| m.build().map(|b| (m, b))).map_err(|e| match e {
@@ -239,7 +254,10 @@ impl Scenario {
                     }
                     other => anyhow!("{file}: {other}"),
                 })?;
-                let (mechanism, built) = built;
+                let (mechanism, mut built) = built;
+                if let Some((q0, v0)) = self.initial.joint_state(&mechanism, |k| counts.joint_name(k), file)? {
+                    (built.q0, built.v0) = (q0, v0);
+                }
                 let rows = built.rows.iter().map(part).collect();
                 let forces = built.forces.iter().map(part).collect();
                 let example = Example::from_spatial_named(&mechanism, built, |k| counts.joint_name(k));
@@ -253,6 +271,39 @@ impl Scenario {
                 Ok(Described::plain(builtin(file, built_in, "model.parameters", parameters)?))
             }
         }
+    }
+}
+
+impl crate::case::scenario::InitialSpec {
+    /// The state of `mechanism` at `[initial] joints` and `rates`, if given,
+    /// each joint named as its output columns are (`name(k)` of joint `k`).
+    fn joint_state(
+        &self,
+        mechanism: &cdyn::spatial::Mechanism,
+        name: impl Fn(usize) -> String,
+        file: &str,
+    ) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
+        if self.joints.is_none() && self.rates.is_none() {
+            return Ok(None);
+        }
+        let space = mechanism.joint_space().map_err(|e| anyhow!("{file}: {e}"))?;
+        let known: Vec<(usize, String)> = space.joints().map(|k| (k, name(k))).collect();
+        let pick = |key: &str, given: &Option<std::collections::BTreeMap<String, f64>>| {
+            let values = given.iter().flatten().map(|(joint, &value)| match known.iter().find(|(_, n)| n == joint) {
+                Some(&(k, _)) => Ok((k, value)),
+                None => {
+                    let names: Vec<&str> = known.iter().map(|(_, n)| n.as_str()).collect();
+                    bail!(
+                        "{file}: [initial] {key}: no revolute or prismatic joint {joint:?}; the joints are {}",
+                        names.join(", ")
+                    )
+                }
+            });
+            values.collect::<Result<Vec<_>>>()
+        };
+        let (coordinates, rates) = (pick("joints", &self.joints)?, pick("rates", &self.rates)?);
+        let state = mechanism.state_at_joints(&coordinates, &rates).map_err(|e| anyhow!("{file}: [initial] {e}"))?;
+        Ok(Some(state))
     }
 }
 

@@ -150,7 +150,7 @@ pub fn four_bar_angles(p: FourBarParams) -> Result<Example> {
         q0,
         v0,
         observables: observables.into_iter().map(String::from).collect(),
-        observe: Box::new(move |q, v, out| {
+        observe: Box::new(move |_t, q, v, out| {
             out[..3].copy_from_slice(&[q[2], q[1], v[2]]);
             let k = if has_load {
                 out[3] = q[3].sin().atan2(q[3].cos());
