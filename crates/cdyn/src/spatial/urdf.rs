@@ -23,12 +23,13 @@
 //! prismatic, a zero axis on a moving joint, and several root links.
 //!
 //! A revolute or prismatic joint's `<limit>` becomes its [`JointLimit`]
-//! (checked: NaN or inverted bounds are refused, naming the joint).
+//! (checked: NaN or inverted bounds are refused, naming the joint), held
+//! by a run with stops ([`crate::stops`], as `cdyn run` runs it).
 //!
 //! Not modelled, and listed in [`UrdfRobot::notes`] (a run prints them on
 //! one line): collision and contact, transmissions, Gazebo extensions,
-//! safety controllers, calibration; and the limits, which `cdyn run` does
-//! not enforce yet (the library's [`crate::stops`] does).
+//! safety controllers, calibration; and the limits' effort bounds (no
+//! joint actuators yet).
 
 use super::body::Body;
 use super::joint::{Joint, JointKind};
@@ -316,9 +317,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         joint_names.push(j.name.clone());
     }
     if limited > 0 {
-        notes.push(format!(
-            "limit of {limited} joints: checked, and held by the library's cdyn::stops, not yet by cdyn run; effort bounds (no actuators yet)"
-        ));
+        notes.push(format!("the effort bounds of {limited} joints' <limit> (no joint actuators yet)"));
     }
     if still > 0 {
         notes.push(format!("<dynamics> or <mimic> of {still} fixed or floating joints (nothing to move)"));
