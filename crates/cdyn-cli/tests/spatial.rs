@@ -228,7 +228,22 @@ fn bad_spatial_entries_get_one_line_naming_the_entry() {
         (good.replace("[[bodies]]", "[[drives]]\nkind = \"angle\"\n\n[[bodies]]"), &["spatial", "[[drives]]"]),
         (
             good.replace("point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0, 0.0]\nlimit = { lower = -1.0, upper = 1.0 }"),
-            &["joints[0] (spherical): limit: joint limits are held by the library", "not yet by cdyn run"],
+            &["joints[0] (spherical): joint 0 is spherical: only revolute and prismatic joints have a coordinate"],
+        ),
+        (
+            good.replace("kind = \"spherical\"", "kind = \"revolute\"\naxis = [0.0, 1.0, 0.0]")
+                .replace("point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0, 0.0]\nlimit = { lower = 1.0, upper = -1.0 }"),
+            &["joints[0] (revolute): limit lower = 1, upper = -1: lower is above upper"],
+        ),
+        (
+            good.replace("kind = \"spherical\"", "kind = \"revolute\"\naxis = [0.0, 1.0, 0.0]")
+                .replace("point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0, 0.0]\nlimit = { lower = -1.0, upper = nan }"),
+            &["joints[0] (revolute): limit lower = -1, upper = NaN: a bound is not a number"],
+        ),
+        (
+            good.replace("kind = \"spherical\"", "kind = \"revolute\"\naxis = [0.0, 1.0, 0.0]")
+                .replace("point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0, 0.0]\nlimit = { lower = -1.0, stiff = 2.0 }"),
+            &["joints[0]", "stiff"],
         ),
     ];
     for (text, expected) in cases {

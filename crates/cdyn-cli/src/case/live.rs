@@ -57,6 +57,12 @@ impl Live {
     /// `case` started at its initial state, with the outputs `select` names
     /// (every column without it); `file` names the scenario in errors.
     pub fn new(case: Case, select: Option<&[String]>, file: &str) -> Result<Self> {
+        if let Some(limits) = &case.limits {
+            return Err(anyhow!(
+                "{file}: joint {}: limit: joint limits are held by cdyn run (and cdyn.run), not yet by a case stepped from outside (cdyn.Simulation, the C API, the FMU)",
+                limits.first_joint()
+            ));
+        }
         let all = columns(&case.example);
         let selected = selected(select, &all, file)?;
         let case = Arc::new(case);

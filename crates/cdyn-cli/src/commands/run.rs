@@ -35,6 +35,9 @@ pub fn run(args: CaseArgs) -> Result<Ended> {
         view3d::write(&out, &results[0].name, sketch, &results[0].frames)?;
     }
     viewer.write(&out, &results[0].name, std::slice::from_ref(&case), &results)?;
+    if let Some(limits) = &results[0].limits {
+        print(&format!("{}\n", limits.line()))?;
+    }
     print(&report::table(&results))?;
     print(&format!("wrote {}\n", out.display()))?;
     ended(&results, &out)

@@ -34,6 +34,7 @@ pub fn cases() -> Result<Vec<Case>> {
                 row_entries: Vec::new(),
                 notes: Vec::new(),
                 force_entries: Vec::new(),
+                limits: None,
             });
         }
     }

@@ -94,7 +94,7 @@ pub enum Problem {
         reason: &'static str,
     },
     /// A joint without a coordinate of its own where one is needed.
-    #[error("joint {index} is {kind}: only revolute and prismatic joints have a coordinate to couple")]
+    #[error("joint {index} is {kind}: only revolute and prismatic joints have a coordinate (to couple or to limit)")]
     NoCoordinate {
         /// The joint's position.
         index: usize,

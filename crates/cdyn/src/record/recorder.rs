@@ -281,9 +281,14 @@ impl<'a, K: Sink> Recorder<'a, K> {
                 (self.record.momenta[j].initial, self.record.momenta[j].last) = (p, p);
             }
         } else {
-            for j in 0..self.record.momenta.len() {
+            for m in &mut self.record.momenta {
+                // A run with stops changes its model between steps
+                // (`crate::stops`), and with it the momenta it keeps: each
+                // is found by its name, one no longer there left as it was.
+                let symmetries = sim.symmetries();
+                let names = symmetries.kept.iter().map(|k| &k.name).chain(symmetries.broken.iter().map(|b| &b.name));
+                let Some(j) = names.into_iter().position(|name| *name == m.name) else { continue };
                 let p = sim.momentum(j);
-                let m = &mut self.record.momenta[j];
                 m.last = p;
                 m.max_drift = m.max_drift.max((p - m.initial).abs());
             }

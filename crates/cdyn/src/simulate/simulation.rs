@@ -51,6 +51,13 @@ impl<'m> Simulation<'m> {
         self.system.model()
     }
 
+    /// Continues `previous`, a run of another model ending where this one
+    /// starts ([`crate::stops`]): its counts, and its evaluations.
+    pub(crate) fn continue_from(&mut self, previous: &Simulation<'_>) {
+        self.continue_counts(previous);
+        self.system.add_evaluations(previous.evaluations());
+    }
+
     /// Writes `(q, v, e)` into the state and restarts the scheme (see [`Simulation::set_state`]).
     pub(super) fn replace_state(&mut self, q: &[f64], v: &[f64], e: f64) {
         let (t, n) = (self.t(), self.system.n());

@@ -164,10 +164,26 @@ impl<S: System> Stepper<S> {
     pub fn steps(&self) -> u64 {
         self.step
     }
-    /// Counts steps on from `step`, as a run restarted at `t = step · h`
-    /// with another model does ([`crate::stops`]).
-    pub(crate) fn resume_at(&mut self, step: u64) {
-        self.step = step;
+    /// Counts on from `previous`, the run this one continues with another
+    /// model from `previous`'s end ([`crate::stops`]): its steps (so that
+    /// `t` goes on), and the iterations and rank losses of its method, so
+    /// that a run's totals cover all of it.
+    pub(crate) fn continue_counts<T: System>(&mut self, previous: &Stepper<T>) {
+        self.step = previous.step;
+        self.projection_iterations += previous.projection_iterations;
+        self.projection_failures += previous.projection_failures;
+        self.rattle_iterations += previous.rattle_iterations;
+        self.newton_iterations += previous.newton_iterations;
+        self.newton_correction = self.newton_correction.max(previous.newton_correction);
+        self.rank_loss = match (previous.rank_loss, self.rank_loss) {
+            (Some(a), Some(b)) => Some(RankLoss {
+                max: a.max.max(b.max),
+                steps: a.steps + b.steps,
+                first_time: a.first_time,
+                last_time: b.last_time,
+            }),
+            (a, b) => a.or(b),
+        };
     }
     /// Current time, `step · h` (not accumulated, so it does not drift).
     pub fn t(&self) -> f64 {

@@ -23,12 +23,13 @@
 //! prismatic, a zero axis on a moving joint, and several root links.
 //!
 //! A revolute or prismatic joint's `<limit>` becomes its [`JointLimit`]
-//! (checked: NaN or inverted bounds are refused, naming the joint).
+//! (checked: NaN or inverted bounds are refused, naming the joint), held
+//! by a run with stops ([`crate::stops`], as `cdyn run` runs it).
 //!
 //! Not modelled, and listed in [`UrdfRobot::notes`] (a run prints them on
 //! one line): collision and contact, transmissions, Gazebo extensions,
-//! safety controllers, calibration; and the limits, which `cdyn run` does
-//! not enforce yet (the library's [`crate::stops`] does).
+//! safety controllers, calibration. A limit's effort bound clamps the
+//! joint's actuator where the scenario gives it one ([`super::Actuator`]).
 
 use super::body::Body;
 use super::joint::{Joint, JointKind};
@@ -270,7 +271,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         notes.push(format!("{merges} massless or zero-inertia links merged into the links they are fixed to"));
     }
     let (mut joints, mut joint_names, mut mimics) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut still, mut limited) = (0, 0);
+    let mut still = 0;
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
         let (damping, friction) = j.dynamics.as_ref().map_or((0.0, 0.0), |d| (d.damping, d.friction));
@@ -306,7 +307,6 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         }
         if let Some(limit) = urdf_limit(j) {
             limit.check().map_err(|e| refused("joint", &j.name, e.to_string().replace("invalid model: ", "")))?;
-            limited += 1;
             joint = joint.with_limit(limit);
         }
         if let Some(m) = j.mimic.as_ref().filter(|_| moves) {
@@ -314,11 +314,6 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         }
         joints.push(joint);
         joint_names.push(j.name.clone());
-    }
-    if limited > 0 {
-        notes.push(format!(
-            "limit of {limited} joints: checked, and held by the library's cdyn::stops, not yet by cdyn run; effort bounds (no actuators yet)"
-        ));
     }
     if still > 0 {
         notes.push(format!("<dynamics> or <mimic> of {still} fixed or floating joints (nothing to move)"));

@@ -28,7 +28,9 @@
 //!
 //! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`.
 
-mod run;
 mod spatial;
+mod stepping;
+mod unilateral;
 
-pub use run::{Change, Event, Report, Unilateral, run_with_stops};
+pub use stepping::{StopSimulation, run_with_stops};
+pub use unilateral::{Change, Event, Report, Unilateral};

@@ -1,7 +1,7 @@
 //! A spatial mechanism's joint limits as stops: each finite side of a
 //! limit its joint can meet ([`Mechanism::stops`]).
 
-use super::run::Unilateral;
+use super::unilateral::Unilateral;
 use crate::error::Result;
 use crate::model::Model;
 use crate::spatial::Mechanism;

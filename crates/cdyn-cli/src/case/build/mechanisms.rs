@@ -58,12 +58,6 @@ impl Scenario {
             robot_joints: joint_names,
             notes,
         };
-        if let Some(i) = entries.joints.iter().position(|j| j.limit.is_some()) {
-            bail!(
-                "{file}: joints[{i}] ({}): limit: joint limits are held by the library (cdyn::stops::run_with_stops), not yet by cdyn run",
-                entries.joints[i].kind.name()
-            );
-        }
         joints.extend(entries.joints);
         let actuators = counts.actuated_joints(&entries.actuators, &joints, file)?;
         let mut bodies = robot.bodies;

@@ -12,6 +12,7 @@ mod invariants;
 mod mechanisms;
 
 use crate::case::runner::Case;
+use crate::case::runner::limits::{Limits, StopName};
 use crate::case::scenario::{GravitySpec, Scenario};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
@@ -22,6 +23,7 @@ use cdyn::error::{Part, positive};
 use cdyn::models::{Example, Kind};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
 use std::path::Path;
+use std::sync::Arc;
 
 /// The built-in model `kind`, its parameters read from `parameters`, which
 /// the file writes as the table `[within]`; errors name the table, the key
@@ -104,7 +106,18 @@ impl Scenario {
                 );
             }
         }
-        let Described { mut example, rows, notes, force_entries } = self.example(file)?;
+        let Described { mut example, rows, notes, force_entries, limits } = self.example(file)?;
+        // A run with limits rebuilds its model at each stop, from the
+        // mechanism: what was added to the built model would be lost.
+        if let Some(limits) = &limits {
+            let joint = limits.first_joint();
+            if !self.invariants.is_empty() {
+                bail!("{file}: [[invariants]] with joint limits (joint {joint}): not supported yet");
+            }
+            if !example.model.inputs().is_empty() {
+                bail!("{file}: [[inputs]] with joint limits (joint {joint}): not supported yet");
+            }
+        }
         for (k, spec) in self.invariants.iter().enumerate() {
             spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
         }
@@ -154,6 +167,18 @@ impl Scenario {
                 );
             }
         }
+        if let Some(limits) = &limits {
+            let gaps = limits.system.gaps(&example.q0, &example.v0).map_err(|e| anyhow!("{file}: [initial]: {e}"))?;
+            if let Some((stop, [g, _])) = limits.stops.iter().zip(gaps).find(|(_, [g, _])| *g < 0.0) {
+                let side = if stop.upper { "upper" } else { "lower" };
+                bail!(
+                    "{file}: joint {}: starts {:.3e} past its {side} limit {} (limits hold a joint within its range from the start)",
+                    stop.joint,
+                    -g,
+                    stop.bound
+                );
+            }
+        }
         if !self.inputs.is_empty() && !matches!(self.model.kind, Kind::Mechanism | Kind::Spatial) {
             bail!(
                 "{file}: [[inputs]] drive keys of a mechanism's entries: they need [model] kind = \"mechanism\" or \"spatial\""
@@ -170,7 +195,7 @@ impl Scenario {
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
             None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, notes, force_entries })
+        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, notes, force_entries, limits })
     }
 
     /// The model with its initial state, for mechanisms the entry
@@ -261,7 +286,8 @@ impl Scenario {
                 let rows = built.rows.iter().map(part).collect();
                 let forces = built.forces.iter().map(part).collect();
                 let example = Example::from_spatial_named(&mechanism, built, |k| counts.joint_name(k));
-                Ok(Described { example, rows, notes: counts.notes, force_entries: forces })
+                let limits = spatial_limits(mechanism, |k| counts.joint_name(k));
+                Ok(Described { example, rows, notes: counts.notes, force_entries: forces, limits })
             }
             built_in => {
                 if m.gravity.is_some() {
@@ -314,13 +340,28 @@ struct Described {
     rows: Vec<String>,
     notes: Vec<String>,
     force_entries: Vec<String>,
+    limits: Option<Limits>,
 }
 
 impl Described {
     /// A built-in model: no entries, nothing left out.
     fn plain(example: Example) -> Self {
-        Self { example, rows: Vec::new(), notes: Vec::new(), force_entries: Vec::new() }
+        Self { example, rows: Vec::new(), notes: Vec::new(), force_entries: Vec::new(), limits: None }
     }
+}
+
+/// The limits of a spatial mechanism's joints, if any has one (a stop, or
+/// a velocity bound to report), its joints named by `name`.
+fn spatial_limits(mechanism: cdyn::spatial::Mechanism, name: impl Fn(usize) -> String) -> Option<Limits> {
+    mechanism.joints.iter().any(|j| j.limit.is_some()).then(|| {
+        let stops = mechanism
+            .stops()
+            .into_iter()
+            .map(|stop| StopName { joint: name(stop.joint), upper: stop.upper, bound: mechanism.stop_bound(stop).0 })
+            .collect();
+        let joints = (0..mechanism.joints.len()).map(name).collect();
+        Limits { system: Arc::new(mechanism), stops, joints }
+    })
 }
 
 /// The library's error, naming the scenario's entry (`joints[2] (revolute)`,

@@ -9,6 +9,7 @@
 //! May import: `io` (and `case`'s frames).
 
 mod estimate;
+pub mod limits;
 mod result;
 mod rows;
 pub mod stiffness;
@@ -26,6 +27,7 @@ use cdyn::models::Example;
 use cdyn::record::{Record, Recorder, Sink};
 use cdyn::simulate::system::System;
 use cdyn::simulate::{Stepper, steps_to};
+use cdyn::stops::StopSimulation;
 use cdyn::{Settings, Simulation};
 use indicatif::ProgressBar;
 use result::Method;
@@ -55,6 +57,9 @@ pub struct Case {
     /// The scenario entry behind each force element of the model (a
     /// joint's damping, a damper), where known: a step too long for it names it.
     pub force_entries: Vec<String>,
+    /// The joint limits the run holds, if any: it then steps the model of
+    /// the limits held ([`cdyn::stops::StopSimulation`]).
+    pub limits: Option<limits::Limits>,
 }
 
 impl Case {
@@ -136,31 +141,90 @@ fn simulate<K: Sink>(
         Watch::Interrupts(_) if ex.drawing.is_some() || ex.sketch.is_some() => Frames::of(ex.model.n()),
         _ => Frames::none(),
     };
+    if let Some(limits) = &case.limits {
+        return match StopSimulation::new(&*limits.system, case.settings, &ex.q0, &ex.v0) {
+            Ok(mut run) => {
+                let (record, interrupted) =
+                    drive(&mut run, recorder, case.t_end, case.every, watch, &mut frames, states)?;
+                let mut method = run.simulation(|sim| Method::of(sim, interrupted, frames));
+                method.limits = Some(limits.report(run.report()));
+                Ok((record, method))
+            }
+            Err(e) => Ok((recorder.abandon(e), Method::default())),
+        };
+    }
     match Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0) {
         Ok(mut sim) => {
             let (record, interrupted) = drive(&mut sim, recorder, case.t_end, case.every, watch, &mut frames, states)?;
-            let method = Method {
-                interrupted,
-                control: Some(sim.settings().control),
-                tuning: Some(*sim.tuning()),
-                projection_iterations_per_step: sim
-                    .settings()
-                    .control
-                    .projection
-                    .is_some()
-                    .then(|| sim.projection_iterations() as f64 / sim.steps().max(1) as f64),
-                rattle_iterations_per_step: (case.settings.scheme == cdyn::Scheme::Rattle)
-                    .then(|| sim.rattle_iterations() as f64 / sim.steps().max(1) as f64),
-                newton: (case.settings.scheme == cdyn::Scheme::GeneralizedAlpha).then(|| NewtonReport {
-                    corrections_per_step: sim.newton_iterations() as f64 / sim.steps().max(1) as f64,
-                    newton_correction: sim.newton_correction(),
-                }),
-                frames,
-                rank_loss: sim.rank_loss().copied(),
-            };
-            Ok((record, method))
+            Ok((record, Method::of(&sim, interrupted, frames)))
         }
         Err(e) => Ok((recorder.abandon(e), Method::default())),
+    }
+}
+
+/// What the runner steps: a simulation, or a run with stops.
+trait Stepped {
+    fn step(&mut self) -> cdyn::Result<()>;
+    fn steps(&self) -> u64;
+    fn t(&self) -> f64;
+    fn q(&self) -> &[f64];
+    fn v(&self) -> &[f64];
+    fn h(&self) -> f64;
+    fn sample<K: Sink>(&mut self, recorder: &mut Recorder<'_, K>) -> Result<(), K::Error>;
+    fn finish<K: Sink>(&self, recorder: Recorder<'_, K>) -> Record;
+}
+
+impl<S: System> Stepped for Stepper<S> {
+    fn step(&mut self) -> cdyn::Result<()> {
+        Stepper::step(self)
+    }
+    fn steps(&self) -> u64 {
+        Stepper::steps(self)
+    }
+    fn t(&self) -> f64 {
+        Stepper::t(self)
+    }
+    fn q(&self) -> &[f64] {
+        Stepper::q(self)
+    }
+    fn v(&self) -> &[f64] {
+        Stepper::v(self)
+    }
+    fn h(&self) -> f64 {
+        self.settings().h
+    }
+    fn sample<K: Sink>(&mut self, recorder: &mut Recorder<'_, K>) -> Result<(), K::Error> {
+        recorder.sample(self)
+    }
+    fn finish<K: Sink>(&self, recorder: Recorder<'_, K>) -> Record {
+        recorder.finish(self)
+    }
+}
+
+impl<U: cdyn::stops::Unilateral + ?Sized> Stepped for StopSimulation<'_, U> {
+    fn step(&mut self) -> cdyn::Result<()> {
+        StopSimulation::step(self)
+    }
+    fn steps(&self) -> u64 {
+        StopSimulation::steps(self)
+    }
+    fn t(&self) -> f64 {
+        StopSimulation::t(self)
+    }
+    fn q(&self) -> &[f64] {
+        StopSimulation::q(self)
+    }
+    fn v(&self) -> &[f64] {
+        StopSimulation::v(self)
+    }
+    fn h(&self) -> f64 {
+        self.simulation(|sim| sim.settings().h)
+    }
+    fn sample<K: Sink>(&mut self, recorder: &mut Recorder<'_, K>) -> Result<(), K::Error> {
+        self.simulation_mut(|sim| recorder.sample(sim))
+    }
+    fn finish<K: Sink>(&self, recorder: Recorder<'_, K>) -> Record {
+        self.simulation(|sim| recorder.finish(sim))
     }
 }
 
@@ -168,8 +232,8 @@ fn simulate<K: Sink>(
 /// between two steps: the state it stopped at is sampled too (a complete
 /// CSV row), and the record says it was interrupted. `frames` is offered
 /// every sample, and the state it ends at.
-fn drive<S: System, K: Sink>(
-    sim: &mut Stepper<S>,
+fn drive<S: Stepped, K: Sink>(
+    sim: &mut S,
     mut recorder: Recorder<'_, K>,
     t_end: f64,
     every: u64,
@@ -179,7 +243,7 @@ fn drive<S: System, K: Sink>(
 ) -> Result<(Record, bool), K::Error> {
     let (error, interrupted) = drive_frames(sim, &mut recorder, t_end, every, watch, frames, &mut states)?;
     frames.end(sim.t(), sim.q());
-    let mut record = recorder.finish(sim);
+    let mut record = sim.finish(recorder);
     if error.is_some() {
         record.error = error;
     }
@@ -187,8 +251,8 @@ fn drive<S: System, K: Sink>(
 }
 
 /// [`drive`] until the run ends; returns the simulation's error, if any, and whether it was interrupted.
-fn drive_frames<S: System, K: Sink>(
-    sim: &mut Stepper<S>,
+fn drive_frames<S: Stepped, K: Sink>(
+    sim: &mut S,
     recorder: &mut Recorder<'_, K>,
     t_end: f64,
     every: u64,
@@ -196,7 +260,7 @@ fn drive_frames<S: System, K: Sink>(
     frames: &mut Frames,
     states: &mut Option<&mut States>,
 ) -> Result<(Option<cdyn::Error>, bool), K::Error> {
-    let steps = match steps_to(t_end, sim.settings().h) {
+    let steps = match steps_to(t_end, sim.h()) {
         Ok(n) => n,
         Err(e) => return Ok((Some(e), false)),
     };
@@ -242,13 +306,13 @@ fn drive_frames<S: System, K: Sink>(
 
 /// Samples `sim` into `recorder`, offers its positions to `frames`, and
 /// keeps its time, `q` and `v` in `states` where they are kept.
-fn sample<S: System, K: Sink>(
+fn sample<S: Stepped, K: Sink>(
     recorder: &mut Recorder<'_, K>,
-    sim: &mut Stepper<S>,
+    sim: &mut S,
     frames: &mut Frames,
     states: &mut Option<&mut States>,
 ) -> Result<(), K::Error> {
-    recorder.sample(sim)?;
+    sim.sample(recorder)?;
     frames.push(sim.t(), sim.q());
     if let Some(s) = states.as_deref_mut() {
         s.t.push(sim.t());

@@ -2,6 +2,7 @@
 //! library's record of the run, and what its method did.
 
 use super::Case;
+use super::limits::LimitsReport;
 use crate::case::frames::Frames;
 use cdyn::record::{Record, Series};
 use cdyn::simulate::RankLoss;
@@ -37,6 +38,9 @@ pub struct CaseResult {
     /// (`dependent_rows = "tolerate"`): the most rows at once, how many
     /// steps, the first and last; `null` if none were.
     pub dependent_rows: Option<RankLoss>,
+    /// What the run did at its joint limits (absent without limits).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limits: Option<LimitsReport>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
     /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
@@ -67,6 +71,34 @@ pub(super) struct Method {
     pub(super) newton: Option<NewtonReport>,
     pub(super) frames: Frames,
     pub(super) rank_loss: Option<RankLoss>,
+    pub(super) limits: Option<LimitsReport>,
+}
+
+impl Method {
+    /// What `sim`'s method did over its run.
+    pub(super) fn of(sim: &cdyn::Simulation<'_>, interrupted: bool, frames: Frames) -> Self {
+        let scheme = sim.settings().scheme;
+        let per_step = |count: u64| count as f64 / sim.steps().max(1) as f64;
+        Method {
+            interrupted,
+            control: Some(sim.settings().control),
+            tuning: Some(*sim.tuning()),
+            projection_iterations_per_step: sim
+                .settings()
+                .control
+                .projection
+                .is_some()
+                .then(|| per_step(sim.projection_iterations())),
+            rattle_iterations_per_step: (scheme == cdyn::Scheme::Rattle).then(|| per_step(sim.rattle_iterations())),
+            newton: (scheme == cdyn::Scheme::GeneralizedAlpha).then(|| NewtonReport {
+                corrections_per_step: per_step(sim.newton_iterations()),
+                newton_correction: sim.newton_correction(),
+            }),
+            frames,
+            rank_loss: sim.rank_loss().copied(),
+            limits: None,
+        }
+    }
 }
 
 /// The series of a run that kept none (sweeps).
@@ -91,6 +123,7 @@ impl CaseResult {
             rattle_iterations_per_step: method.rattle_iterations_per_step,
             newton: method.newton,
             dependent_rows: method.rank_loss,
+            limits: method.limits,
             interrupted: method.interrupted,
             frames: method.frames,
         }

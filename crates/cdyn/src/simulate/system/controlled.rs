@@ -109,6 +109,11 @@ impl<'m> ControlledSystem<'m> {
         self.dependent_rows = dependent;
     }
 
+    /// Counts `n` evaluations made before it (by the run it continues).
+    pub(crate) fn add_evaluations(&mut self, n: u64) {
+        self.evaluations += n;
+    }
+
     /// The model it evaluates.
     pub fn model(&self) -> &'m Model {
         self.model

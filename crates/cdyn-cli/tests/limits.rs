@@ -1,0 +1,224 @@
+//! Joint limits held by `cdyn run`: a rod on a revolute joint falls from
+//! rest onto a stop, from a scenario's `limit` key and from a URDF
+//! `<limit>`, against the stop computed by hand.
+//!
+//! A rod of mass `m`, centre of mass `L` from the pivot, inertia `I` about
+//! the pivot, released at rest at `φ₀` from the hanging position, has
+//! `φ̇² = 2k (cos φ − cos φ₀)`, `k = m g L / I`. With `sin(φ/2) = sin(φ₀/2)
+//! sin ψ` the time to fall to `φ*` is the elliptic integral
+//! `t* = (F(π/2 | m) − F(ψ* | m)) / √k`, `m = sin²(φ₀/2)`, `sin ψ* =
+//! sin(φ*/2) / sin(φ₀/2)`, and the rate there `√(2k (cos φ* − cos φ₀))`.
+
+mod common;
+
+use common::{cdyn, one_error_line, path_str, scenario};
+use std::path::Path;
+
+const G: f64 = 9.81;
+
+/// `t*` of the module's head: `∫ dψ / √(1 − m sin²ψ)` over `[ψ*, π/2]`
+/// by Simpson's rule (the integrand is smooth), over `√k`.
+fn stop_time(k: f64, phi0: f64, phi_stop: f64) -> f64 {
+    let a = (phi0 / 2.0).sin();
+    let psi_stop = ((phi_stop / 2.0).sin() / a).asin();
+    let f = |psi: f64| 1.0 / (1.0 - a * a * psi.sin().powi(2)).sqrt();
+    let n = 2000;
+    let h = (std::f64::consts::FRAC_PI_2 - psi_stop) / n as f64;
+    let weight = |i: usize| if i == 0 || i == n { 1.0 } else { [2.0, 4.0][i % 2] };
+    (0..=n).map(|i| weight(i) * f(psi_stop + i as f64 * h)).sum::<f64>() * h / 3.0 / k.sqrt()
+}
+
+/// The rate `|φ̇|` at `φ*`.
+fn stop_rate(k: f64, phi0: f64, phi_stop: f64) -> f64 {
+    (2.0 * k * (phi_stop.cos() - phi0.cos())).sqrt()
+}
+
+/// A CSV's header and rows.
+type Table = (Vec<String>, Vec<Vec<f64>>);
+
+/// The CSV's header and rows.
+fn table(path: &Path) -> Table {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    (header, rows)
+}
+
+/// Runs `text` (with `files` beside it); returns stdout, the CSV and summary.json's case.
+fn run(text: &str, files: &[(&str, &str)]) -> (String, Table, serde_json::Value) {
+    let (dir, path) = scenario("stop.toml", text);
+    for (name, body) in files {
+        std::fs::write(dir.join(name), body).unwrap();
+    }
+    let out = dir.join("out");
+    let result = cdyn(&["run", path_str(&path), "--out", path_str(&out)]);
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    (String::from_utf8_lossy(&result.stdout).into_owned(), table(&out.join("stop.csv")), summary["cases"][0].clone())
+}
+
+// The rod of the library's test (crates/cdyn/tests/limits.rs), released at
+// φ₀ = 1.2 rad onto a stop at φ = 0.3 rad: its joint's θ = φ − φ₀ ≥ −0.9.
+const M: f64 = 2.0;
+const L: f64 = 0.5;
+const JYY: f64 = 0.02;
+const PHI0: f64 = 1.2;
+const PHI_STOP: f64 = 0.3;
+const H: f64 = 1e-3;
+
+fn rod(limit: &str) -> String {
+    let (s, c) = (PHI0.sin(), PHI0.cos());
+    format!(
+        r#"
+[model]
+kind = "spatial"
+gravity = [0.0, 0.0, -{G}]
+
+[integrator]
+scheme = "rk4"
+h = {H}
+t_end = 1.0
+
+[[bodies]]
+name = "rod"
+mass = {M}
+inertia = [0.02, {JYY}, 0.005]
+position = [{x}, 0.0, {z}]
+orientation = [{q0}, 0.0, {q2}, 0.0]
+
+[[joints]]
+kind = "revolute"
+a = "rod"
+b = "ground"
+point = [0.0, 0.0, 0.0]
+axis = [0.0, 1.0, 0.0]
+limit = {limit}
+"#,
+        x = -L * s,
+        z = -L * c,
+        q0 = (PHI0 / 2.0).cos(),
+        q2 = (PHI0 / 2.0).sin(),
+    )
+}
+
+fn column(header: &[String], name: &str) -> usize {
+    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+#[test]
+fn a_rod_falling_onto_its_limit_is_stopped_when_the_elliptic_integral_says_and_held_there() {
+    let k = M * G * L / (JYY + M * L * L);
+    let (t_star, rate) = (stop_time(k, PHI0, PHI_STOP), stop_rate(k, PHI0, PHI_STOP));
+    let bound = PHI_STOP - PHI0;
+    let (stdout, (header, rows), case) = run(&rod(&format!("{{ lower = {bound} }}")), &[]);
+    assert!(stdout.contains("limits: 1 impact, 0 releases"), "{stdout}");
+    let events = case["limits"]["events"].as_array().unwrap();
+    assert_eq!(events.len(), 1, "{events:?}");
+    let event = &events[0];
+    assert_eq!((event["joint"].as_str(), event["side"].as_str()), (Some("joints[0]"), Some("lower")));
+    assert_eq!((event["event"].as_str(), event["held"].as_bool()), (Some("impact"), Some(true)));
+    let t = event["t"].as_f64().unwrap();
+    eprintln!("stopped at {t}, by hand {t_star}; rate {} against {rate}", event["rate"]);
+    assert!((t - t_star).abs() < 1e-6, "stopped at {t}, by hand {t_star}");
+    let hit = event["rate"].as_f64().unwrap();
+    // Seen at the step's end, up to h after the crossing: within h |θ̈| of the rate there.
+    assert!((-hit - rate).abs() < H * k, "{hit} against {rate}");
+    let lost = event["kinetic_energy_lost"].as_f64().unwrap();
+    assert!((lost - 0.5 * (JYY + M * L * L) * hit * hit).abs() < 1e-9 * lost, "{lost}");
+    // The CSV: one table on the h grid; θ at the bound and at rest from the step after.
+    let (q, v) = (column(&header, "joints[0].q"), column(&header, "joints[0].v"));
+    assert_eq!(rows.len(), 1001);
+    assert!(rows.iter().enumerate().all(|(i, r)| (r[0] - i as f64 * H).abs() < 1e-12));
+    let after: Vec<_> = rows.iter().filter(|r| r[0] > t + H).collect();
+    assert!(after.len() > 500);
+    let worst = after.iter().fold(0.0_f64, |w, r| w.max((r[q] - bound).abs()).max(r[v].abs()));
+    assert!(worst < 1e-9, "off the stop by {worst}");
+    assert!(rows.iter().all(|r| r[q] >= bound - 1e-9), "past the stop");
+}
+
+#[test]
+fn a_rod_with_restitution_rebounds_at_minus_e_times_its_rate_and_its_velocity_bound_is_reported() {
+    let e = 0.5;
+    let bound = PHI_STOP - PHI0;
+    let text = rod(&format!("{{ lower = {bound}, restitution = {e}, velocity = 1.0 }}"));
+    let (stdout, (header, rows), case) = run(&text, &[]);
+    let events = case["limits"]["events"].as_array().unwrap();
+    let first = &events[0];
+    assert_eq!((first["event"].as_str(), first["held"].as_bool()), (Some("impact"), Some(false)));
+    let (rate, t) = (first["rate"].as_f64().unwrap(), first["t"].as_f64().unwrap());
+    // The CSV row of the impact's step holds the state after it: θ̇⁺ = −e θ̇⁻.
+    let v = column(&header, "joints[0].v");
+    let row = rows.iter().find(|r| r[0] > t).unwrap();
+    assert!((row[v] + e * rate).abs() < 1e-9 * rate.abs(), "{} against {rate}", row[v]);
+    // The fastest the joint went is the rate into the stop, within h |θ̈|.
+    let k = M * G * L / (JYY + M * L * L);
+    let exceeded = &case["limits"]["velocity_exceeded"][0];
+    assert_eq!(exceeded["joint"].as_str(), Some("joints[0]"));
+    let ratio = exceeded["ratio"].as_f64().unwrap();
+    assert!((ratio - stop_rate(k, PHI0, PHI_STOP)).abs() < H * k, "{ratio}");
+    assert!(stdout.contains("joints[0] exceeded its velocity bound"), "{stdout}");
+}
+
+/// A bar on a hinge about y, its centre of mass `L` along x from it, the
+/// hinge limited to ±0.5 rad.
+const BAR: &str = r#"<robot name="bar">
+  <link name="base"/>
+  <link name="bar">
+    <inertial>
+      <origin xyz="0.4 0 0"/>
+      <mass value="1.5"/>
+      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.03"/>
+    </inertial>
+  </link>
+  <joint name="hinge" type="revolute">
+    <parent link="base"/>
+    <child link="bar"/>
+    <axis xyz="0 1 0"/>
+    <limit lower="-0.5" upper="0.5" effort="10" velocity="10"/>
+  </joint>
+</robot>
+"#;
+
+#[test]
+fn a_urdf_joint_is_held_at_its_limit() {
+    // Released horizontal (φ₀ = π/2 from hanging), the bar turns by θ =
+    // π/2 − φ about +y, onto the upper bound θ = 0.5.
+    let text = format!(
+        "[model]\nkind = \"spatial\"\nurdf = \"bar.urdf\"\ngravity = [0.0, 0.0, -{G}]\n\n[integrator]\nscheme = \"rk4\"\nh = {H}\nt_end = 1.0\n"
+    );
+    let (stdout, (header, rows), case) = run(&text, &[("bar.urdf", BAR)]);
+    assert!(stdout.contains("limits: 1 impact, 0 releases"), "{stdout}");
+    assert!(!stdout.contains("not yet by cdyn run"), "{stdout}");
+    let (m, l, iyy) = (1.5, 0.4, 0.03);
+    let k = m * G * l / (iyy + m * l * l);
+    let phi0 = std::f64::consts::FRAC_PI_2;
+    let t_star = stop_time(k, phi0, phi0 - 0.5);
+    let event = &case["limits"]["events"][0];
+    assert_eq!((event["joint"].as_str(), event["side"].as_str()), (Some("hinge"), Some("upper")));
+    let t = event["t"].as_f64().unwrap();
+    assert!((t - t_star).abs() < 1e-6, "stopped at {t}, by hand {t_star}");
+    let q = column(&header, "hinge.q");
+    let max = rows.iter().fold(f64::MIN, |w, r| w.max(r[q]));
+    assert!(max < 0.5 + 1e-9, "swung past its limit to {max}");
+    let last = rows.last().unwrap();
+    assert!((last[q] - 0.5).abs() < 1e-9, "{}", last[q]);
+}
+
+#[test]
+fn bad_limits_get_one_line_naming_the_joint() {
+    let text = format!(
+        "[model]\nkind = \"spatial\"\nurdf = \"bar.urdf\"\n\n[integrator]\nscheme = \"rk4\"\nh = {H}\nt_end = 0.1\n"
+    );
+    let cases = [
+        (BAR.replace(r#"lower="-0.5" upper="0.5""#, r#"lower="0.5" upper="-0.5""#), "lower is above upper"),
+        (BAR.replace(r#"upper="0.5""#, r#"upper="nan""#), "a bound is not a number"),
+    ];
+    for (urdf, reason) in cases {
+        let (dir, path) = scenario("bad.toml", &text);
+        std::fs::write(dir.join("bar.urdf"), urdf).unwrap();
+        let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+        assert!(line.contains("bad.toml") && line.contains("\"hinge\"") && line.contains(reason), "{line}");
+    }
+}

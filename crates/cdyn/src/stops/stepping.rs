@@ -1,0 +1,267 @@
+//! [`StopSimulation`]: a run with stops taken one step at a time, for a
+//! caller that records or steers it between steps (`cdyn run`'s recorder,
+//! [`run_with_stops`](super::run_with_stops)). It owns the current
+//! segment — the model of the stops held and the [`Simulation`] of it —
+//! and after each step hits, holds and releases stops as the module's
+//! head says, starting the next segment where the last one ended.
+
+use super::unilateral::{Change, Event, Report, Unilateral};
+use crate::dynamics::assemble::assemble;
+use crate::dynamics::{Breakdown, Dynamics};
+use crate::error::{Error, Part, Problem, Result};
+use crate::model::Model;
+use crate::simulate::{Settings, Simulation, steps_to};
+use std::sync::Arc;
+
+/// A [`Simulation`] of a system with stops, stepped by the caller; the
+/// stops are hit, held and released between steps.
+///
+/// The simulation of the current segment is lent out by
+/// [`StopSimulation::simulation`] and [`StopSimulation::simulation_mut`]
+/// (to sample it, say); its state is the run's state.
+pub struct StopSimulation<'u, U: Unilateral + ?Sized> {
+    // Declared before `model`, so dropped before it: it borrows the model.
+    sim: Simulation<'static>,
+    model: Arc<Model>,
+    system: &'u U,
+    settings: Settings,
+    /// The stops held, in the order of the model's last rows.
+    held: Vec<usize>,
+    /// Each stop's `(g, ġ)` at the start of the step being taken.
+    before: Vec<[f64; 2]>,
+    /// Evaluates the multipliers of the held stops' rows.
+    dynamics: Dynamics,
+    report: Report,
+}
+
+impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
+    /// Starts `system` at `t = 0` from `(q0, v0)` (no stop passed), no
+    /// stop held, as [`Simulation::new`] starts a model.
+    pub fn new(system: &'u U, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        let before = system.gaps(q0, v0)?;
+        for (k, [g, _]) in before.iter().enumerate() {
+            if *g < 0.0 {
+                let reason = format!("{} is passed by {:.3e} at the start", system.name(k), -g);
+                return Err(Problem::Stop { reason }.at(Part::InitialState));
+            }
+        }
+        let model = Arc::new(system.model_holding(&[])?);
+        let sim = start(&model, settings, q0, v0)?;
+        let dynamics = Dynamics::new(&model);
+        Ok(Self { sim, model, system, settings, held: Vec::new(), before, dynamics, report: Report::default() })
+    }
+
+    /// One step of size `h`, then the stops: those it closed are hit (the
+    /// state after the impact is the step's), held ones pulled away from
+    /// are released.
+    pub fn step(&mut self) -> Result<()> {
+        self.sim.step()?;
+        let (step, t) = (self.sim.steps(), self.sim.t());
+        let (q, v) = (self.sim.q(), self.sim.v());
+        let gaps = self.system.gaps(q, v)?;
+        for (index, ratio) in self.system.overspeed(q, v)? {
+            let overspeed = &mut self.report.overspeed;
+            match overspeed.binary_search_by_key(&index, |o| o.0) {
+                Ok(k) => overspeed[k].1 = overspeed[k].1.max(ratio),
+                Err(k) => overspeed.insert(k, (index, ratio, t)),
+            }
+        }
+        let hits: Vec<usize> = (0..gaps.len()).filter(|k| !self.held.contains(k) && gaps[*k][0] < 0.0).collect();
+        if !hits.is_empty() {
+            return self.impact(&hits, &gaps, step, t);
+        }
+        if !self.held.is_empty() && self.release(step, t)? {
+            let (q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
+            return self.restart(&q, &v, true);
+        }
+        self.before = gaps;
+        Ok(())
+    }
+
+    /// Hits the stops `hits` (whose gaps closed in the step to `t`):
+    /// Newton's impact, the stops held if plastic, and a new segment.
+    fn impact(&mut self, hits: &[usize], gaps: &[[f64; 2]], step: u64, t: f64) -> Result<()> {
+        let h = self.settings.h;
+        let with: Vec<usize> = self.held.iter().chain(hits).copied().collect();
+        let impact = self.system.model_holding(&with)?;
+        let (mut q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
+        // The positions onto every row, stops hit included, and the
+        // velocities there with (v̂) and without (v_p) the stops hit
+        // moving: v_p is Newton's plastic impact; v̂ + (1 + e)(v_p − v̂)
+        // meets the other rows and leaves the stops at −e times v̂'s rate.
+        let mut plastic = v.clone();
+        assemble(&impact, &mut q, &mut plastic, t, ASSEMBLY_TOLERANCE)?;
+        let mut free = v;
+        assemble(&self.model, &mut q.clone(), &mut free, t, ASSEMBLY_TOLERANCE)?;
+        // One coefficient for stops hit at once: the largest of theirs.
+        let e = hits.iter().map(|&k| self.system.restitution(k)).fold(0.0, f64::max);
+        let v: Vec<f64> = free.iter().zip(&plastic).map(|(f, p)| f + (1.0 + e) * (p - f)).collect();
+        let kinetic_lost = impact.kinetic(&q, &free) - impact.kinetic(&q, &v);
+        let rates = self.system.gaps(&q, &free)?;
+        for &stop in hits {
+            let t = crossing(self.before[stop], gaps[stop], t - h, h);
+            let change = Change::Impact { rate: rates[stop][1], kinetic_lost, held: e == 0.0 };
+            self.report.events.push(Event { stop, step, t, change });
+        }
+        let held_more = e == 0.0;
+        if held_more {
+            self.held = with;
+        }
+        self.restart(&q, &v, held_more)
+    }
+
+    /// Releases the held stops whose multiplier turned to pulling at the
+    /// current state; whether any was.
+    fn release(&mut self, step: u64, t: f64) -> Result<bool> {
+        let (q, v) = (self.sim.q(), self.sim.v());
+        self.dynamics.evaluate(&self.model, q, v, t).map_err(|b| breakdown(b, step, t))?;
+        let lambda = &self.dynamics.lambda()[self.model.m() - self.held.len()..];
+        let before = self.report.events.len();
+        for (&stop, &multiplier) in self.held.iter().zip(lambda) {
+            if multiplier > 0.0 {
+                self.report.events.push(Event { stop, step, t, change: Change::Release { multiplier } });
+            }
+        }
+        let released = &self.report.events[before..];
+        self.held.retain(|k| !released.iter().any(|event| event.stop == *k));
+        Ok(self.report.events.len() > before)
+    }
+
+    /// Starts the next segment at `(q, v)`, with the model of the stops
+    /// held now if they changed: the scheme afresh, the energy reference
+    /// the energy there (see the module's head).
+    fn restart(&mut self, q: &[f64], v: &[f64], held_changed: bool) -> Result<()> {
+        let model =
+            if held_changed { Arc::new(self.system.model_holding(&self.held)?) } else { Arc::clone(&self.model) };
+        // The run's state need not meet the start's tolerance: it is the
+        // run's, as consistent as its method keeps it.
+        let settings = Settings { consistency_tolerance: None, ..self.settings };
+        let mut sim = start(&model, settings, q, v)?;
+        sim.continue_from(&self.sim);
+        // The old simulation goes first, then the model it borrowed.
+        self.sim = sim;
+        if held_changed {
+            self.dynamics = Dynamics::new(&model);
+        }
+        self.model = model;
+        self.before = self.system.gaps(q, v)?;
+        Ok(())
+    }
+
+    /// Lends the current segment's simulation to `f`: the run's state,
+    /// time, steps and counts (which cover the whole run). Lent to a
+    /// closure rather than returned, as its model is the run's to replace.
+    pub fn simulation<R>(&self, f: impl FnOnce(&Simulation<'_>) -> R) -> R {
+        f(&self.sim)
+    }
+
+    /// Lends the current segment's simulation to `f`, mutably (a recorder
+    /// samples it so); a state `f` sets is the run's from then on.
+    pub fn simulation_mut<R>(&mut self, f: impl FnOnce(&mut Simulation<'_>) -> R) -> R {
+        f(&mut self.sim)
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.sim.steps()
+    }
+
+    /// Current time.
+    pub fn t(&self) -> f64 {
+        self.sim.t()
+    }
+
+    /// Current positions.
+    pub fn q(&self) -> &[f64] {
+        self.sim.q()
+    }
+
+    /// Current velocities.
+    pub fn v(&self) -> &[f64] {
+        self.sim.v()
+    }
+
+    /// The stops held now (indices, see [`Unilateral::stops`]).
+    pub fn held(&self) -> &[usize] {
+        &self.held
+    }
+
+    /// The stops hit and released so far, and the velocity bounds exceeded.
+    pub fn report(&self) -> &Report {
+        &self.report
+    }
+
+    /// The report of the run.
+    pub fn into_report(self) -> Report {
+        self.report
+    }
+}
+
+/// Steps `system` from `(q0, v0)` to `t_end` with `settings`, its stops
+/// hit, held and released as they come; `observe(t, q, v)` sees the
+/// start, every `every`-th step and the last (after a change made at that
+/// step). Returns the changes and the velocity bounds exceeded. A
+/// [`StopSimulation`] steps the same run one step at a time.
+pub fn run_with_stops<U: Unilateral + ?Sized, E: From<Error>>(
+    system: &U,
+    settings: Settings,
+    q0: &[f64],
+    v0: &[f64],
+    t_end: f64,
+    every: u64,
+    mut observe: impl FnMut(f64, &[f64], &[f64]) -> std::result::Result<(), E>,
+) -> std::result::Result<Report, E> {
+    let (steps, every) = (steps_to(t_end, settings.h)?, every.max(1));
+    let mut run = StopSimulation::new(system, settings, q0, v0)?;
+    observe(0.0, run.q(), run.v())?;
+    while run.steps() < steps {
+        run.step()?;
+        let step = run.steps();
+        if step.is_multiple_of(every) || step == steps {
+            observe(run.t(), run.q(), run.v())?;
+        }
+    }
+    Ok(run.into_report())
+}
+
+/// A simulation of the model in `model`'s allocation.
+fn start(model: &Arc<Model>, settings: Settings, q: &[f64], v: &[f64]) -> Result<Simulation<'static>> {
+    // SAFETY: the model lives in the `Arc`'s allocation, which neither
+    // moves nor changes while the `StopSimulation` holds the `Arc`; the
+    // simulation borrowing it is dropped before it (field order, and
+    // `restart` replaces the simulation before the model), and no
+    // reference with the made-up lifetime leaves the type: `simulation`
+    // and `simulation_mut` lend it to closures that take any lifetime, so
+    // keep nothing of it.
+    let model: &'static Model = unsafe { &*Arc::as_ptr(model) };
+    Simulation::new(model, settings, q, v)
+}
+
+fn breakdown(b: Breakdown, step: u64, t: f64) -> Error {
+    match b {
+        Breakdown::Singular(row) => Error::SingularConstraints { step, t, row },
+        Breakdown::NonFinite => Error::Diverged { step, t },
+        Breakdown::Mass(coordinate) => Error::MassNotPositive { step, t, coordinate },
+    }
+}
+
+/// How closely an impact's projection meets the rows.
+const ASSEMBLY_TOLERANCE: f64 = 1e-12;
+
+/// The time in `[t0, t0 + h]` where the cubic through `(g, ġ)` at both
+/// ends crosses zero (`g ≥ 0` at `t0`, `< 0` at the end), by bisection.
+fn crossing([g0, r0]: [f64; 2], [g1, r1]: [f64; 2], t0: f64, h: f64) -> f64 {
+    let cubic = |s: f64| {
+        let (s2, s3) = (s * s, s * s * s);
+        g0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+            + r0 * h * (s3 - 2.0 * s2 + s)
+            + g1 * (3.0 * s2 - 2.0 * s3)
+            + r1 * h * (s3 - s2)
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if cubic(mid) >= 0.0 { lo = mid } else { hi = mid }
+    }
+    t0 + h * 0.5 * (lo + hi)
+}

@@ -1,0 +1,74 @@
+//! What a system with stops is ([`Unilateral`]) and what its run reports
+//! ([`Report`]: the stops hit and released, the velocity bounds exceeded).
+
+use crate::error::Result;
+use crate::model::Model;
+
+/// A system with stops, for [`run_with_stops`].
+pub trait Unilateral {
+    /// How many stops it has.
+    fn stops(&self) -> usize;
+    /// Its model with the stops `held` (indices, in this order) as its last
+    /// rows, each `g = 0`.
+    fn model_holding(&self, held: &[usize]) -> Result<Model>;
+    /// Each stop's gap `g` (`≥ 0` allowed) and its rate `ġ` at `(q, v)`.
+    fn gaps(&self, q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>>;
+    /// Newton's coefficient of restitution of a stop.
+    fn restitution(&self, stop: usize) -> f64;
+    /// How messages name a stop (`"joint 2's upper limit"`).
+    fn name(&self, stop: usize) -> String;
+    /// The coordinates moving faster than their velocity bound at `(q, v)`:
+    /// `(index, |rate| / bound)` with the ratio above 1. Reported, not enforced.
+    fn overspeed(&self, _q: &[f64], _v: &[f64]) -> Result<Vec<(usize, f64)>> {
+        Ok(Vec::new())
+    }
+}
+
+/// What a run with stops did besides its states.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub struct Report {
+    /// The stops hit and released, in order.
+    pub events: Vec<Event>,
+    /// Each coordinate that exceeded its velocity bound at a step's end:
+    /// `(index, largest |rate| / bound, first time)`, by index.
+    pub overspeed: Vec<(usize, f64, f64)>,
+}
+
+/// What happened at a stop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Change {
+    /// Hit with the gap's rate `rate` (< 0); the impact took `kinetic_lost`
+    /// of kinetic energy; `held` unless it rebounded (`e > 0`).
+    Impact {
+        /// `ġ` just before the impact, at the stop (the positions projected
+        /// onto it, the velocities onto the other rows there).
+        rate: f64,
+        /// `T⁻ − T⁺` across the impact, at the stop: `(1 − e²) ġ² / (2 g_q M⁻¹ g_qᵀ)`
+        /// for one stop, the kinetic energy of the velocity along it.
+        kinetic_lost: f64,
+        /// Whether the stop is held now.
+        held: bool,
+    },
+    /// Released: the row's multiplier turned to pulling.
+    Release {
+        /// `λ` of the row `g = 0` (> 0).
+        multiplier: f64,
+    },
+}
+
+/// A stop hit or released.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Event {
+    /// Which stop (see [`Unilateral::stops`]).
+    pub stop: usize,
+    /// The step after which it was seen (`t = step · h`).
+    pub step: u64,
+    /// When: for an impact, the crossing time within that step; for a
+    /// release, the step's end.
+    pub t: f64,
+    /// What happened.
+    pub change: Change,
+}
