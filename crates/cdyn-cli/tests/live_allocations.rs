@@ -71,25 +71,28 @@ fn a_cosimulation_step_allocates_nothing() {
     }
 }
 
-#[test]
-fn a_robots_step_and_outputs_with_its_joint_angles_allocate_nothing() {
+/// `examples/NAME` stepped from outside: refused, naming the first limited
+/// joint (arm.urdf's limits are held by cdyn run, and a stepped case does
+/// not hold them yet), then the same scenario beside a copy of arm.urdf
+/// without its `<limit>`s (and so without their effort clamps).
+fn live_without_limits(name: &str) -> Live {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
-    let text = std::fs::read_to_string(examples.join("arm_tethered.toml")).unwrap();
-    let (parsed, _) = scenario::parse(&text, "arm_tethered.toml").unwrap();
-    // Its robot's joint limits are held by cdyn run, and refused here (a
-    // stepped case does not hold them yet), naming the first limited joint.
-    let refused = Live::from_scenario(&parsed, &examples.join("arm_tethered.toml")).err().unwrap().to_string();
+    let text = std::fs::read_to_string(examples.join(name)).unwrap();
+    let (parsed, _) = scenario::parse(&text, name).unwrap();
+    let refused = Live::from_scenario(&parsed, &examples.join(name)).err().unwrap().to_string();
     assert!(refused.contains("joint shoulder_yaw: limit: joint limits are held by cdyn run"), "{refused}");
-    // The same robot without its limits.
-    let dir = std::env::temp_dir().join(format!("cdyn-live-arm-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("cdyn-live-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let urdf = std::fs::read_to_string(examples.join("arm.urdf")).unwrap();
     let unlimited: Vec<&str> = urdf.lines().filter(|l| !l.contains("<limit")).collect();
     std::fs::write(dir.join("arm.urdf"), unlimited.join("\n")).unwrap();
-    let path = dir.join("arm_tethered.toml");
+    let path = dir.join(name);
     std::fs::write(&path, &text).unwrap();
-    let mut live = Live::from_scenario(&parsed, &path).unwrap();
-    assert!(live.output_names().iter().any(|n| n == "wrist.q"), "{:?}", live.output_names());
+    Live::from_scenario(&parsed, &path).unwrap()
+}
+
+/// Twenty periods of ten steps, each followed by reading every output: no allocation.
+fn steps_and_outputs_allocate_nothing(live: &mut Live) {
     let mut outputs = vec![0.0; live.output_names().len()];
     for k in 0..20 {
         let before = count();
@@ -101,17 +104,15 @@ fn a_robots_step_and_outputs_with_its_joint_angles_allocate_nothing() {
 }
 
 #[test]
+fn a_robots_step_and_outputs_with_its_joint_angles_allocate_nothing() {
+    let mut live = live_without_limits("arm_tethered.toml");
+    assert!(live.output_names().iter().any(|n| n == "wrist.q"), "{:?}", live.output_names());
+    steps_and_outputs_allocate_nothing(&mut live);
+}
+
+#[test]
 fn an_actuated_robots_step_and_its_torque_outputs_allocate_nothing() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/arm_pd.toml");
-    let (parsed, _) = scenario::parse(&std::fs::read_to_string(&path).unwrap(), &path.display().to_string()).unwrap();
-    let mut live = Live::from_scenario(&parsed, &path).unwrap();
+    let mut live = live_without_limits("arm_pd.toml");
     assert!(live.output_names().iter().any(|n| n == "shoulder_pitch.tau"), "{:?}", live.output_names());
-    let mut outputs = vec![0.0; live.output_names().len()];
-    for k in 0..20 {
-        let before = count();
-        live.step(10).unwrap();
-        let stepped = count();
-        live.outputs(&mut outputs);
-        assert_eq!([stepped - before, count() - stepped], [0, 0], "allocations by step, outputs at period {k}");
-    }
+    steps_and_outputs_allocate_nothing(&mut live);
 }
