@@ -111,10 +111,10 @@ impl Scenario {
         // mechanism: what was added to the built model would be lost. The
         // inputs are not: the mechanism's actuators hold them (the same
         // handles in every rebuilt model).
-        if let Some(limits) = &limits {
-            if !self.invariants.is_empty() {
-                bail!("{file}: [[invariants]] with joint limits (joint {}): not supported yet", limits.first_joint());
-            }
+        if let Some(limits) = &limits
+            && !self.invariants.is_empty()
+        {
+            bail!("{file}: [[invariants]] with joint limits (joint {}): not supported yet", limits.first_joint());
         }
         for (k, spec) in self.invariants.iter().enumerate() {
             spec.declare(&mut example).map_err(|e| anyhow!("{file}: invariants[{k}]: {e}"))?;
