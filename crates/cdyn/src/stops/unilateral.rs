@@ -4,7 +4,7 @@
 use crate::error::Result;
 use crate::model::Model;
 
-/// A system with stops, for [`run_with_stops`].
+/// A system with stops, for [`run_with_stops`](super::run_with_stops).
 pub trait Unilateral {
     /// How many stops it has.
     fn stops(&self) -> usize;
