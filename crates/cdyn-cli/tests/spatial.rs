@@ -502,8 +502,11 @@ drives = "actuators[2].target"
 start = 0.0
 "#;
 
-/// Runs `text` beside arm.urdf; the CSV's header and rows, or the error line.
-fn run_arm(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
+/// A run's CSV header and rows, and summary.json's case.
+type ArmRun = (Vec<String>, Vec<Vec<f64>>, serde_json::Value);
+
+/// Runs `text` beside arm.urdf, or gives the error line.
+fn run_arm(text: &str) -> Result<ArmRun, String> {
     let (dir, path) = scenario("arm.toml", text);
     std::fs::write(dir.join("arm.urdf"), example("arm.urdf")).unwrap();
     let out = dir.join("out");
@@ -511,12 +514,15 @@ fn run_arm(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
     if !result.status.success() {
         return Err(one_error_line(&result));
     }
-    Ok(table(&out.join("arm.csv")))
+    let (header, rows) = table(&out.join("arm.csv"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    Ok((header, rows, summary["cases"][0].clone()))
 }
 
 #[test]
 fn an_arm_starts_at_its_initial_joint_angles_and_writes_each_actuators_torque() {
-    let (header, rows) = run_arm(ACTUATED_ARM).unwrap();
+    let (header, rows, summary) = run_arm(ACTUATED_ARM).unwrap();
     let col = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
     let first = &rows[0];
     // The t = 0 row reads the given joint values back (the assembly's
@@ -542,6 +548,36 @@ fn an_arm_starts_at_its_initial_joint_angles_and_writes_each_actuators_torque() 
     assert!((last[0] - 0.1).abs() < 1e-12 && (last[col("wrist.tau")] - 0.6).abs() < 1e-12, "{last:?}");
     // The clamped servo drives the pitch up towards its target.
     assert!(last[col("shoulder_pitch.q")] > 0.45, "{}", last[col("shoulder_pitch.q")]);
+    // summary.json's joint space: each joint column's range and last value
+    // as the CSV holds them, and each actuator against its effort.
+    let joint_space = &summary["joint_space"];
+    let columns = joint_space["joints"].as_array().unwrap();
+    let joint_columns = header.iter().filter(|h| [".q", ".v", ".tau"].iter().any(|s| h.ends_with(s))).count();
+    assert_eq!(columns.len(), joint_columns, "{joint_space}");
+    for c in columns {
+        let name = c["column"].as_str().unwrap();
+        let values: Vec<f64> = rows.iter().map(|r| r[col(name)]).collect();
+        let (min, max) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        assert_eq!(
+            [c["min"].as_f64(), c["max"].as_f64(), c["final"].as_f64()],
+            [Some(min), Some(max), values.last().copied()],
+            "{name}"
+        );
+    }
+    let actuators = joint_space["actuators"].as_array().unwrap();
+    let pitch = &actuators[0];
+    assert_eq!(
+        (pitch["column"].as_str(), pitch["max_abs"].as_f64(), pitch["effort"].as_f64()),
+        (Some("shoulder_pitch.tau"), Some(30.0), Some(30.0))
+    );
+    let samples = pitch["samples"].as_u64().unwrap();
+    assert_eq!(samples, rows.len() as u64);
+    let at_bound = rows.iter().filter(|r| r[col("shoulder_pitch.tau")].abs() == 30.0).count() as u64;
+    assert!(at_bound >= 1 && pitch["saturated_samples"].as_u64() == Some(at_bound), "{pitch} against {at_bound}");
+    // The wrist has no <limit> in arm.urdf, so no effort bound to reach.
+    assert!(actuators[1]["effort"].is_null(), "{}", actuators[1]);
+    assert_eq!(actuators[1]["saturated_samples"].as_u64(), Some(0), "{}", actuators[1]);
+    assert!((actuators[1]["max_abs"].as_f64().unwrap() - 0.6).abs() < 1e-12, "{}", actuators[1]);
 }
 
 #[test]

@@ -35,6 +35,7 @@ pub fn cases() -> Result<Vec<Case>> {
                 notes: Vec::new(),
                 force_entries: Vec::new(),
                 limits: None,
+                joint_columns: None,
             });
         }
     }

@@ -12,6 +12,7 @@ mod invariants;
 mod mechanisms;
 
 use crate::case::runner::Case;
+use crate::case::runner::JointColumns;
 use crate::case::runner::limits::{Limits, StopName};
 use crate::case::scenario::{GravitySpec, Scenario};
 use crate::case::wording::{locate, reason};
@@ -106,7 +107,7 @@ impl Scenario {
                 );
             }
         }
-        let Described { mut example, rows, notes, force_entries, limits } = self.example(file)?;
+        let Described { mut example, rows, notes, force_entries, limits, joint_columns } = self.example(file)?;
         // A run with limits rebuilds its model at each stop, from the
         // mechanism: what was added to the built model would be lost. The
         // inputs are not: the mechanism's actuators hold them (the same
@@ -193,7 +194,20 @@ impl Scenario {
             Some(n) => bail!("{file}: [output] name = {n:?}: use letters, digits, '_', '-', '.'"),
             None => path.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned()),
         };
-        Ok(Case { name, example, settings, t_end, every, assembly, row_entries: rows, notes, force_entries, limits })
+        let row_entries = rows;
+        Ok(Case {
+            name,
+            example,
+            settings,
+            t_end,
+            every,
+            assembly,
+            row_entries,
+            notes,
+            force_entries,
+            limits,
+            joint_columns,
+        })
     }
 
     /// The model with its initial state, for mechanisms the entry
@@ -283,9 +297,19 @@ impl Scenario {
                 }
                 let rows = built.rows.iter().map(part).collect();
                 let forces = built.forces.iter().map(part).collect();
+                let first = built.model.n();
                 let example = Example::from_spatial_named(&mechanism, built, |k| counts.joint_name(k));
+                let joint_columns = (example.observables.len() > first).then(|| JointColumns {
+                    first,
+                    efforts: mechanism
+                        .actuators
+                        .iter()
+                        .map(|a| mechanism.joints[a.joint].limit.map_or(f64::INFINITY, |l| l.effort))
+                        .collect(),
+                });
                 let limits = spatial_limits(mechanism, |k| counts.joint_name(k));
-                Ok(Described { example, rows, notes: counts.notes, force_entries: forces, limits })
+                let notes = counts.notes;
+                Ok(Described { example, rows, notes, force_entries: forces, limits, joint_columns })
             }
             built_in => {
                 if m.gravity.is_some() {
@@ -339,12 +363,14 @@ struct Described {
     notes: Vec<String>,
     force_entries: Vec<String>,
     limits: Option<Limits>,
+    joint_columns: Option<JointColumns>,
 }
 
 impl Described {
     /// A built-in model: no entries, nothing left out.
     fn plain(example: Example) -> Self {
-        Self { example, rows: Vec::new(), notes: Vec::new(), force_entries: Vec::new(), limits: None }
+        let (rows, notes, force_entries) = (Vec::new(), Vec::new(), Vec::new());
+        Self { example, rows, notes, force_entries, limits: None, joint_columns: None }
     }
 }
 

@@ -4,17 +4,21 @@
 //!
 //! Here the [`Case`] and the runs (to a CSV file, in memory, quietly);
 //! `estimate` what a run will write before it starts; `result` what a case
-//! produced, as `summary.json` reports it; `rows` the samples as CSV rows.
+//! produced, as `summary.json` reports it; `rows` the samples as CSV rows;
+//! `joint_stats` a spatial run's joint space over its samples; `limits` the
+//! joint limits a run holds; `stiffness` a step too long for its damping.
 //!
 //! May import: `io` (and `case`'s frames).
 
 mod estimate;
+mod joint_stats;
 pub mod limits;
 mod result;
 mod rows;
 pub mod stiffness;
 
 pub use estimate::{Estimate, OUTPUT_LIMIT, every_to_fit};
+pub use joint_stats::{ActuatorStats, JointColumn, JointColumns, JointStats};
 pub use result::{CaseResult, NewtonReport};
 pub use rows::{Rows, columns, row_values};
 
@@ -30,6 +34,7 @@ use cdyn::simulate::{Stepper, steps_to};
 use cdyn::stops::StopSimulation;
 use cdyn::{Settings, Simulation};
 use indicatif::ProgressBar;
+use joint_stats::Watching;
 use result::Method;
 use rows::CsvRows;
 use std::path::Path;
@@ -60,9 +65,18 @@ pub struct Case {
     /// The joint limits the run holds, if any: it then steps the model of
     /// the limits held ([`cdyn::stops::StopSimulation`]).
     pub limits: Option<limits::Limits>,
+    /// Where a spatial run's joint columns are among the observables, for
+    /// `summary.json`'s `joint_space`.
+    pub joint_columns: Option<JointColumns>,
 }
 
 impl Case {
+    /// Empty statistics of its joint columns (none without them).
+    fn joint_stats(&self) -> JointStats {
+        let at = self.joint_columns.as_ref();
+        at.map_or_else(JointStats::default, |at| JointStats::new(&self.example.observables, at))
+    }
+
     /// Checks that the case can start: settings valid, initial state
     /// consistent, and an explicit step within its scheme's stability limit
     /// on the damping and springs ([`stiffness::refusal`]): past it, a run
@@ -83,10 +97,12 @@ impl Case {
 pub fn run_case_in_memory(case: &Case, stop: &dyn Fn() -> bool) -> (CaseResult, Rows) {
     let mut rows = Rows { columns: columns(&case.example), ..Rows::default() };
     let mut states = States::default();
-    let recorder = Recorder::example(&case.example).keep_series(false).sink(&mut rows);
+    let mut stats = case.joint_stats();
+    let sink = Watching { inner: &mut rows, stats: &mut stats };
+    let recorder = Recorder::example(&case.example).keep_series(false).sink(sink);
     let Ok(record) = simulate(case, recorder, Watch::Asking(stop), Some(&mut states));
     (rows.t_exact, rows.q, rows.v) = (states.t, states.q, states.v);
-    (CaseResult::new(case, record), rows)
+    (CaseResult::new(case, record).with_joint_space(case, stats), rows)
 }
 
 /// Runs `case`, writing `dir/<name>.csv` (under a temporary name until it
@@ -96,13 +112,15 @@ pub fn run_case_in_memory(case: &Case, stop: &dyn Fn() -> bool) -> (CaseResult, 
 pub fn run_case(case: &Case, dir: &Path, progress: &ProgressBar) -> Result<CaseResult> {
     let path = dir.join(format!("{}.csv", case.name));
     let mut file = AtomicFile::create(&path)?;
+    let mut stats = case.joint_stats();
     let record = CsvRows::start(file.writer(), &case.example).and_then(|rows| {
-        let recorder = Recorder::example(&case.example).keep_series(true).sink(rows);
+        let sink = Watching { inner: rows, stats: &mut stats };
+        let recorder = Recorder::example(&case.example).keep_series(true).sink(sink);
         simulate(case, recorder, Watch::Interrupts(progress), None)
     });
     let record = record.with_context(|| format!("cannot write {}", path.display()))?;
     file.commit()?;
-    Ok(CaseResult::new(case, record))
+    Ok(CaseResult::new(case, record).with_joint_space(case, stats))
 }
 
 /// Runs `case` keeping only its statistics (for sweeps).

@@ -2,6 +2,7 @@
 //! library's record of the run, and what its method did.
 
 use super::Case;
+use super::joint_stats::JointStats;
 use super::limits::LimitsReport;
 use crate::case::frames::Frames;
 use cdyn::record::{Record, Series};
@@ -41,6 +42,10 @@ pub struct CaseResult {
     /// What the run did at its joint limits (absent without limits).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limits: Option<LimitsReport>,
+    /// A spatial run's joint columns and actuators over the samples
+    /// written (absent for other runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint_space: Option<JointStats>,
     /// `None` when the run finished; the error otherwise.
     pub error: Option<String>,
     /// Whether SIGINT or SIGTERM stopped the run (at `steps`, `t_final`).
@@ -124,9 +129,15 @@ impl CaseResult {
             newton: method.newton,
             dependent_rows: method.rank_loss,
             limits: method.limits,
+            joint_space: None,
             interrupted: method.interrupted,
             frames: method.frames,
         }
+    }
+
+    /// With the joint-space statistics of a case that has joint columns.
+    pub(super) fn with_joint_space(self, case: &Case, stats: JointStats) -> Self {
+        Self { joint_space: case.joint_columns.is_some().then_some(stats), ..self }
     }
 
     /// Sampled time histories, for the figures (empty for sweeps).
