@@ -4,16 +4,18 @@
 //!
 //! Here the case and its model; `mechanisms` the planar and spatial
 //! mechanisms of the entries (and a URDF robot's) and the entry behind each
-//! part; `invariants` the declared `[[invariants]]`.
+//! part; `spatial` a spatial scenario's model with its initial joint
+//! state, joint columns and limits; `invariants` the declared `[[invariants]]`.
 //!
 //! May import: `io` (and `case`'s scenario, runner and wording).
 
 mod invariants;
 mod mechanisms;
+mod spatial;
 
 use crate::case::runner::Case;
 use crate::case::runner::JointColumns;
-use crate::case::runner::limits::{Limits, StopName};
+use crate::case::runner::limits::Limits;
 use crate::case::scenario::{GravitySpec, Scenario};
 use crate::case::wording::{locate, reason};
 use anyhow::{Result, anyhow, bail};
@@ -24,7 +26,6 @@ use cdyn::error::{Part, positive};
 use cdyn::models::{Example, Kind};
 use cdyn::simulate::{nearest_valid_t_end, steps_to};
 use std::path::Path;
-use std::sync::Arc;
 
 /// The built-in model `kind`, its parameters read from `parameters`, which
 /// the file writes as the table `[within]`; errors name the table, the key
@@ -275,42 +276,7 @@ impl Scenario {
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
                 Ok(Described { rows, ..Described::plain(Example::from_mechanism(built, None)) })
             }
-            Kind::Spatial => {
-                let gravity = match m.gravity {
-                    None => [0.0; 3],
-                    Some(GravitySpec::Vector3(g)) if g.iter().all(|x| x.is_finite()) => g,
-                    _ => bail!("{file}: [model] gravity: a spatial mechanism takes a finite vector [gx, gy, gz]"),
-                };
-                let mut entries = self.spatial.clone().unwrap_or_default();
-                crate::case::inputs::drive_actuators(&self.inputs, &mut entries.actuators, file)?;
-                let (mechanism, counts) = self.spatial_mechanism(file, entries, gravity)?;
-                let part = |part: &Part| counts.entry(part);
-                let built = mechanism.and_then(|m| m.build().map(|b| (m, b))).map_err(|e| match e {
-                    cdyn::Error::InvalidModel { at: at @ (Part::Body { .. } | Part::Element { .. }), problem } => {
-                        anyhow!("{file}: {}: {problem}", part(&at))
-                    }
-                    other => anyhow!("{file}: {other}"),
-                })?;
-                let (mechanism, mut built) = built;
-                if let Some((q0, v0)) = self.initial.joint_state(&mechanism, |k| counts.joint_name(k), file)? {
-                    (built.q0, built.v0) = (q0, v0);
-                }
-                let rows = built.rows.iter().map(part).collect();
-                let forces = built.forces.iter().map(part).collect();
-                let first = built.model.n();
-                let example = Example::from_spatial_named(&mechanism, built, |k| counts.joint_name(k));
-                let joint_columns = (example.observables.len() > first).then(|| JointColumns {
-                    first,
-                    efforts: mechanism
-                        .actuators
-                        .iter()
-                        .map(|a| mechanism.joints[a.joint].limit.map_or(f64::INFINITY, |l| l.effort))
-                        .collect(),
-                });
-                let limits = spatial_limits(mechanism, |k| counts.joint_name(k));
-                let notes = counts.notes;
-                Ok(Described { example, rows, notes, force_entries: forces, limits, joint_columns })
-            }
+            Kind::Spatial => self.spatial_example(file),
             built_in => {
                 if m.gravity.is_some() {
                     bail!("{file}: [model] gravity: this model takes its parameters in [model.parameters]");
@@ -319,39 +285,6 @@ impl Scenario {
                 Ok(Described::plain(builtin(file, built_in, "model.parameters", parameters)?))
             }
         }
-    }
-}
-
-impl crate::case::scenario::InitialSpec {
-    /// The state of `mechanism` at `[initial] joints` and `rates`, if given,
-    /// each joint named as its output columns are (`name(k)` of joint `k`).
-    fn joint_state(
-        &self,
-        mechanism: &cdyn::spatial::Mechanism,
-        name: impl Fn(usize) -> String,
-        file: &str,
-    ) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
-        if self.joints.is_none() && self.rates.is_none() {
-            return Ok(None);
-        }
-        let space = mechanism.joint_space().map_err(|e| anyhow!("{file}: {e}"))?;
-        let known: Vec<(usize, String)> = space.joints().map(|k| (k, name(k))).collect();
-        let pick = |key: &str, given: &Option<std::collections::BTreeMap<String, f64>>| {
-            let values = given.iter().flatten().map(|(joint, &value)| match known.iter().find(|(_, n)| n == joint) {
-                Some(&(k, _)) => Ok((k, value)),
-                None => {
-                    let names: Vec<&str> = known.iter().map(|(_, n)| n.as_str()).collect();
-                    bail!(
-                        "{file}: [initial] {key}: no revolute or prismatic joint {joint:?}; the joints are {}",
-                        names.join(", ")
-                    )
-                }
-            });
-            values.collect::<Result<Vec<_>>>()
-        };
-        let (coordinates, rates) = (pick("joints", &self.joints)?, pick("rates", &self.rates)?);
-        let state = mechanism.state_at_joints(&coordinates, &rates).map_err(|e| anyhow!("{file}: [initial] {e}"))?;
-        Ok(Some(state))
     }
 }
 
@@ -372,20 +305,6 @@ impl Described {
         let (rows, notes, force_entries) = (Vec::new(), Vec::new(), Vec::new());
         Self { example, rows, notes, force_entries, limits: None, joint_columns: None }
     }
-}
-
-/// The limits of a spatial mechanism's joints, if any has one (a stop, or
-/// a velocity bound to report), its joints named by `name`.
-fn spatial_limits(mechanism: cdyn::spatial::Mechanism, name: impl Fn(usize) -> String) -> Option<Limits> {
-    mechanism.joints.iter().any(|j| j.limit.is_some()).then(|| {
-        let stops = mechanism
-            .stops()
-            .into_iter()
-            .map(|stop| StopName { joint: name(stop.joint), upper: stop.upper, bound: mechanism.stop_bound(stop).0 })
-            .collect();
-        let joints = (0..mechanism.joints.len()).map(name).collect();
-        Limits { system: Arc::new(mechanism), stops, joints }
-    })
 }
 
 /// The library's error, naming the scenario's entry (`joints[2] (revolute)`,
