@@ -32,5 +32,5 @@ mod spatial;
 mod stepping;
 mod unilateral;
 
-pub use stepping::{StopSimulation, run_with_stops};
+pub use stepping::{START_SLACK, StopSimulation, run_with_stops};
 pub use unilateral::{Change, Event, Report, Unilateral};

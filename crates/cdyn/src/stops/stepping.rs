@@ -40,7 +40,7 @@ impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
     pub fn new(system: &'u U, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
         let before = system.gaps(q0, v0)?;
         for (k, [g, _]) in before.iter().enumerate() {
-            if *g < 0.0 {
+            if *g < -START_SLACK {
                 let reason = format!("{} is passed by {:.3e} at the start", system.name(k), -g);
                 return Err(Problem::Stop { reason }.at(Part::InitialState));
             }
@@ -244,6 +244,11 @@ fn breakdown(b: Breakdown, step: u64, t: f64) -> Error {
         Breakdown::Mass(coordinate) => Error::MassNotPositive { step, t, coordinate },
     }
 }
+
+/// How far past a stop a run may start: a pose placed at a bound (a
+/// robot's zero pose at a limit of 0) lands there only to round-off
+/// (2.8e-17 seen), and is at the stop, not past it.
+pub const START_SLACK: f64 = 1e-12;
 
 /// How closely an impact's projection meets the rows.
 const ASSEMBLY_TOLERANCE: f64 = 1e-12;

@@ -169,7 +169,9 @@ impl Scenario {
         }
         if let Some(limits) = &limits {
             let gaps = limits.system.gaps(&example.q0, &example.v0).map_err(|e| anyhow!("{file}: [initial]: {e}"))?;
-            if let Some((stop, [g, _])) = limits.stops.iter().zip(gaps).find(|(_, [g, _])| *g < 0.0) {
+            if let Some((stop, [g, _])) =
+                limits.stops.iter().zip(gaps).find(|(_, [g, _])| *g < -cdyn::stops::START_SLACK)
+            {
                 let side = if stop.upper { "upper" } else { "lower" };
                 bail!(
                     "{file}: joint {}: starts {:.3e} past its {side} limit {} (limits hold a joint within its range from the start)",
