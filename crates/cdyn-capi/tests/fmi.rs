@@ -6,32 +6,11 @@
 //! step (fmi2SetReal, fmi2DoStep, fmi2GetReal) allocates nothing.
 
 use cdyn_capi::fmi::*;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use cdyn_cli::io::alloc_count::{Counting, thread_allocations};
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::sync::Mutex;
 
-/// Counts this thread's allocations (other threads of the harness do not count).
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
+/// Counts allocations by thread (`thread_allocations`): the harness's other threads do not count.
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
@@ -218,11 +197,11 @@ fn a_communication_step_allocates_nothing() {
     fmu.start();
     let (vrs, mut outputs) = ([T, ANGLE, 11, 12, 13], [0.0; 5]);
     for k in 0..50 {
-        let before = ALLOCATIONS.with(|c| c.get());
+        let before = thread_allocations();
         assert_eq!(fmu.set(TAU, (k as f64 * 0.1).sin()), OK);
         assert_eq!(unsafe { fmi2DoStep(fmu.c, k as f64 * 0.01, 0.01, 1) }, OK);
         assert_eq!(unsafe { fmi2GetReal(fmu.c, vrs.as_ptr(), vrs.len(), outputs.as_mut_ptr()) }, OK);
-        assert_eq!(ALLOCATIONS.with(|c| c.get()) - before, 0, "communication step {k}");
+        assert_eq!(thread_allocations() - before, 0, "communication step {k}");
     }
     assert!((outputs[0] - 0.5).abs() < 1e-12);
 }

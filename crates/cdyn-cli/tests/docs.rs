@@ -2,7 +2,6 @@
 //! README's commands do what it says, `cdyn paper` prints the README's
 //! table to the last digit, and every link between the pages resolves.
 
-#[allow(dead_code)] // each test file uses some of the helpers
 mod common;
 
 use common::{cdyn, path_str, scenario};

@@ -2,7 +2,6 @@
 //! example of it, the exit codes are in `cdyn --help`, and completions and
 //! man pages are generated for every command.
 
-#[allow(dead_code)] // each test file uses some of the helpers
 mod common;
 
 use common::{cdyn, path_str};

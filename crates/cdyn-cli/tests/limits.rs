@@ -11,8 +11,7 @@
 
 mod common;
 
-use common::{cdyn, one_error_line, path_str, scenario};
-use std::path::Path;
+use common::{Table, cdyn, one_error_line, path_str, scenario, summary_case, table};
 
 const G: f64 = 9.81;
 
@@ -33,18 +32,6 @@ fn stop_rate(k: f64, phi0: f64, phi_stop: f64) -> f64 {
     (2.0 * k * (phi_stop.cos() - phi0.cos())).sqrt()
 }
 
-/// A CSV's header and rows.
-type Table = (Vec<String>, Vec<Vec<f64>>);
-
-/// The CSV's header and rows.
-fn table(path: &Path) -> Table {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
-    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
-    (header, rows)
-}
-
 /// Runs `text` (with `files` beside it); returns stdout, the CSV and summary.json's case.
 fn run(text: &str, files: &[(&str, &str)]) -> (String, Table, serde_json::Value) {
     let (dir, path) = scenario("stop.toml", text);
@@ -54,9 +41,7 @@ fn run(text: &str, files: &[(&str, &str)]) -> (String, Table, serde_json::Value)
     let out = dir.join("out");
     let result = cdyn(&["run", path_str(&path), "--out", path_str(&out)]);
     assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    (String::from_utf8_lossy(&result.stdout).into_owned(), table(&out.join("stop.csv")), summary["cases"][0].clone())
+    (String::from_utf8_lossy(&result.stdout).into_owned(), table(&out.join("stop.csv")), summary_case(&out))
 }
 
 // The rod of the library's test (crates/cdyn/tests/limits.rs), released at

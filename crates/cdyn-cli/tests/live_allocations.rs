@@ -8,37 +8,16 @@
 
 use cdyn_cli::case::live::Live;
 use cdyn_cli::case::scenario;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use cdyn_cli::io::alloc_count::{Counting, thread_allocations};
 use std::path::Path;
-
-struct Counting;
-
-thread_local! {
-    /// Allocations made by this thread: other threads of the test harness do not count.
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
+
+/// Allocations by this thread so far.
+fn count() -> usize {
+    thread_allocations() as usize
+}
 
 fn pendulum(scheme: &str) -> Live {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/pd_pendulum.toml");

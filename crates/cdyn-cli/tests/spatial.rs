@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{cdyn, one_error_line, path_str, scenario};
+use common::{cdyn, one_error_line, path_str, scenario, summary_case, table};
 use std::path::{Path, PathBuf};
 
 fn example(name: &str) -> String {
@@ -19,15 +19,6 @@ fn run(name: &str, text: &str) -> PathBuf {
     let result = cdyn(&["run", path_str(&path), "--out", path_str(&out)]);
     assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
     out
-}
-
-/// The CSV's header and rows.
-fn table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
-    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
-    (header, rows)
 }
 
 #[test]
@@ -515,9 +506,7 @@ fn run_arm(text: &str) -> Result<ArmRun, String> {
         return Err(one_error_line(&result));
     }
     let (header, rows) = table(&out.join("arm.csv"));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    Ok((header, rows, summary["cases"][0].clone()))
+    Ok((header, rows, summary_case(&out)))
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Helpers shared by the CLI tests that run the binary on scenario files
 //! written on the fly.
+#![allow(dead_code)] // each test file uses some of the helpers
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -31,4 +32,23 @@ pub fn one_error_line(out: &Output) -> String {
     assert_eq!(stderr.trim_end().lines().count(), 1, "not one line: {stderr}");
     assert!(stderr.starts_with("error: "), "{stderr}");
     stderr
+}
+
+/// A CSV's header and rows.
+pub type Table = (Vec<String>, Vec<Vec<f64>>);
+
+/// The header and rows of the CSV at `path`.
+pub fn table(path: &Path) -> Table {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    (header, rows)
+}
+
+/// The first case of the `summary.json` a run wrote into `out`.
+pub fn summary_case(out: &Path) -> serde_json::Value {
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    summary["cases"][0].clone()
 }
