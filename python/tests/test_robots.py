@@ -201,10 +201,16 @@ H = 1e-4
 # (shoulder_lift at its lower 0, elbow_flex at its upper 0), which gravity
 # would hold it against, so it starts inside its range (`[initial]
 # joints`, and Pinocchio's q likewise); Panda's zero pose has joint 4
-# outside its range (−3.07 to −0.07 rad), so it is not compared here.
+# outside its range (−3.07 to −0.07 rad), so it starts at −1.5 there, its
+# fingers resting at their lower bound 0 (with nothing along them: held
+# by no stop, they stay there as Pinocchio's free ones do).
 @pytest.mark.parametrize(
     "relative, t_end, joints",
-    [(UR5, 1.0, {}), (SO100, 0.05, {"shoulder_lift": 1.0, "elbow_flex": -1.0})],
+    [
+        (UR5, 1.0, {}),
+        (SO100, 0.05, {"shoulder_lift": 1.0, "elbow_flex": -1.0}),
+        (PANDA, 0.05, {"panda_joint4": -1.5}),
+    ],
 )
 def test_joint_trajectories_agree_with_pinocchio(relative, t_end, joints):
     robot = Robot(relative)

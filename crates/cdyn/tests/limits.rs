@@ -27,9 +27,14 @@ fn k() -> f64 {
 
 /// The rod at φ₀, its joint's coordinate θ = φ − φ₀ limited below at the stop.
 fn pendulum(limit: JointLimit) -> Mechanism {
+    pendulum_at(PHI0, limit)
+}
+
+/// The rod at rest at `phi0` from the vertical, its joint limited by `limit`.
+fn pendulum_at(phi0: f64, limit: JointLimit) -> Mechanism {
     let rod = Body::new("rod", M, [0.02, JYY, 0.005])
-        .with_position([-L * PHI0.sin(), 0.0, -L * PHI0.cos()])
-        .with_orientation([(PHI0 / 2.0).cos(), 0.0, (PHI0 / 2.0).sin(), 0.0]);
+        .with_position([-L * phi0.sin(), 0.0, -L * phi0.cos()])
+        .with_orientation([(phi0 / 2.0).cos(), 0.0, (phi0 / 2.0).sin(), 0.0]);
     let pivot = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).with_axis([0.0, 1.0, 0.0]).with_limit(limit);
     Mechanism::new([0.0, 0.0, -G]).with_bodies(vec![rod]).with_joints(vec![pivot])
 }
@@ -37,14 +42,19 @@ fn pendulum(limit: JointLimit) -> Mechanism {
 /// `t*` by Simpson's rule after `φ = φ₀ − s²`, which takes the root's
 /// singularity at φ₀ away: `dφ/√(…) = 2 s ds/√(2k (cos(φ₀ − s²) − cos φ₀))`.
 fn stop_time() -> f64 {
+    fall_time(PHI0, PHI_STOP)
+}
+
+/// The time from rest at `phi0` to `phi` (`−φ₀ < φ < φ₀`), as [`stop_time`].
+fn fall_time(phi0: f64, phi: f64) -> f64 {
     let f = |s: f64| {
         if s == 0.0 {
-            2.0 / (2.0 * k() * PHI0.sin()).sqrt()
+            2.0 / (2.0 * k() * phi0.sin()).sqrt()
         } else {
-            2.0 * s / (2.0 * k() * ((PHI0 - s * s).cos() - PHI0.cos())).sqrt()
+            2.0 * s / (2.0 * k() * ((phi0 - s * s).cos() - phi0.cos())).sqrt()
         }
     };
-    let (b, n) = ((PHI0 - PHI_STOP).sqrt(), 20_000);
+    let (b, n) = ((phi0 - phi).sqrt(), 20_000);
     let h = b / n as f64;
     (0..=n)
         .map(|i| {
@@ -111,6 +121,34 @@ fn a_pendulum_falling_onto_its_stop_is_stopped_there_and_held() {
 }
 
 #[test]
+fn a_range_shorter_than_a_turn_is_told_apart_through_pi() {
+    // From rest at φ₀ = 3 (near upright) the rod falls through the bottom,
+    // its joint's angle θ = φ − φ₀ through −π at φ = 3 − π, onto the stop
+    // θ = −5.9 (φ = −2.9) of its range [−5.9, 0.1], shorter than a turn.
+    // Measured in (−π, π], θ jumps to +π there: read as such, it was past
+    // the upper bound, and −5.9 was no stop. Short of the top, gravity
+    // pulls the rod back off the stop: released the step after.
+    let (phi0, lower) = (3.0, -5.9);
+    let mechanism = pendulum_at(phi0, JointLimit::new(lower, 0.1));
+    let built = mechanism.build().unwrap();
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+    let report =
+        run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 3.0, 100, |_, _, _| Ok(()))
+            .unwrap();
+    let (t_star, rate) = (fall_time(phi0, phi0 + lower), (2.0 * k() * ((phi0 + lower).cos() - phi0.cos())).sqrt());
+    let [
+        Event { stop: 0, step, t, change: Change::Impact { rate: hit, held: true, .. }, .. },
+        Event { stop: 0, step: released, change: Change::Release { .. }, .. },
+    ] = report.events[..]
+    else {
+        panic!("{:?}", report.events)
+    };
+    assert_eq!(released, step + 1);
+    assert!((t - t_star).abs() < 1e-6, "stopped at {t}, by hand {t_star}");
+    assert!((-hit - rate).abs() < 1e-3 * k(), "{hit} against {rate}");
+}
+
+#[test]
 fn a_stop_with_restitution_throws_the_joint_back() {
     let e = 0.5;
     let (events, samples) =
@@ -168,4 +206,59 @@ fn bad_limits_are_refused_naming_the_joint() {
         assert!(e.contains("element 0 (revolute)"), "{e}");
         assert!(e.contains(says), "{e}");
     }
+}
+
+/// A rod on joint `j` and a second rod on joint `k`, a `<mimic>` of `j` at
+/// half its angle; `j` limited to ±0.3 and, where `k_limit`, `k` to ±0.15.
+#[cfg(feature = "urdf")]
+fn mimic_pair(k_limit: bool) -> Mechanism {
+    let k_limit = if k_limit { r#"<limit lower="-0.15" upper="0.15" effort="1" velocity="10"/>"# } else { "" };
+    let urdf = format!(
+        r#"<robot name="pair"><link name="base"/>
+        <joint name="j" type="revolute"><parent link="base"/><child link="a"/>
+          <axis xyz="0 1 0"/><limit lower="-0.3" upper="0.3" effort="1" velocity="10"/></joint>
+        <link name="a"><inertial><origin xyz="0.2 0 0"/><mass value="2"/>
+          <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>
+        <joint name="k" type="revolute"><parent link="a"/><child link="b"/>
+          <origin xyz="0.4 0 0"/><axis xyz="0 1 0"/><mimic joint="j" multiplier="0.5"/>{k_limit}</joint>
+        <link name="b"><inertial><origin xyz="0.1 0 0"/><mass value="1"/>
+          <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link></robot>"#
+    );
+    cdyn::spatial::read_urdf(&urdf, [0.0, 0.0, -G]).unwrap().mechanism
+}
+
+#[cfg(feature = "urdf")]
+#[test]
+fn stops_a_mimic_reaches_with_its_leader_are_held_by_one_row() {
+    // Falling from the horizontal, j reaches its bound 0.3 and k, at half
+    // j's angle, its bound 0.15 at the same instant: the two stops' rows
+    // and the mimic row are dependent, so one row holds both. The run is
+    // the one with k's limit left out, to round-off.
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+    let run = |k_limit: bool| {
+        let mechanism = mimic_pair(k_limit);
+        let built = mechanism.build().unwrap();
+        let mut joints = Vec::new();
+        let report =
+            run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 1.0, 10, |_, q, v| {
+                let theta = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?;
+                joints.push([theta[0].unwrap()[0], theta[1].unwrap()[0]]);
+                Ok(())
+            })
+            .unwrap();
+        (report.events, joints)
+    };
+    let (events, joints) = run(true);
+    let (alone, reduced) = run(false);
+    // Both of the stops met are hit, at the same step, and held.
+    let hit: Vec<_> =
+        events.iter().map(|e| (e.stop, e.step, matches!(e.change, Change::Impact { held: true, .. }))).collect();
+    assert_eq!(hit.len(), 2, "{events:?}");
+    assert!(hit[0].1 == hit[1].1 && hit[0].2 && hit[1].2, "{events:?}");
+    assert_eq!(alone.len(), 1, "{alone:?}");
+    let [j, k] = *joints.last().unwrap();
+    assert!((j.abs() - 0.3).abs() < 1e-9 && (k - 0.5 * j).abs() < 1e-9, "{j} {k}");
+    let worst =
+        joints.iter().zip(&reduced).map(|(a, b)| (a[0] - b[0]).abs().max((a[1] - b[1]).abs())).fold(0.0, f64::max);
+    assert!(worst < 1e-12, "{worst}");
 }

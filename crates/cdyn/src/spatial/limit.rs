@@ -9,12 +9,15 @@
 //! rows on joint coordinates); when a stop is hit, held and released is the
 //! run's business ([`crate::stops`]), as it changes which rows the model has.
 //!
-//! A revolute joint's coordinate is an angle in `(−π, π]`: a bound at or
-//! beyond ±π (URDF's ±2π of a multi-turn joint) cannot be met by it and
-//! makes no stop ([`crate::spatial::Mechanism::unreachable_limits`] counts them, for a run
-//! to say so).
+//! A revolute joint's coordinate is an angle in `(−π, π]`. A range shorter
+//! than a turn is told apart from it wherever its bounds lie (Panda's
+//! joint 6 goes to 3.75 rad); in a range of a turn or more (URDF's ±2π of a
+//! multi-turn joint) a bound at or beyond ±π cannot be met and makes no
+//! stop ([`crate::spatial::Mechanism::unreachable_limits`] counts them, for
+//! a run to say so).
 
 use crate::error::{Problem, Result};
+use std::f64::consts::TAU;
 
 /// The range of a revolute or prismatic joint's coordinate (see
 /// [`crate::spatial::Mechanism::joint_coordinates`]): an angle in rad, a displacement in
@@ -55,6 +58,23 @@ fn minus_infinity() -> f64 {
 }
 
 impl JointLimit {
+    /// Whether a revolute joint's angle, measured in `(−π, π]`, tells
+    /// which side of this range it is on: a range shorter than a turn,
+    /// whose bounds may lie beyond ±π (Panda's joint 6: −0.0175 to 3.7525).
+    pub(crate) fn within_a_turn(&self) -> bool {
+        self.upper - self.lower < TAU
+    }
+
+    /// A revolute joint's angle measured in `(−π, π]` as an angle of a range
+    /// [`within_a_turn`](Self::within_a_turn): in `[lower, upper]` when
+    /// inside it, else past the nearer bound. Measured as it is, Panda's
+    /// joint 6 turning through π within its range read as far past its
+    /// lower bound, and a stop took it there.
+    pub(crate) fn unwrap_angle(&self, angle: f64) -> f64 {
+        let theta = self.lower + (angle - self.lower).rem_euclid(TAU);
+        if theta - self.upper > self.lower + TAU - theta { theta - TAU } else { theta }
+    }
+
     /// `lower ≤ θ ≤ upper`, stopped without rebound, no velocity or effort bound.
     pub fn new(lower: f64, upper: f64) -> Self {
         Self { lower, upper, restitution: 0.0, velocity: f64::INFINITY, effort: f64::INFINITY }

@@ -5,7 +5,7 @@ use super::actuator::Actuator;
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
 use super::coordinate::{JointCoordinate, JointSpace, Mimic, StopRow};
 use super::joint::{Joint, JointKind};
-use super::limit::Stop;
+use super::limit::{JointLimit, Stop};
 use super::load::Load;
 use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
@@ -316,14 +316,14 @@ impl Mechanism {
     }
 
     /// Every finite side of every joint's limit that the joint's coordinate
-    /// can meet (an angle is in `(−π, π]`: a bound at or beyond ±π is not
-    /// a stop), lower before upper, joints in order.
+    /// can meet (an angle is in `(−π, π]`: in a range of a turn or more, a
+    /// bound at or beyond ±π is not a stop), lower before upper, joints in order.
     pub fn stops(&self) -> Vec<Stop> {
         let mut out = Vec::new();
         for (joint, j) in self.joints.iter().enumerate() {
             let Some(l) = j.limit else { continue };
             for (upper, bound) in [(false, l.lower), (true, l.upper)] {
-                if reachable(j.kind, bound) {
+                if reachable(j.kind, &l, bound) {
                     out.push(Stop { joint, upper });
                 }
             }
@@ -331,10 +331,14 @@ impl Mechanism {
         out
     }
 
-    /// How many finite bounds no stop stands for: a revolute joint's at or beyond ±π.
+    /// How many finite bounds no stop stands for: a revolute joint's at or
+    /// beyond ±π in a range of a turn or more.
     pub fn unreachable_limits(&self) -> usize {
-        let bounds = self.joints.iter().filter_map(|j| j.limit.map(|l| (j.kind, [l.lower, l.upper])));
-        bounds.flat_map(|(kind, b)| b.map(|b| b.is_finite() && !reachable(kind, b))).filter(|&x| x).count()
+        let bounds = self.joints.iter().filter_map(|j| j.limit.map(|l| (j.kind, l)));
+        bounds
+            .flat_map(|(kind, l)| [l.lower, l.upper].map(|b| b.is_finite() && !reachable(kind, &l, b)))
+            .filter(|&x| x)
+            .count()
     }
 
     /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
@@ -351,6 +355,10 @@ impl Mechanism {
             .map(|&s| {
                 let (bound, sign, _) = self.stop_bound(s);
                 let [x, rate, _] = theta[s.joint].expect("a stop's joint has a coordinate");
+                let x = match self.joints[s.joint] {
+                    Joint { kind: JointKind::Revolute, limit: Some(l), .. } if l.within_a_turn() => l.unwrap_angle(x),
+                    _ => x,
+                };
                 [sign * (x - bound), sign * rate]
             })
             .collect())
@@ -386,9 +394,9 @@ pub(super) fn reads(j: &Joint) -> Reads {
     }
 }
 
-fn reachable(kind: JointKind, bound: f64) -> bool {
+fn reachable(kind: JointKind, limit: &JointLimit, bound: f64) -> bool {
     match kind {
-        JointKind::Revolute => bound.abs() < std::f64::consts::PI,
+        JointKind::Revolute => limit.within_a_turn() || bound.abs() < std::f64::consts::PI,
         _ => bound.is_finite(),
     }
 }

@@ -40,7 +40,9 @@ pub struct Report {
 #[non_exhaustive]
 pub enum Change {
     /// Hit with the gap's rate `rate` (< 0); the impact took `kinetic_lost`
-    /// of kinetic energy; `held` unless it rebounded (`e > 0`).
+    /// of kinetic energy; `held` unless it rebounded (`e > 0`). A stop the
+    /// joint crossed and turned back from within the step (`rate ≥ 0`, a
+    /// graze) only has its position put back: not held, no energy taken.
     Impact {
         /// `ġ` just before the impact, at the stop (the positions projected
         /// onto it, the velocities onto the other rows there).
