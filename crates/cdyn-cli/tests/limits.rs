@@ -15,16 +15,9 @@ use common::{Table, cdyn, one_error_line, path_str, scenario, summary_case, tabl
 
 const G: f64 = 9.81;
 
-/// `t*` of the module's head: `∫ dψ / √(1 − m sin²ψ)` over `[ψ*, π/2]`
-/// by Simpson's rule (the integrand is smooth), over `√k`.
+/// `t*` of the module's head ([`cdyn::reference::time_to_swing`]).
 fn stop_time(k: f64, phi0: f64, phi_stop: f64) -> f64 {
-    let a = (phi0 / 2.0).sin();
-    let psi_stop = ((phi_stop / 2.0).sin() / a).asin();
-    let f = |psi: f64| 1.0 / (1.0 - a * a * psi.sin().powi(2)).sqrt();
-    let n = 2000;
-    let h = (std::f64::consts::FRAC_PI_2 - psi_stop) / n as f64;
-    let weight = |i: usize| if i == 0 || i == n { 1.0 } else { [2.0, 4.0][i % 2] };
-    (0..=n).map(|i| weight(i) * f(psi_stop + i as f64 * h)).sum::<f64>() * h / 3.0 / k.sqrt()
+    cdyn::reference::time_to_swing(k, phi0, phi_stop).unwrap()
 }
 
 /// The rate `|φ̇|` at `φ*`.

@@ -34,32 +34,9 @@ fn pendulum(limit: JointLimit) -> Mechanism {
     Mechanism::new([0.0, 0.0, -G]).with_bodies(vec![rod]).with_joints(vec![pivot])
 }
 
-/// `t*` by Simpson's rule after `φ = φ₀ − s²`, which takes the root's
-/// singularity at φ₀ away: `dφ/√(…) = 2 s ds/√(2k (cos(φ₀ − s²) − cos φ₀))`.
+/// `t*`, by the closed form (shared with the planar and CLI tests).
 fn stop_time() -> f64 {
-    let f = |s: f64| {
-        if s == 0.0 {
-            2.0 / (2.0 * k() * PHI0.sin()).sqrt()
-        } else {
-            2.0 * s / (2.0 * k() * ((PHI0 - s * s).cos() - PHI0.cos())).sqrt()
-        }
-    };
-    let (b, n) = ((PHI0 - PHI_STOP).sqrt(), 20_000);
-    let h = b / n as f64;
-    (0..=n)
-        .map(|i| {
-            f(i as f64 * h)
-                * if i == 0 || i == n {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                }
-        })
-        .sum::<f64>()
-        * h
-        / 3.0
+    cdyn::reference::time_to_swing(k(), PHI0, PHI_STOP).unwrap()
 }
 
 /// Runs the pendulum to `t_end`, returning the events and the joint's `(θ, θ̇)` at each sample.
