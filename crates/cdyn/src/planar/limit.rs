@@ -198,8 +198,13 @@ mod tests {
             let u = rotate(q[2], [0.6, 0.8]);
             (q[3] + wb[0] - q[0] - wa[0]) * u[0] + (q[4] + wb[1] - q[1] - wa[1]) * u[1]
         };
-        let by_hand: [&dyn Fn(&[f64]) -> f64; 3] = [&|q| q[5] - q[2], &slide, &|q| q[5]];
-        for (k, theta) in by_hand.iter().enumerate() {
+        let by_hand = |k: usize, q: &[f64]| match k {
+            0 => q[5] - q[2],
+            1 => slide(q),
+            _ => q[5],
+        };
+        for k in 0..3 {
+            let theta = |q: &[f64]| by_hand(k, q);
             let [x, rate] = m.joint_coordinate(k, &q, &v).unwrap();
             assert!((x - theta(&q)).abs() < 1e-15, "element {k}: {x} against {}", theta(&q));
             let eps = 1e-6;

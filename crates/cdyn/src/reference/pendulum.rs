@@ -151,10 +151,12 @@ impl PendulumExact {
 /// `(−π, π)` or zero, and `psi` beyond `±psi0`.
 pub fn time_to_swing(w2: f64, psi0: f64, psi: f64) -> Result<f64> {
     positive("w2", w2)?;
-    if !(psi0.abs() < std::f64::consts::PI) || psi0 == 0.0 {
+    // Written so that a NaN fails each test.
+    let (swings, within) = (psi0.abs() < std::f64::consts::PI && psi0 != 0.0, psi.abs() <= psi0.abs());
+    if !swings {
         return Err(Error::InvalidParameter { name: "psi0", value: psi0, reason: "must be in (−π, π), not 0" });
     }
-    if !(psi.abs() <= psi0.abs()) {
+    if !within {
         return Err(Error::InvalidParameter {
             name: "psi", value: psi, reason: "must be between −|psi0| and |psi0|"
         });
