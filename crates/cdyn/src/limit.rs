@@ -133,7 +133,7 @@ impl JointLimit {
 
     /// The finite sides, lower before upper: the stops a coordinate that
     /// can take any value meets (a spatial angle takes only `(−π, π]`).
-    pub fn finite_sides(&self) -> impl Iterator<Item = bool> + '_ {
-        [false, true].into_iter().filter(|&upper| self.side(upper).0.is_finite())
+    pub fn finite_sides(self) -> impl Iterator<Item = bool> {
+        [false, true].into_iter().filter(move |&upper| self.side(upper).0.is_finite())
     }
 }

@@ -123,9 +123,7 @@ impl Mechanism {
     /// elements in order.
     pub fn stops(&self) -> Vec<Stop> {
         let limits = self.elements.iter().enumerate().filter_map(|(joint, e)| Some((joint, e.limit()?)));
-        limits
-            .flat_map(|(joint, l)| l.finite_sides().map(move |upper| Stop { joint, upper }).collect::<Vec<_>>())
-            .collect()
+        limits.flat_map(|(joint, l)| l.finite_sides().map(move |upper| Stop { joint, upper })).collect()
     }
 
     /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
