@@ -15,16 +15,9 @@ use common::{Table, cdyn, one_error_line, path_str, scenario, summary_case, tabl
 
 const G: f64 = 9.81;
 
-/// `t*` of the module's head: `∫ dψ / √(1 − m sin²ψ)` over `[ψ*, π/2]`
-/// by Simpson's rule (the integrand is smooth), over `√k`.
+/// `t*` of the module's head ([`cdyn::reference::time_to_swing`]).
 fn stop_time(k: f64, phi0: f64, phi_stop: f64) -> f64 {
-    let a = (phi0 / 2.0).sin();
-    let psi_stop = ((phi_stop / 2.0).sin() / a).asin();
-    let f = |psi: f64| 1.0 / (1.0 - a * a * psi.sin().powi(2)).sqrt();
-    let n = 2000;
-    let h = (std::f64::consts::FRAC_PI_2 - psi_stop) / n as f64;
-    let weight = |i: usize| if i == 0 || i == n { 1.0 } else { [2.0, 4.0][i % 2] };
-    (0..=n).map(|i| weight(i) * f(psi_stop + i as f64 * h)).sum::<f64>() * h / 3.0 / k.sqrt()
+    cdyn::reference::time_to_swing(k, phi0, phi_stop).unwrap()
 }
 
 /// The rate `|φ̇|` at `φ*`.
@@ -206,4 +199,136 @@ fn bad_limits_get_one_line_naming_the_joint() {
         let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
         assert!(line.contains("bad.toml") && line.contains("\"hinge\"") && line.contains(reason), "{line}");
     }
+}
+
+/// A planar rod hanging from the ground `L` above its centre of mass
+/// (`point_b = [0, L]`), its angle 0 hanging, released at rest at `PHI0`:
+/// its revolute joint's coordinate is its angle.
+fn planar_rod(limit: &str, more: &str) -> String {
+    format!(
+        r#"
+[model]
+kind = "mechanism"
+gravity = [0.0, -{G}]
+
+[integrator]
+scheme = "rk4"
+h = {H}
+t_end = 1.0
+
+[[bodies]]
+name = "rod"
+mass = {M}
+inertia = {JYY}
+position = [{x}, {y}]
+angle = {PHI0}
+
+[[joints]]
+kind = "revolute"
+a = "ground"
+b = "rod"
+point_b = [0.0, {L}]
+limit = {limit}
+{more}"#,
+        x = L * PHI0.sin(),
+        y = -L * PHI0.cos(),
+    )
+}
+
+#[test]
+fn a_planar_rod_falling_onto_its_limit_is_stopped_when_the_elliptic_integral_says_and_held_there() {
+    let k = M * G * L / (JYY + M * L * L);
+    let t_star = stop_time(k, PHI0, PHI_STOP);
+    let (stdout, (header, rows), case) = run(&planar_rod(&format!("{{ lower = {PHI_STOP} }}"), ""), &[]);
+    assert!(stdout.contains("limits: 1 impact, 0 releases"), "{stdout}");
+    let events = case["limits"]["events"].as_array().unwrap();
+    assert_eq!(events.len(), 1, "{events:?}");
+    let event = &events[0];
+    assert_eq!((event["joint"].as_str(), event["side"].as_str()), (Some("joints[0]"), Some("lower")));
+    assert_eq!((event["bound"].as_f64(), event["held"].as_bool()), (Some(PHI_STOP), Some(true)));
+    let t = event["t"].as_f64().unwrap();
+    assert!((t - t_star).abs() < 1e-6, "stopped at {t}, by hand {t_star}");
+    let hit = event["rate"].as_f64().unwrap();
+    assert!((-hit - stop_rate(k, PHI0, PHI_STOP)).abs() < H * k, "{hit}");
+    // One table on the h grid, the angle at the bound from the step after on.
+    let angle = column(&header, "rod.angle");
+    assert_eq!(rows.len(), 1001);
+    let after: Vec<_> = rows.iter().filter(|r| r[0] > t + H).collect();
+    assert!(after.len() > 500);
+    assert!(after.iter().all(|r| (r[angle] - PHI_STOP).abs() < 1e-9), "off the stop");
+    assert!(rows.iter().all(|r| r[angle] >= PHI_STOP - 1e-9), "past the stop");
+}
+
+#[test]
+fn a_planar_slider_is_stopped_at_its_limit_down_an_incline_and_its_velocity_bound_reported() {
+    // A point mass from rest down a line at α below the horizontal: s = ½ g sin α t².
+    let (alpha, d) = (0.5_f64, 0.4);
+    let text = format!(
+        r#"
+[model]
+kind = "mechanism"
+gravity = [0.0, -{G}]
+
+[integrator]
+scheme = "rk4"
+h = {H}
+t_end = 0.6
+
+[[bodies]]
+name = "block"
+mass = 3.0
+position = [0.0, 0.0]
+
+[[joints]]
+kind = "prismatic"
+a = "ground"
+b = "block"
+axis = [{c}, {s}]
+limit = {{ upper = {d}, velocity = 1.0 }}
+"#,
+        c = alpha.cos(),
+        s = -alpha.sin(),
+    );
+    let (stdout, (header, rows), case) = run(&text, &[]);
+    let a = G * alpha.sin();
+    let t_star = (2.0 * d / a).sqrt();
+    let event = &case["limits"]["events"][0];
+    assert_eq!((event["joint"].as_str(), event["side"].as_str()), (Some("joints[0]"), Some("upper")));
+    let t = event["t"].as_f64().unwrap();
+    assert!((t - t_star).abs() < 1e-9, "stopped at {t}, by hand {t_star}");
+    // Past 1 m/s at t = 1 / a, first seen at the step's end after it.
+    let exceeded = &case["limits"]["velocity_exceeded"][0];
+    assert_eq!(exceeded["joint"].as_str(), Some("joints[0]"));
+    let first = exceeded["t"].as_f64().unwrap();
+    assert!(first >= 1.0 / a && first < 1.0 / a + H + 1e-12, "{first}");
+    assert!(stdout.contains("joints[0] exceeded its velocity bound"), "{stdout}");
+    // Held at s = d: x = d cos α from then on.
+    let x = column(&header, "block.x");
+    let last = rows.last().unwrap();
+    assert!((last[x] - d * alpha.cos()).abs() < 1e-9, "{}", last[x]);
+}
+
+#[test]
+fn bad_planar_limits_get_one_line_naming_the_file_and_the_joint() {
+    for (limit, says) in [
+        ("{ lower = 1.0, upper = -1.0 }", "joints[0] (revolute): limit lower = 1, upper = -1: lower is above upper"),
+        ("{ lower = nan }", "joints[0] (revolute): limit lower = NaN, upper = inf: a bound is not a number"),
+        ("{ lower = 0.1, restitution = -0.5 }", "joints[0] (revolute): restitution = -0.5 must be in [0, 1]"),
+        ("{ lower = 0.1, velocity = -2.0 }", "joints[0] (revolute): velocity limit = -2"),
+        ("{ lower = 0.1, effort = 3.0 }", "limit effort = 3: a planar joint has no actuator to clamp"),
+        ("{ lower = 0.1, uper = 1.0 }", "uper"),
+    ] {
+        let (dir, path) = scenario("bad.toml", &planar_rod(limit, ""));
+        let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+        assert!(line.contains("bad.toml") && line.contains("joints[0]") && line.contains(says), "{limit}: {line}");
+    }
+    // Started past its bound; a limit on a joint without a coordinate.
+    let (dir, path) = scenario("bad.toml", &planar_rod("{ upper = 1.0 }", ""));
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("bad.toml: joint joints[0]: starts 2.000e-1 past its upper limit 1"), "{line}");
+    let distance =
+        "[[joints]]\nkind = \"distance\"\na = \"ground\"\nb = \"rod\"\nlength = 1.0\nlimit = { lower = 0.0 }\n";
+    let (dir, path) = scenario("bad.toml", &planar_rod("{ lower = 0.3 }", distance));
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("bad.toml") && line.contains("joints[1]") && line.contains("limit"), "{line}");
 }

@@ -7,7 +7,7 @@
 //!
 //! | layer | modules |
 //! |---|---|
-//! | checking and leaves | [`error`], [`reference`](mod@reference) (closed-form motions), [`ad`] (the scalar physics is written in, one-pass Jacobians), [`linalg`] (`M`, `S = Φ_q M⁻¹ Φ_qᵀ` and its factorization), `json_float` (with `serde`) |
+//! | checking and leaves | [`error`], [`reference`](mod@reference) (closed-form motions), [`ad`] (the scalar physics is written in, one-pass Jacobians), [`linalg`] (`M`, `S = Φ_q M⁻¹ Φ_qᵀ` and its factorization), [`limit`] (joint limits and their sides, planar and spatial), `json_float` (with `serde`) |
 //! | what a system is | [`model`]: coordinates, mass, constraint / force / kinetic elements, nonholonomic rows, unit vectors, time functions, declared invariants |
 //! | what it does, uncontrolled | [`dynamics`]: `Φ`, `λ`, `A`, the energy constraint `Ψ`, diagnostics, the momenta it keeps, assembly onto the constraints |
 //! | stepping | [`integrate`] (the schemes) |
@@ -73,6 +73,7 @@ pub mod error;
 pub mod integrate;
 #[cfg(feature = "serde")]
 pub mod json_float;
+pub mod limit;
 pub mod linalg;
 pub mod model;
 pub mod models;

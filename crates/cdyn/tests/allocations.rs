@@ -105,7 +105,7 @@ fn tractor_trailer() -> Example {
     let tractor = m.rigid("tractor", 2.0, 0.4, [0.0, 0.0], 0.0);
     let trailer = m.rigid("trailer", 1.0, 0.2, [-1.1, 0.0], 0.0);
     m.add(Element::KnifeEdge { body: tractor, point: [0.3, 0.0], blade: [1.0, 0.0] });
-    m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0] });
+    m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0], limit: None });
     m.add(Element::KnifeEdge { body: trailer, point: [-0.4, 0.0], blade: [1.0, 0.0] });
     m.add(Element::Spring {
         a: BodyId::Ground,

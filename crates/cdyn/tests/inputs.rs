@@ -13,7 +13,7 @@ use cdyn::{Control, Scheme, Settings, Simulation};
 fn pendulum(torque: Option<f64>, length: Option<f64>) -> cdyn::planar::Built {
     let mut m = Mechanism::new([0.0, -9.81]);
     let bob = m.push(Body::rigid("bob", 1.0, 0.1, [0.0, -1.0], 0.0));
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bob, pb: [0.0, 1.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bob, pb: [0.0, 1.0], limit: None });
     m.add(Element::AppliedTorque { body: bob, f: TimeFn::constant(torque.unwrap_or(0.0)) });
     m.add(Element::Spring {
         a: bob,
@@ -161,7 +161,7 @@ fn a_bad_input_value_or_name_is_refused_with_what_exists() {
     assert!(sim.set_input(2, 1.0).is_err());
     let mut m = Mechanism::new([0.0, -9.81]);
     let bob = m.push(Body::rigid("bob", 1.0, 0.1, [0.0, -1.0], 0.0));
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bob, pb: [0.0, 1.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bob, pb: [0.0, 1.0], limit: None });
     m.drive(0, "length", &Input::new("l", 1.0));
     let e = m.build().err().unwrap().to_string();
     assert!(

@@ -39,37 +39,9 @@ fn pendulum_at(phi0: f64, limit: JointLimit) -> Mechanism {
     Mechanism::new([0.0, 0.0, -G]).with_bodies(vec![rod]).with_joints(vec![pivot])
 }
 
-/// `t*` by Simpson's rule after `φ = φ₀ − s²`, which takes the root's
-/// singularity at φ₀ away: `dφ/√(…) = 2 s ds/√(2k (cos(φ₀ − s²) − cos φ₀))`.
+/// `t*`, by the closed form (shared with the planar and CLI tests).
 fn stop_time() -> f64 {
-    fall_time(PHI0, PHI_STOP)
-}
-
-/// The time from rest at `phi0` to `phi` (`−φ₀ < φ < φ₀`), as [`stop_time`].
-fn fall_time(phi0: f64, phi: f64) -> f64 {
-    let f = |s: f64| {
-        if s == 0.0 {
-            2.0 / (2.0 * k() * phi0.sin()).sqrt()
-        } else {
-            2.0 * s / (2.0 * k() * ((phi0 - s * s).cos() - phi0.cos())).sqrt()
-        }
-    };
-    let (b, n) = ((phi0 - phi).sqrt(), 20_000);
-    let h = b / n as f64;
-    (0..=n)
-        .map(|i| {
-            f(i as f64 * h)
-                * if i == 0 || i == n {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                }
-        })
-        .sum::<f64>()
-        * h
-        / 3.0
+    cdyn::reference::time_to_swing(k(), PHI0, PHI_STOP).unwrap()
 }
 
 /// Runs the pendulum to `t_end`, returning the events and the joint's `(θ, θ̇)` at each sample.
@@ -135,7 +107,10 @@ fn a_range_shorter_than_a_turn_is_told_apart_through_pi() {
     let report =
         run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 3.0, 100, |_, _, _| Ok(()))
             .unwrap();
-    let (t_star, rate) = (fall_time(phi0, phi0 + lower), (2.0 * k() * ((phi0 + lower).cos() - phi0.cos())).sqrt());
+    let (t_star, rate) = (
+        cdyn::reference::time_to_swing(k(), phi0, phi0 + lower).unwrap(),
+        (2.0 * k() * ((phi0 + lower).cos() - phi0.cos())).sqrt(),
+    );
     let [
         Event { stop: 0, step, t, change: Change::Impact { rate: hit, held: true, .. }, .. },
         Event { stop: 0, step: released, change: Change::Release { .. }, .. },

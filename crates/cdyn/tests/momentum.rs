@@ -31,10 +31,10 @@ fn chain(masses: &[f64], gravity: [f64; 2], grounded: bool) -> (Model, Vec<f64>,
         b.angular_velocity = if i % 2 == 0 { 1.0 } else { -0.5 };
     }
     for w in ids.windows(2) {
-        m.add(Element::Revolute { a: w[0], pa: [0.5, 0.0], b: w[1], pb: [-0.5, 0.0] });
+        m.add(Element::Revolute { a: w[0], pa: [0.5, 0.0], b: w[1], pb: [-0.5, 0.0], limit: None });
     }
     if grounded {
-        m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: ids[0], pb: [-0.5, 0.0] });
+        m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: ids[0], pb: [-0.5, 0.0], limit: None });
     }
     let built = m.build().unwrap();
     let (mut q, mut v) = (built.q0, built.v0);

@@ -22,7 +22,7 @@ fn trailer() -> Mechanism {
     let tractor = m.rigid("tractor", 2.0, 0.4, [0.0, 0.0], 0.2);
     let trailer = m.rigid("trailer", 1.0, 0.2, [-1.2, -0.3], 0.5);
     m.add(Element::KnifeEdge { body: tractor, point: [0.3, 0.1], blade: [1.0, 0.1] });
-    m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0] });
+    m.add(Element::Revolute { a: tractor, pa: [-0.5, 0.0], b: trailer, pb: [0.6, 0.0], limit: None });
     m.add(Element::KnifeEdge { body: trailer, point: [-0.4, 0.0], blade: [2.0, -0.3] });
     m.add(Element::Spring {
         a: BodyId::Ground,
@@ -465,7 +465,7 @@ fn a_bicycle_with_fixed_steering_drives_in_a_circle() {
     m.bodies[1].velocity = [u, omega * l];
     m.bodies[1].angular_velocity = omega;
     m.add(Element::KnifeEdge { body: frame, point: [-l / 2.0, 0.0], blade: [1.0, 0.0] });
-    m.add(Element::Revolute { a: frame, pa: [l / 2.0, 0.0], b: wheel, pb: [0.0, 0.0] });
+    m.add(Element::Revolute { a: frame, pa: [l / 2.0, 0.0], b: wheel, pb: [0.0, 0.0], limit: None });
     m.add(Element::FixedAngle { a: frame, b: wheel, angle: delta });
     m.add(Element::KnifeEdge { body: wheel, point: [0.0, 0.0], blade: [1.0, 0.0] });
     let b = m.build().unwrap();

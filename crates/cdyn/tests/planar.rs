@@ -41,7 +41,7 @@ fn point_mass_on_a_rod_and_rigid_body_on_a_pin_are_the_same_pendulum() {
     let body = rigid.rigid("bar", m, inertia, [l * c, l * s], theta0);
     rigid.bodies[0].velocity = [-l * s * omega0, l * c * omega0];
     rigid.bodies[0].angular_velocity = omega0;
-    rigid.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: body, pb: [-l, 0.0] });
+    rigid.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: body, pb: [-l, 0.0], limit: None });
 
     let mut point = Mechanism::new([0.0, -G]);
     let bob = point.point("bob", m, [l_eq * c, l_eq * s]);
@@ -61,7 +61,7 @@ fn point_mass_on_a_rod_and_rigid_body_on_a_pin_are_the_same_pendulum() {
 fn bad_descriptions_name_the_element() {
     let mut m = Mechanism::new([0.0, -G]);
     let bob = m.point("bob", 1.0, [1.0, 0.0]);
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: BodyId::Body(7), pb: [0.0, 0.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: BodyId::Body(7), pb: [0.0, 0.0], limit: None });
     let err = m.build().err().unwrap().to_string();
     assert!(err.contains("element 0 (revolute)") && err.contains("body 7 does not exist"), "{err}");
 
@@ -110,7 +110,7 @@ fn assembly_respects_a_moving_drive() {
     use cdyn::model::timefn::TimeFn;
     let mut m = Mechanism::new([0.0, -G]);
     let bar = m.rigid("bar", 1.0, 0.1, [0.52, 0.03], 0.05);
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bar, pb: [-0.5, 0.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bar, pb: [-0.5, 0.0], limit: None });
     m.add(Element::DriveAngle { a: BodyId::Ground, b: bar, f: TimeFn::linear(0.0, 2.0) });
     let built = m.build().unwrap();
     let (mut q, mut v) = (built.q0.clone(), built.v0.clone());

@@ -27,10 +27,10 @@ fn parallelogram(theta0: f64, omega0: f64, redundant: bool) -> Mechanism {
     m.bodies[0].angular_velocity = omega0;
     m.bodies[2].angular_velocity = omega0;
     let ground = BodyId::Ground;
-    m.add(Element::Revolute { a: ground, pa: [0.0, 0.0], b: left, pb: [-0.5, 0.0] });
-    m.add(Element::Revolute { a: left, pa: [0.5, 0.0], b: coupler, pb: [-1.0, 0.0] });
-    m.add(Element::Revolute { a: coupler, pa: [1.0, 0.0], b: right, pb: [0.5, 0.0] });
-    m.add(Element::Revolute { a: ground, pa: [2.0, 0.0], b: right, pb: [-0.5, 0.0] });
+    m.add(Element::Revolute { a: ground, pa: [0.0, 0.0], b: left, pb: [-0.5, 0.0], limit: None });
+    m.add(Element::Revolute { a: left, pa: [0.5, 0.0], b: coupler, pb: [-1.0, 0.0], limit: None });
+    m.add(Element::Revolute { a: coupler, pa: [1.0, 0.0], b: right, pb: [0.5, 0.0], limit: None });
+    m.add(Element::Revolute { a: ground, pa: [2.0, 0.0], b: right, pb: [-0.5, 0.0], limit: None });
     if redundant {
         m.add(Element::Distance { a: ground, pa: [1.0, 0.0], b: coupler, pb: [0.0, 0.0], length: 1.0 });
     }
@@ -123,11 +123,11 @@ fn n_four_bar(n: usize) -> Mechanism {
         let coupler = m.rigid(&format!("coupler{i}"), 1.0, inertia, [i as f64 + 0.5, 1.0], 0.0);
         let b = m.bodies.len() - 1;
         m.bodies[b].velocity = [1.0, 0.0];
-        m.add(Element::Revolute { a: cranks[i], pa: [0.5, 0.0], b: coupler, pb: [-0.5, 0.0] });
-        m.add(Element::Revolute { a: coupler, pa: [0.5, 0.0], b: cranks[i + 1], pb: [0.5, 0.0] });
+        m.add(Element::Revolute { a: cranks[i], pa: [0.5, 0.0], b: coupler, pb: [-0.5, 0.0], limit: None });
+        m.add(Element::Revolute { a: coupler, pa: [0.5, 0.0], b: cranks[i + 1], pb: [0.5, 0.0], limit: None });
     }
     for (i, &crank) in cranks.iter().enumerate() {
-        m.add(Element::Revolute { a: BodyId::Ground, pa: [i as f64, 0.0], b: crank, pb: [-0.5, 0.0] });
+        m.add(Element::Revolute { a: BodyId::Ground, pa: [i as f64, 0.0], b: crank, pb: [-0.5, 0.0], limit: None });
     }
     m
 }

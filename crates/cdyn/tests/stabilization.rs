@@ -55,10 +55,10 @@ fn free_four_bar(theta: f64) -> (Model, Vec<f64>) {
     let coupler = m.rigid("coupler", p.coupler_mass, p.coupler_inertia, [q[3], q[4]], q[5]);
     let rocker = m.rigid("rocker", p.rocker_mass, p.rocker_inertia, [q[6], q[7]], q[8]);
     let bob = m.point("bob", 2.5, [q[3], q[4] - 0.8]);
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5 * a, 0.0] });
-    m.add(Element::Revolute { a: crank, pa: [0.5 * a, 0.0], b: coupler, pb: [-0.5 * b, 0.0] });
-    m.add(Element::Revolute { a: coupler, pa: [0.5 * b, 0.0], b: rocker, pb: [0.5 * c, 0.0] });
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [d, 0.0], b: rocker, pb: [-0.5 * c, 0.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5 * a, 0.0], limit: None });
+    m.add(Element::Revolute { a: crank, pa: [0.5 * a, 0.0], b: coupler, pb: [-0.5 * b, 0.0], limit: None });
+    m.add(Element::Revolute { a: coupler, pa: [0.5 * b, 0.0], b: rocker, pb: [0.5 * c, 0.0], limit: None });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [d, 0.0], b: rocker, pb: [-0.5 * c, 0.0], limit: None });
     m.add(Element::Distance { a: coupler, pa: [0.0, 0.0], b: bob, pb: [0.0, 0.0], length: 0.8 });
     let built = m.build().unwrap();
     (built.model, built.q0)

@@ -146,7 +146,7 @@ pub fn mechanism(q0: [f64; 7]) -> Mechanism {
     let ids: Vec<BodyId> =
         (0..7).map(|i| m.rigid(&format!("body{}", i + 1), M[i], I[i], centres[i], angles[i])).collect();
     let ground = BodyId::Ground;
-    let rev = |a, pa, b, pb| Element::Revolute { a, pa, b, pb };
+    let rev = |a, pa, b, pb| Element::Revolute { a, pa, b, pb, limit: None };
     m.add(rev(ground, [0.0, 0.0], ids[0], body1_o))
         .add(rev(ids[0], body1_p, ids[1], body2_p))
         // The three loop closures, as g₁…g₆: E on body 2 minus E on 3, 4, 6.

@@ -92,7 +92,7 @@ pub fn damped_pendulum(p: DampedPendulumParams) -> Result<Example> {
     state(th0, om0, &mut q0, &mut v0);
     let mut m = Mechanism::new([0.0, -p.gravity]);
     let bar = m.push(rigid_body("bar", p.mass, p.inertia, [q0[0], q0[1]], q0[2], [v0[0], v0[1]], v0[2]));
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bar, pb: [-lc, 0.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: bar, pb: [-lc, 0.0], limit: None });
     m.add(Element::RotaryDamper { a: BodyId::Ground, b: bar, damping: p.damping });
     let built = m.build()?;
 

@@ -176,11 +176,18 @@ pub fn slider_crank(p: SliderCrankParams) -> Result<Example> {
     let rod = m.push(rigid_body("rod", p.rod_mass, p.rod_inertia, [rx, ry], ra, [rvx, rvy], rw));
     let slider =
         m.push(rigid_body("slider", p.slider_mass, p.slider_inertia, [k.slider[0], 0.0], 0.0, [k.slider[1], 0.0], 0.0));
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5 * r, 0.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5 * r, 0.0], limit: None });
     m.add(Element::DriveAngle { a: BodyId::Ground, b: crank, f: TimeFn::linear(p.theta0, p.omega) });
-    m.add(Element::Revolute { a: crank, pa: [0.5 * r, 0.0], b: rod, pb: [-0.5 * l, 0.0] });
-    m.add(Element::Revolute { a: rod, pa: [0.5 * l, 0.0], b: slider, pb: [0.0, 0.0] });
-    m.add(Element::Prismatic { a: BodyId::Ground, pa: [0.0, 0.0], b: slider, pb: [0.0, 0.0], axis: [1.0, 0.0] });
+    m.add(Element::Revolute { a: crank, pa: [0.5 * r, 0.0], b: rod, pb: [-0.5 * l, 0.0], limit: None });
+    m.add(Element::Revolute { a: rod, pa: [0.5 * l, 0.0], b: slider, pb: [0.0, 0.0], limit: None });
+    m.add(Element::Prismatic {
+        a: BodyId::Ground,
+        pa: [0.0, 0.0],
+        b: slider,
+        pb: [0.0, 0.0],
+        axis: [1.0, 0.0],
+        limit: None,
+    });
     if let Some(load) = &p.load {
         load.attach(&mut m, slider, [0.0, 0.0], [k.slider[0], 0.0], [k.slider[1], 0.0]);
     }

@@ -7,9 +7,12 @@ use super::constraints::{AnchoredRod, Distance, KnifeEdge, OnLine, PointRod, Pre
 use super::element::{Coordinate, Element};
 use super::ends::{End, idx_array, with_k};
 use super::inputs::wire;
+use super::layout::{Layout, offsets};
+use super::limit::{check_limit, stop_row};
 use super::loads::{Damper, Gravity, PointLoad, RotaryDamper, Spring, Torque, Torsion};
 use super::mechanism::Mechanism;
 use crate::error::{Error, Part, Problem, Result, finite, non_negative, positive};
+use crate::limit::Stop;
 use crate::model::angular::Generator;
 use crate::model::input::Parameter;
 use crate::model::timefn::TimeFn;
@@ -37,16 +40,22 @@ impl Mechanism {
     /// The model, its initial state and coordinate names. Errors name the
     /// body or element (by position, from 0) at fault.
     pub fn build(&self) -> Result<Built> {
+        self.build_holding(&[])
+    }
+
+    /// [`Mechanism::build`] with the joint limits' stops `held` as rows
+    /// `g = 0` after all others, in that order (see [`Mechanism::stops`]);
+    /// each row's element is its joint's.
+    pub fn build_holding(&self, held: &[Stop]) -> Result<Built> {
         if !self.gravity.iter().all(|g| g.is_finite()) {
             let value = self.gravity.into_iter().find(|g| !g.is_finite()).unwrap_or(f64::NAN);
             return Err(Error::InvalidParameter { name: "gravity", value, reason: "must be finite" });
         }
         let mut mass = Vec::new();
-        let (mut q0, mut v0, mut names, mut offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut q0, mut v0, mut names) = (Vec::new(), Vec::new(), Vec::new());
         let mut earlier = std::collections::HashSet::with_capacity(self.bodies.len());
         for (i, b) in self.bodies.iter().enumerate() {
             b.check(i, &mut earlier)?;
-            offsets.push(mass.len());
             mass.extend([b.mass, b.mass]);
             q0.extend(b.position);
             v0.extend(b.velocity);
@@ -58,6 +67,7 @@ impl Mechanism {
                 names.push(format!("{}.angle", b.name));
             }
         }
+        let offsets = offsets(&self.bodies);
         let mut builder = Model::builder(mass).coordinate_names(names.clone());
         // The rigid translations: kept where nothing holds the mechanism in place.
         for (axis, name) in
@@ -96,17 +106,17 @@ impl Mechanism {
             let at = || Part::Element { index: k, kind: e.kind() };
             let (e, constant) = wire(e, &driven).map_err(|why| why.at(at()))?;
             builder = layout.add(builder, &e, constant).map_err(|why| why.at(at()))?;
+            check_limit(&layout, &e).map_err(|why| why.at(at()))?;
             row_elements.resize(builder.rows(), k);
+        }
+        for &stop in held {
+            let e = self.elements.get(stop.joint).ok_or(Problem::NoSuchJoint { index: stop.joint })?;
+            let at = Part::Element { index: stop.joint, kind: e.kind() };
+            builder = stop_row(&layout, builder, e, stop).map_err(|why| why.at(at))?;
+            row_elements.push(stop.joint);
         }
         Ok(Built { model: builder.build()?, q0, v0, names, offsets, row_elements, drawing: self.drawing() })
     }
-}
-
-/// The checked bodies and where each one's coordinates start: what an
-/// element needs to find the coordinates it reads.
-struct Layout<'a> {
-    bodies: &'a [Body],
-    offsets: &'a [usize],
 }
 
 impl Layout<'_> {
@@ -114,8 +124,8 @@ impl Layout<'_> {
     /// the place of its rest length or angle, if one does.
     fn add(&self, builder: ModelBuilder, e: &Element, constant: Option<Parameter>) -> Result<ModelBuilder> {
         match *e {
-            Element::Revolute { a, pa, b, pb } => self.revolute(builder, a, pa, b, pb),
-            Element::Prismatic { a, pa, b, pb, axis } => self.prismatic(builder, a, pa, b, pb, axis),
+            Element::Revolute { a, pa, b, pb, .. } => self.revolute(builder, a, pa, b, pb),
+            Element::Prismatic { a, pa, b, pb, axis, .. } => self.prismatic(builder, a, pa, b, pb, axis),
             Element::Distance { a, pa, b, pb, length } => self.distance(builder, a, pa, b, pb, length),
             Element::FixedAngle { a, b, angle } => {
                 finite("angle", angle)?;
@@ -225,12 +235,8 @@ impl Layout<'_> {
         let normal = [-axis[1] / norm, axis[0] / norm];
         let (ea, eb, idx) = self.two_points(a, pa, b, pb)?;
         let builder = with_k!(idx, K, builder.constrain(OnLine::<K> { a: ea, b: eb, normal }, idx_array(&idx)));
-        let body = |id| match id {
-            BodyId::Ground => None,
-            BodyId::Body(i) => self.bodies.get(i),
-        };
-        if [a, b].into_iter().all(|id| body(id).is_none_or(|b| b.inertia.is_some())) {
-            let angle = |id| body(id).map_or(0.0, |b: &Body| b.angle);
+        if [a, b].into_iter().all(|id| self.body(id).is_none_or(|b| b.inertia.is_some())) {
+            let angle = |id| self.body(id).map_or(0.0, |b: &Body| b.angle);
             self.relative_angle(builder, a, b, TimeFn::constant(angle(b) - angle(a)))
         } else {
             Ok(builder)
@@ -302,75 +308,6 @@ impl Layout<'_> {
         let mut idx = Vec::new();
         let end = self.attach(body, point, &mut idx)?;
         Ok(with_k!(idx, K, builder.force(PointLoad::<K> { end, fx: fx.clone(), fy: fy.clone() }, idx_array(&idx))))
-    }
-
-    /// Both ends of a two-point element, on two different bodies, and the
-    /// coordinates they read (`a`'s first).
-    fn two_points(&self, a: BodyId, pa: [f64; 2], b: BodyId, pb: [f64; 2]) -> Result<(End, End, Vec<usize>)> {
-        self.distinct(a, b)?;
-        let mut idx = Vec::new();
-        let ea = self.attach(a, pa, &mut idx)?;
-        let eb = self.attach(b, pb, &mut idx)?;
-        Ok((ea, eb, idx))
-    }
-
-    /// The angle coordinates of two different bodies (`None` for the
-    /// ground), and the coordinates they read.
-    fn two_angles(&self, a: BodyId, b: BodyId) -> Result<(Option<usize>, Option<usize>, Vec<usize>)> {
-        self.distinct(a, b)?;
-        let mut idx = Vec::new();
-        let ia = self.attach_angle(a, &mut idx)?;
-        let ib = self.attach_angle(b, &mut idx)?;
-        Ok((ia, ib, idx))
-    }
-
-    /// Where a body's coordinates are and what it is, for one end of an element.
-    fn attach(&self, id: BodyId, point: [f64; 2], idx: &mut Vec<usize>) -> Result<End> {
-        for p in point {
-            finite("point", p)?;
-        }
-        let BodyId::Body(i) = id else {
-            return Ok(End::Ground { point });
-        };
-        let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
-        let (at, first) = (idx.len(), self.offsets[i]);
-        match b.inertia {
-            Some(_) => {
-                idx.extend([first, first + 1, first + 2]);
-                Ok(End::Rigid { at, local: point })
-            }
-            None if point == [0.0, 0.0] => {
-                idx.extend([first, first + 1]);
-                Ok(End::Point { at })
-            }
-            None => Err(Problem::PointMassOffset { body: b.name.clone() }.into()),
-        }
-    }
-
-    /// The angle coordinate of a body, for elements on relative angles.
-    fn attach_angle(&self, id: BodyId, idx: &mut Vec<usize>) -> Result<Option<usize>> {
-        let BodyId::Body(i) = id else {
-            return Ok(None);
-        };
-        let b = self.bodies.get(i).ok_or(Problem::NoSuchBody { index: i })?;
-        if b.inertia.is_none() {
-            return Err(Problem::NoAngle { body: b.name.clone() }.into());
-        }
-        idx.push(self.offsets[i] + 2);
-        Ok(Some(idx.len() - 1))
-    }
-
-    /// An element connects two different bodies.
-    fn distinct(&self, a: BodyId, b: BodyId) -> Result<()> {
-        if a == b { Err(Problem::SameBody { body: self.name(a) }.into()) } else { Ok(()) }
-    }
-
-    /// A body's name for messages: its own, `ground`, or its position if it does not exist.
-    fn name(&self, id: BodyId) -> String {
-        match id {
-            BodyId::Ground => "ground".into(),
-            BodyId::Body(i) => self.bodies.get(i).map_or_else(|| format!("body {i}"), |b| b.name.clone()),
-        }
     }
 }
 

@@ -120,7 +120,7 @@ fn ends(e: &Element) -> (Vec<BodyPoint>, Option<[f64; 2]>) {
         | Element::Distance { a, pa, b, pb, .. }
         | Element::Spring { a, pa, b, pb, .. }
         | Element::Damper { a, pa, b, pb, .. } => (vec![(a, pa), (b, pb)], None),
-        Element::Prismatic { a, pa, b, pb, axis } => (vec![(a, pa), (b, pb)], Some(axis)),
+        Element::Prismatic { a, pa, b, pb, axis, .. } => (vec![(a, pa), (b, pb)], Some(axis)),
         Element::KnifeEdge { body, point, blade } => (vec![(body, point)], Some(blade)),
         Element::FixedAngle { a, b, .. }
         | Element::DriveAngle { a, b, .. }
@@ -142,10 +142,10 @@ mod tests {
         let mut m = Mechanism::new([0.0, -9.81]);
         let crank = m.rigid("crank", 1.0, 0.1, [0.5, 0.0], 0.0);
         let bob = m.point("bob", 1.0, [2.0, 0.0]);
-        m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5, 0.0] });
+        m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5, 0.0], limit: None });
         m.add(Element::DriveAngle { a: BodyId::Ground, b: crank, f: TimeFn::constant(0.0) });
         m.add(Element::Spring { a: crank, pa: [0.5, 0.0], b: bob, pb: [0.0, 0.0], stiffness: 1.0, rest_length: 1.0 });
-        m.add(Element::Revolute { a: crank, pa: [-0.5, 0.0], b: BodyId::Body(7), pb: [0.0, 0.0] });
+        m.add(Element::Revolute { a: crank, pa: [-0.5, 0.0], b: BodyId::Body(7), pb: [0.0, 0.0], limit: None });
         let d = m.drawing();
         assert_eq!(d.bodies.len(), 2);
         assert_eq!((d.bodies[0].x, d.bodies[0].angle), (0, Some(2)));

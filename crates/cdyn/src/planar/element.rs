@@ -2,6 +2,7 @@
 //! code with [`BodyId`]s, or in a scenario file with body names.
 
 use super::body::BodyId;
+use crate::limit::JointLimit;
 use crate::model::timefn::TimeFn;
 
 /// Which coordinate of a body a drive prescribes (`"x"`, `"y"`, `"angle"` in
@@ -77,13 +78,23 @@ elements! {
 #[non_exhaustive]
 pub enum Element<B = BodyId> {
     /// Points `pa` on `a` and `pb` on `b` coincide.
-    Revolute between B {},
+    Revolute between B {
+        /// The range of the relative angle `φ_b − φ_a` (the ground's angle
+        /// is 0; not wrapped, so any finite bound is a stop), for two rigid
+        /// bodies or a rigid body and the ground.
+        #[cfg_attr(feature = "serde", serde(default))]
+        limit: Option<JointLimit>,
+    },
     /// Point `pb` on `b` slides along the line through `pa` on `a` with
     /// direction `axis` (in `a`'s frame); the relative angle stays fixed
     /// when both have one.
     Prismatic between B {
         /// The line's direction in `a`'s frame; any non-zero length.
         axis: [f64; 2],
+        /// The range of the displacement `(p_b − p_a) · u` of `pb` from `pa`
+        /// along the axis (`u` the unit axis, turning with `a`).
+        #[cfg_attr(feature = "serde", serde(default))]
+        limit: Option<JointLimit>,
     },
     /// A massless rod of this length between two points.
     Distance between B {
@@ -260,9 +271,11 @@ impl<B> Element<B> {
     /// which is told the reference's key (`a`, `b`, `body`) for its errors.
     pub fn try_map_bodies<C, E>(self, mut f: impl FnMut(&'static str, B) -> Result<C, E>) -> Result<Element<C>, E> {
         Ok(match self {
-            Element::Revolute { a, pa, b, pb } => Element::Revolute { a: f("a", a)?, pa, b: f("b", b)?, pb },
-            Element::Prismatic { a, pa, b, pb, axis } => {
-                Element::Prismatic { a: f("a", a)?, pa, b: f("b", b)?, pb, axis }
+            Element::Revolute { a, pa, b, pb, limit } => {
+                Element::Revolute { a: f("a", a)?, pa, b: f("b", b)?, pb, limit }
+            }
+            Element::Prismatic { a, pa, b, pb, axis, limit } => {
+                Element::Prismatic { a: f("a", a)?, pa, b: f("b", b)?, pb, axis, limit }
             }
             Element::Distance { a, pa, b, pb, length } => {
                 Element::Distance { a: f("a", a)?, pa, b: f("b", b)?, pb, length }

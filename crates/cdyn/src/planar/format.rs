@@ -94,11 +94,11 @@ mod tests {
         vec![
             (
                 "kind = 'revolute'\na = 'ground'\nb = 'crank'\npoint_b = [-0.5, 0.0]",
-                Element::Revolute { a: GROUND, pa: [0.0, 0.0], b: CRANK, pb: [-0.5, 0.0] },
+                Element::Revolute { a: GROUND, pa: [0.0, 0.0], b: CRANK, pb: [-0.5, 0.0], limit: None },
             ),
             (
                 "kind = 'prismatic'\na = 'ground'\nb = 'bob'\naxis = [1.0, 0.5]",
-                Element::Prismatic { a: GROUND, pa: [0.0, 0.0], b: BOB, pb: [0.0, 0.0], axis: [1.0, 0.5] },
+                Element::Prismatic { a: GROUND, pa: [0.0, 0.0], b: BOB, pb: [0.0, 0.0], axis: [1.0, 0.5], limit: None },
             ),
             (
                 "kind = 'distance'\na = 'crank'\npoint_a = [0.5, 0.0]\nb = 'bob'\nlength = 1.2",

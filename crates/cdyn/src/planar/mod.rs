@@ -12,7 +12,7 @@
 //! entries (`format` reads the three lists), and
 //! [`Mechanism::add_named`] resolves the body names.
 //!
-//! May import: `error`, `ad`, `model`.
+//! May import: `error`, `ad`, `model`, `limit`.
 
 mod body;
 mod build;
@@ -23,6 +23,8 @@ mod ends;
 #[cfg(feature = "serde")]
 pub mod format;
 mod inputs;
+mod layout;
+mod limit;
 mod loads;
 mod mechanism;
 

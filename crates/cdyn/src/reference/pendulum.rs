@@ -141,12 +141,51 @@ impl PendulumExact {
     }
 }
 
+/// The time a pendulum `ψ̈ = −w² sin ψ` (ψ from the bottom) released at
+/// rest at `psi0` takes to swing to `psi`, on its first swing (`|psi| ≤
+/// |psi0| < π`, `psi` on either side of the bottom): with `k = sin(ψ₀/2)`
+/// and `sin u = sin(ψ/2) / k`, `t = (K(k) − F(u, k)) / w`. A rigid body of
+/// inertia `I` about its pivot, centre of mass `L` from it, has `w² = m g L / I`.
+///
+/// Fails with [`Error::InvalidParameter`] for `w2 ≤ 0`, `psi0` not in
+/// `(−π, π)` or zero, and `psi` beyond `±psi0`.
+pub fn time_to_swing(w2: f64, psi0: f64, psi: f64) -> Result<f64> {
+    positive("w2", w2)?;
+    // Written so that a NaN fails each test.
+    let (swings, within) = (psi0.abs() < std::f64::consts::PI && psi0 != 0.0, psi.abs() <= psi0.abs());
+    if !swings {
+        return Err(Error::InvalidParameter { name: "psi0", value: psi0, reason: "must be in (−π, π), not 0" });
+    }
+    if !within {
+        return Err(Error::InvalidParameter {
+            name: "psi", value: psi, reason: "must be between −|psi0| and |psi0|"
+        });
+    }
+    // The swing from −ψ₀ is the mirror image of the one from ψ₀.
+    let (psi0, psi) = if psi0 < 0.0 { (-psi0, -psi) } else { (psi0, psi) };
+    let k = (0.5 * psi0).sin();
+    let u = ((0.5 * psi).sin() / k).clamp(-1.0, 1.0).asin();
+    Ok((elliptic::complete_k(k) - elliptic::incomplete_f(u, k)) / w2.sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::reference::elliptic::{Modulus, complete_k, incomplete_f, jacobi};
     use crate::reference::fine_ode::FineOde;
     use std::f64::consts::PI;
+
+    /// Released at rest, the exact motion is at `psi` after the time to swing there.
+    #[test]
+    fn the_time_to_swing_is_when_the_exact_motion_gets_there() {
+        for (w2, psi0, psi) in [(14.7, 1.2, 0.3), (3.0, 2.9, -1.0), (9.81, -0.4, 0.39), (1.0, 1.0, 1.0)] {
+            let t = time_to_swing(w2, psi0, psi).unwrap();
+            let (theta, _) = PendulumExact::new(w2, psi0 - FRAC_PI_2, 0.0).unwrap().angle(t);
+            close(theta + FRAC_PI_2, psi, 1e-12, &format!("w2 {w2}, from {psi0} to {psi}"));
+        }
+        assert!(time_to_swing(2.0, 0.8, 0.8).unwrap().abs() < 1e-15);
+        assert!(time_to_swing(2.0, 0.8, 0.9).is_err() && time_to_swing(2.0, 3.2, 0.0).is_err());
+    }
 
     fn close(a: f64, b: f64, tol: f64, what: &str) {
         assert!((a - b).abs() <= tol, "{what}: {a} vs {b}, diff {:e} > {tol:e}", (a - b).abs());

@@ -2,7 +2,7 @@
 //! between which bodies, where, and optionally driven; `joint_rows` writes
 //! its constraint rows.
 
-use super::limit::JointLimit;
+use crate::limit::JointLimit;
 use crate::model::timefn::TimeFn;
 
 /// What a joint allows (its `kind` in scenario files).

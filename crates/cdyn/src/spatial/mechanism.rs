@@ -5,12 +5,12 @@ use super::actuator::Actuator;
 use super::body::{Body, Rotation, SpatialBody, coordinate_names};
 use super::coordinate::{JointCoordinate, JointSpace, Mimic, StopRow};
 use super::joint::{Joint, JointKind};
-use super::limit::{JointLimit, Stop};
 use super::load::Load;
 use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
 use crate::ad::scalar::Scalar;
 use crate::error::{Part, Problem, Result};
+use crate::limit::{JointLimit, Stop};
 use crate::model::angular::Generator;
 use crate::model::force::Potential;
 use crate::model::{Model, ModelBuilder};
@@ -322,10 +322,8 @@ impl Mechanism {
         let mut out = Vec::new();
         for (joint, j) in self.joints.iter().enumerate() {
             let Some(l) = j.limit else { continue };
-            for (upper, bound) in [(false, l.lower), (true, l.upper)] {
-                if reachable(j.kind, &l, bound) {
-                    out.push(Stop { joint, upper });
-                }
+            for upper in l.finite_sides().filter(|&upper| reachable(j.kind, &l, l.side(upper).0)) {
+                out.push(Stop { joint, upper });
             }
         }
         out
@@ -343,8 +341,13 @@ impl Mechanism {
 
     /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
     pub fn stop_bound(&self, stop: Stop) -> (f64, f64, f64) {
-        let l = self.joints[stop.joint].limit.expect("a stop's joint has a limit");
-        if stop.upper { (l.upper, -1.0, l.restitution) } else { (l.lower, 1.0, l.restitution) }
+        let l = self.limit(stop);
+        let (bound, sign) = l.side(stop.upper);
+        (bound, sign, l.restitution)
+    }
+
+    fn limit(&self, stop: Stop) -> JointLimit {
+        self.joints[stop.joint].limit.expect("a stop's joint has a limit")
     }
 
     /// The gap `g = s (θ − bound)` and its rate `ġ` of each stop at `(q, v)`.
@@ -353,13 +356,12 @@ impl Mechanism {
         Ok(stops
             .iter()
             .map(|&s| {
-                let (bound, sign, _) = self.stop_bound(s);
                 let [x, rate, _] = theta[s.joint].expect("a stop's joint has a coordinate");
                 let x = match self.joints[s.joint] {
                     Joint { kind: JointKind::Revolute, limit: Some(l), .. } if l.within_a_turn() => l.unwrap_angle(x),
                     _ => x,
                 };
-                [sign * (x - bound), sign * rate]
+                self.limit(s).gap(s.upper, x, rate)
             })
             .collect())
     }

@@ -32,7 +32,7 @@
 //! reads a robot; [`Sketch`] is what figures draw, bodies as their
 //! [`Visual`]s.
 //!
-//! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `planar`.
+//! May import: `error`, `ad`, `linalg`, `model`, `dynamics`, `planar`, `limit`.
 
 mod actuated;
 mod actuator;
@@ -41,7 +41,6 @@ mod chain;
 mod coordinate;
 mod joint;
 mod joint_rows;
-mod limit;
 mod load;
 mod mechanism;
 mod named;
@@ -53,12 +52,12 @@ mod sketch;
 mod urdf;
 mod visual;
 
+pub use crate::limit::{JointLimit, Stop};
 pub use actuator::{Actuator, ActuatorTorques};
 pub use body::{Body, Rotation, SpatialBody, coordinate_names};
 pub use chain::chain;
 pub use coordinate::JointSpace;
 pub use joint::{FRICTION_SLIP, Joint, JointKind};
-pub use limit::{JointLimit, Stop};
 pub use load::Load;
 pub use mechanism::{Built, Coupling, Mechanism};
 pub use sketch::{Anchor, Limb, Sketch};

@@ -4,10 +4,10 @@
 
 use super::body::Body;
 use super::joint::Joint;
-use super::limit::JointLimit;
 use super::load::Load;
 use super::mechanism::Mechanism;
 use crate::error::{Error, Part, Problem, Result};
+use crate::limit::JointLimit;
 use std::collections::HashMap;
 
 impl Mechanism {

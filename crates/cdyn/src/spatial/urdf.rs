@@ -33,11 +33,11 @@
 
 use super::body::Body;
 use super::joint::{Joint, JointKind};
-use super::limit::JointLimit;
 use super::mechanism::{Coupling, Mechanism};
 use super::rotation::{about, compose, rotate, unrotate};
 use super::visual::{Shape, Visual};
 use crate::error::{Error, Part, Problem, Result};
+use crate::limit::JointLimit;
 use std::collections::HashMap;
 
 /// A pose: position and unit quaternion.

@@ -1,5 +1,6 @@
 //! One-sided constraints: stops that hold a coordinate on one side
-//! (`g(q) ≥ 0`), joint limits being the first. A stop is a row of the
+//! (`g(q) ≥ 0`), joint limits being the first (of spatial and planar
+//! mechanisms, each a [`Unilateral`] system). A stop is a row of the
 //! model only while it holds: the run steps the model of the stops held,
 //! and between two steps
 //!
@@ -26,8 +27,9 @@
 //! which the projection removes), and the crossing time the event reports
 //! is the root of the cubic through `(g, ġ)` at the step's two ends.
 //!
-//! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`.
+//! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`, `planar`.
 
+mod planar;
 mod spatial;
 mod stepping;
 mod unilateral;

@@ -1,13 +1,16 @@
 //! The mechanisms of a scenario's entries: planar from `[[bodies]]`,
 //! `[[joints]]`, `[[drives]]`, `[[forces]]`, spatial from those and a URDF
-//! robot's; and the entry (or URDF element) behind each part, for errors.
+//! robot's; the entry (or URDF element) behind each part, for errors; and
+//! a planar mechanism's joint limits, for the run to hold.
 
+use crate::case::runner::limits::{Limits, StopName};
 use crate::case::scenario::{Scenario, SpatialEntries, read_bounded};
 use anyhow::{Result, anyhow, bail};
 use cdyn::error::Part;
 use cdyn::planar::{Element, Group, Mechanism};
 use cdyn::spatial::{Actuator, JointKind};
 use std::path::Path;
+use std::sync::Arc;
 
 impl Scenario {
     /// The spatial mechanism of the `urdf` file named in `[model]` (relative
@@ -103,6 +106,28 @@ impl Scenario {
             }
         }
         Ok(m)
+    }
+
+    /// The joint limits of a planar mechanism of the entries, if any joint
+    /// has one: its stops and joints named as `joints[k]`.
+    pub(super) fn planar_limits(&self, mechanism: Mechanism) -> Option<Limits> {
+        mechanism.elements.iter().any(|e| e.limit().is_some()).then(|| {
+            let names: Vec<String> = self
+                .element_lists()
+                .into_iter()
+                .flat_map(|(group, list)| (0..list.len()).map(move |i| format!("{}[{i}]", group.name())))
+                .collect();
+            let stops = mechanism
+                .stops()
+                .into_iter()
+                .map(|stop| StopName {
+                    joint: names[stop.joint].clone(),
+                    upper: stop.upper,
+                    bound: mechanism.stop_bound(stop).0,
+                })
+                .collect();
+            Limits { system: Arc::new(mechanism), stops, joints: names }
+        })
     }
 }
 

@@ -3,8 +3,8 @@
 //! and the settings; a model's error names the scenario entry that made it.
 //!
 //! Here the case and its model; `mechanisms` the planar and spatial
-//! mechanisms of the entries (and a URDF robot's) and the entry behind each
-//! part; `spatial` a spatial scenario's model with its initial joint
+//! mechanisms of the entries (and a URDF robot's), the entry behind each
+//! part and a planar mechanism's limits; `spatial` a spatial scenario's model with its initial joint
 //! state, joint columns and limits; `invariants` the declared `[[invariants]]`.
 //!
 //! May import: `io` (and `case`'s scenario, runner and wording).
@@ -276,7 +276,8 @@ impl Scenario {
                 let built = mechanism.build();
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
-                Ok(Described { rows, ..Described::plain(Example::from_mechanism(built, None)) })
+                let limits = self.planar_limits(mechanism);
+                Ok(Described { rows, limits, ..Described::plain(Example::from_mechanism(built, None)) })
             }
             Kind::Spatial => self.spatial_example(file),
             built_in => {

@@ -40,11 +40,11 @@ pub fn four_bar(p: FourBarParams) -> Result<Example> {
     let crank = body("crank", p.crank_mass, p.crank_inertia, 0);
     let coupler = body("coupler", p.coupler_mass, p.coupler_inertia, 1);
     let rocker = body("rocker", p.rocker_mass, p.rocker_inertia, 2);
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5 * a, 0.0] });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [0.0, 0.0], b: crank, pb: [-0.5 * a, 0.0], limit: None });
     m.add(Element::DriveAngle { a: BodyId::Ground, b: crank, f: TimeFn::linear(p.theta0, p.omega) });
-    m.add(Element::Revolute { a: crank, pa: [0.5 * a, 0.0], b: coupler, pb: [-0.5 * b, 0.0] });
-    m.add(Element::Revolute { a: coupler, pa: [0.5 * b, 0.0], b: rocker, pb: [0.5 * c, 0.0] });
-    m.add(Element::Revolute { a: BodyId::Ground, pa: [d, 0.0], b: rocker, pb: [-0.5 * c, 0.0] });
+    m.add(Element::Revolute { a: crank, pa: [0.5 * a, 0.0], b: coupler, pb: [-0.5 * b, 0.0], limit: None });
+    m.add(Element::Revolute { a: coupler, pa: [0.5 * b, 0.0], b: rocker, pb: [0.5 * c, 0.0], limit: None });
+    m.add(Element::Revolute { a: BodyId::Ground, pa: [d, 0.0], b: rocker, pb: [-0.5 * c, 0.0], limit: None });
     if let Some(load) = &p.load {
         load.attach(&mut m, rocker, [0.5 * c, 0.0], cp, cv);
     }

@@ -1,27 +1,36 @@
-//! Joint limits: the range of a revolute or prismatic joint's coordinate
-//! `θ` ([`JointLimit`]), each finite side a one-sided stop ([`Stop`]) with
-//! its gap `g = θ − lower` or `upper − θ` (`g ≥ 0` allowed), and the row
-//! `g = 0` that holds a joint at a stop while it pushes into it.
+//! Joint limits, planar and spatial: the range of a revolute or prismatic
+//! joint's coordinate `θ` ([`JointLimit`]), each finite side a one-sided
+//! stop ([`Stop`]) with its gap `g = θ − lower` or `upper − θ` (`g ≥ 0`
+//! allowed, [`JointLimit::gap`]), and the row `g = 0` that holds a joint at
+//! a stop while it pushes into it.
 //!
-//! The mechanism says where the stops are ([`crate::spatial::Mechanism::stops`],
-//! [`crate::spatial::Mechanism::gaps`]) and builds its model with a given set of them held
-//! ([`crate::spatial::Mechanism::build_holding`]: the row is `StopRow` beside the other
-//! rows on joint coordinates); when a stop is hit, held and released is the
-//! run's business ([`crate::stops`]), as it changes which rows the model has.
+//! A mechanism says where its stops are
+//! ([`crate::spatial::Mechanism::stops`], [`crate::planar::Mechanism::stops`])
+//! and builds its model with a given set of them held (`build_holding`: the
+//! row is the gap, written once on the joint's coordinate and
+//! differentiated like any other row); when a stop is hit, held and
+//! released is the run's business ([`crate::stops`]), as it changes which
+//! rows the model has.
 //!
-//! A revolute joint's coordinate is an angle in `(−π, π]`. A range shorter
-//! than a turn is told apart from it wherever its bounds lie (Panda's
-//! joint 6 goes to 3.75 rad); in a range of a turn or more (URDF's ±2π of a
-//! multi-turn joint) a bound at or beyond ±π cannot be met and makes no
-//! stop ([`crate::spatial::Mechanism::unreachable_limits`] counts them, for
-//! a run to say so).
+//! What `θ` is depends on the mechanism: a spatial joint's angle (in
+//! `(−π, π]`: a range shorter than a turn is told apart from it wherever
+//! its bounds lie, Panda's joint 6 going to 3.75 rad, but in a range of a
+//! turn or more, URDF's ±2π of a multi-turn joint, a bound at or beyond ±π
+//! makes no stop: [`crate::spatial::Mechanism::unreachable_limits`]) or
+//! displacement from the initial pose; a planar joint's relative angle
+//! `φ_b − φ_a` (not wrapped) or the displacement of `point_b` from
+//! `point_a` along the axis.
+//!
+//! May import: `error`.
 
 use crate::error::{Problem, Result};
 use std::f64::consts::TAU;
 
-/// The range of a revolute or prismatic joint's coordinate (see
-/// [`crate::spatial::Mechanism::joint_coordinates`]): an angle in rad, a displacement in
-/// length units, from the initial pose. In a scenario file a joint's
+/// The range of a revolute or prismatic joint's coordinate: an angle in
+/// rad, a displacement in length units (for a spatial joint from the
+/// initial pose, see [`crate::spatial::Mechanism::joint_coordinates`]; for
+/// a planar one see [`crate::planar::Element::Revolute`] and
+/// [`crate::planar::Element::Prismatic`]). In a scenario file a joint's
 /// `limit = { lower = -1.0, upper = 1.0 }`; from URDF, `<limit>`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Deserialize), serde(deny_unknown_fields))]
@@ -41,8 +50,9 @@ pub struct JointLimit {
     /// The largest `|θ̇|` (`+∞`: none): reported where exceeded, not enforced.
     #[cfg_attr(feature = "serde", serde(default = "infinity"))]
     pub velocity: f64,
-    /// The largest actuator torque (force) at the joint (`+∞`: none): the
-    /// joint's [`Actuator`](super::Actuator) is clamped to `±effort`.
+    /// The largest actuator torque (force) at the joint (`+∞`: none): a
+    /// spatial joint's [`Actuator`](crate::spatial::Actuator) is clamped to
+    /// `±effort`. A planar joint has no actuator, and refuses a finite one.
     #[cfg_attr(feature = "serde", serde(default = "infinity"))]
     pub effort: f64,
 }
@@ -122,8 +132,29 @@ crate::setters!(JointLimit {
 /// One side of a joint's limit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Stop {
-    /// The joint (an index into [`crate::spatial::Mechanism::joints`]).
+    /// The joint: an index into [`crate::spatial::Mechanism::joints`], or
+    /// into [`crate::planar::Mechanism::elements`].
     pub joint: usize,
     /// The upper bound (else the lower).
     pub upper: bool,
+}
+
+impl JointLimit {
+    /// The bound of one side and its sign `s` (1 lower, −1 upper): the gap
+    /// there is `g = s (θ − bound)`.
+    pub fn side(&self, upper: bool) -> (f64, f64) {
+        if upper { (self.upper, -1.0) } else { (self.lower, 1.0) }
+    }
+
+    /// The gap `g` of one side and its rate `ġ`, at the coordinate `θ` moving at `θ̇`.
+    pub fn gap(&self, upper: bool, theta: f64, rate: f64) -> [f64; 2] {
+        let (bound, sign) = self.side(upper);
+        [sign * (theta - bound), sign * rate]
+    }
+
+    /// The finite sides, lower before upper: the stops a coordinate that
+    /// can take any value meets (a spatial angle takes only `(−π, π]`).
+    pub fn finite_sides(self) -> impl Iterator<Item = bool> {
+        [false, true].into_iter().filter(move |&upper| self.side(upper).0.is_finite())
+    }
 }

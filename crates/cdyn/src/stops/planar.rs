@@ -1,0 +1,46 @@
+//! A planar mechanism's joint limits as stops: each finite side of a
+//! revolute or prismatic joint's limit ([`Mechanism::stops`]).
+
+use super::unilateral::Unilateral;
+use crate::error::Result;
+use crate::model::Model;
+use crate::planar::Mechanism;
+
+impl Unilateral for Mechanism {
+    fn stops(&self) -> usize {
+        Mechanism::stops(self).len()
+    }
+
+    fn model_holding(&self, held: &[usize]) -> Result<Model> {
+        let stops = Mechanism::stops(self);
+        let held: Vec<_> = held.iter().map(|&k| stops[k]).collect();
+        Ok(self.build_holding(&held)?.model)
+    }
+
+    fn gaps(&self, q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>> {
+        Mechanism::gaps(self, &Mechanism::stops(self), q, v)
+    }
+
+    fn restitution(&self, stop: usize) -> f64 {
+        self.stop_bound(Mechanism::stops(self)[stop]).2
+    }
+
+    /// Joints (by element index) faster than their limit's `velocity`.
+    fn overspeed(&self, q: &[f64], v: &[f64]) -> Result<Vec<(usize, f64)>> {
+        let bounded = self.elements.iter().enumerate().filter_map(|(k, e)| Some((k, e.limit()?.velocity)));
+        let mut out = Vec::new();
+        for (k, bound) in bounded.filter(|(_, bound)| bound.is_finite()) {
+            let ratio = self.joint_coordinate(k, q, v)?[1].abs() / bound;
+            if ratio > 1.0 {
+                out.push((k, ratio));
+            }
+        }
+        Ok(out)
+    }
+
+    fn name(&self, stop: usize) -> String {
+        let s = Mechanism::stops(self)[stop];
+        let kind = self.elements[s.joint].kind();
+        format!("element {} ({kind})'s {} limit", s.joint, if s.upper { "upper" } else { "lower" })
+    }
+}
