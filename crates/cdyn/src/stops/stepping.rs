@@ -124,13 +124,29 @@ impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
             plastic.clone_from(&free);
             assemble(&impact, &mut q.clone(), &mut plastic, t, ASSEMBLY_TOLERANCE)?;
         }
-        // One coefficient for stops hit at once: the largest of theirs.
-        let e = hits.iter().filter(|k| closing(k)).map(|&k| self.system.restitution(k)).fold(0.0, f64::max);
-        let v: Vec<f64> = free.iter().zip(&plastic).map(|(f, p)| f + (1.0 + e) * (p - f)).collect();
+        // One coefficient for stops hit at once: the largest of theirs. A
+        // rebound that the load pressing into the stop (g̈ < 0, over the
+        // step) would end within a step, `2 e |ġ| < |g̈| h`, is a plastic
+        // impact: bounces shrinking by e each would otherwise come at every
+        // step without end (Zeno), each a hit.
+        // The rebound is from ġ at the crossing, not at the step's end: seen
+        // up to h late, the joint has gained speed from the load since, and
+        // rebounding with it gave back energy the bounce did not have (a
+        // bounce every second step without end, at 7.4e-3 rad/s, seen).
+        let crossings: Vec<[f64; 2]> = hits.iter().map(|&k| crossing(self.before[k], gaps[k], h)).collect();
+        let bounces = |(k, [_, rate]): (usize, [f64; 2])| {
+            let pressing = (self.before[k][1] - gaps[k][1]) / h;
+            closing(&k) && 2.0 * self.system.restitution(k) * -rate >= pressing * h
+        };
+        let bouncing = || hits.iter().copied().zip(crossings.iter().copied()).filter(|&hit| bounces(hit));
+        let e = bouncing().map(|(k, _)| self.system.restitution(k)).fold(0.0, f64::max);
+        let slower = bouncing().map(|(k, [_, rate])| (rate / rates[k][1]).clamp(0.0, 1.0)).fold(1.0, f64::min);
+        // v_p + e r (v_p − v̂): the stops' rate −e r ġ, r = ġ(crossing) / ġ.
+        let v: Vec<f64> = free.iter().zip(&plastic).map(|(f, p)| p + e * slower * (p - f)).collect();
         let kinetic_lost = impact.kinetic(&q, &free) - impact.kinetic(&q, &v);
         let held_more = e == 0.0 && rows.len() > held;
-        for &stop in hits {
-            let t = crossing(self.before[stop], gaps[stop], t - h, h);
+        for (&stop, [s, _]) in hits.iter().zip(crossings) {
+            let t = t - h + s * h;
             let held = held_more && closing(&stop);
             let change = Change::Impact { rate: rates[stop][1], kinetic_lost, held };
             self.report.events.push(Event { stop, step, t, change });
@@ -331,9 +347,10 @@ const RELEASE_THRESHOLD: f64 = 1e-10;
 /// How closely an impact's projection meets the rows.
 const ASSEMBLY_TOLERANCE: f64 = 1e-12;
 
-/// The time in `[t0, t0 + h]` where the cubic through `(g, ġ)` at both
-/// ends crosses zero (`g ≥ 0` at `t0`, `< 0` at the end), by bisection.
-fn crossing([g0, r0]: [f64; 2], [g1, r1]: [f64; 2], t0: f64, h: f64) -> f64 {
+/// Where in a step of `h` (a fraction of it) the cubic through `(g, ġ)` at
+/// both ends crosses zero (`g ≥ 0` at the start, `< 0` at the end), by
+/// bisection, and the cubic's rate there.
+fn crossing([g0, r0]: [f64; 2], [g1, r1]: [f64; 2], h: f64) -> [f64; 2] {
     let cubic = |s: f64| {
         let (s2, s3) = (s * s, s * s * s);
         g0 * (2.0 * s3 - 3.0 * s2 + 1.0)
@@ -346,5 +363,10 @@ fn crossing([g0, r0]: [f64; 2], [g1, r1]: [f64; 2], t0: f64, h: f64) -> f64 {
         let mid = 0.5 * (lo + hi);
         if cubic(mid) >= 0.0 { lo = mid } else { hi = mid }
     }
-    t0 + h * 0.5 * (lo + hi)
+    let s = 0.5 * (lo + hi);
+    let slope = g0 * (6.0 * s * s - 6.0 * s)
+        + r0 * h * (3.0 * s * s - 4.0 * s + 1.0)
+        + g1 * (6.0 * s - 6.0 * s * s)
+        + r1 * h * (3.0 * s * s - 2.0 * s);
+    [s, slope / h]
 }

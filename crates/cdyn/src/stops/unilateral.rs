@@ -47,8 +47,12 @@ pub enum Change {
         /// `ġ` just before the impact, at the stop (the positions projected
         /// onto it, the velocities onto the other rows there).
         rate: f64,
-        /// `T⁻ − T⁺` across the impact, at the stop: `(1 − e²) ġ² / (2 g_q M⁻¹ g_qᵀ)`
-        /// for one stop, the kinetic energy of the velocity along it.
+        /// `T⁻ − T⁺` across the impact, at the stop: `(ġ² − e² ġ_c²) / (2 g_q M⁻¹ g_qᵀ)`
+        /// for one stop, with `ġ_c` the rate at the crossing (the rebound's
+        /// `−e ġ_c`: from the step's end, up to `h` after the crossing, it
+        /// would give back the energy the load put in since). A rebound the
+        /// load would end within a step (`2 e |ġ_c| < |g̈| h`) is plastic:
+        /// bounces end held instead of coming at every step.
         kinetic_lost: f64,
         /// Whether the stop is held now.
         held: bool,
