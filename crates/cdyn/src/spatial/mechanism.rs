@@ -10,7 +10,7 @@ use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
 use crate::ad::scalar::Scalar;
 use crate::error::{Part, Problem, Result};
-use crate::limit::{JointLimit, Stop};
+use crate::limit::Stop;
 use crate::model::angular::Generator;
 use crate::model::force::Potential;
 use crate::model::{Model, ModelBuilder};
@@ -315,57 +315,6 @@ impl Mechanism {
         Ok(JointSpace::new(read))
     }
 
-    /// Every finite side of every joint's limit that the joint's coordinate
-    /// can meet (an angle is in `(−π, π]`: in a range of a turn or more, a
-    /// bound at or beyond ±π is not a stop), lower before upper, joints in order.
-    pub fn stops(&self) -> Vec<Stop> {
-        let mut out = Vec::new();
-        for (joint, j) in self.joints.iter().enumerate() {
-            let Some(l) = j.limit else { continue };
-            for upper in l.finite_sides().filter(|&upper| reachable(j.kind, &l, l.side(upper).0)) {
-                out.push(Stop { joint, upper });
-            }
-        }
-        out
-    }
-
-    /// How many finite bounds no stop stands for: a revolute joint's at or
-    /// beyond ±π in a range of a turn or more.
-    pub fn unreachable_limits(&self) -> usize {
-        let bounds = self.joints.iter().filter_map(|j| j.limit.map(|l| (j.kind, l)));
-        bounds
-            .flat_map(|(kind, l)| [l.lower, l.upper].map(|b| b.is_finite() && !reachable(kind, &l, b)))
-            .filter(|&x| x)
-            .count()
-    }
-
-    /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
-    pub fn stop_bound(&self, stop: Stop) -> (f64, f64, f64) {
-        let l = self.limit(stop);
-        let (bound, sign) = l.side(stop.upper);
-        (bound, sign, l.restitution)
-    }
-
-    fn limit(&self, stop: Stop) -> JointLimit {
-        self.joints[stop.joint].limit.expect("a stop's joint has a limit")
-    }
-
-    /// The gap `g = s (θ − bound)` and its rate `ġ` of each stop at `(q, v)`.
-    pub fn gaps(&self, stops: &[Stop], q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>> {
-        let theta = self.joint_coordinates(q, v, &vec![0.0; q.len()])?;
-        Ok(stops
-            .iter()
-            .map(|&s| {
-                let [x, rate, _] = theta[s.joint].expect("a stop's joint has a coordinate");
-                let x = match self.joints[s.joint] {
-                    Joint { kind: JointKind::Revolute, limit: Some(l), .. } if l.within_a_turn() => l.unwrap_angle(x),
-                    _ => x,
-                };
-                self.limit(s).gap(s.upper, x, rate)
-            })
-            .collect())
-    }
-
     /// Each body's initial pose, its orientation checked.
     pub(super) fn poses(&self) -> Result<Vec<Pose>> {
         self.bodies
@@ -393,13 +342,6 @@ pub(super) fn reads(j: &Joint) -> Reads {
             let b = SpatialBody::of(b).coordinates();
             Reads::Bodies(std::array::from_fn(|i| if i < 7 { a[i] } else { b[i - 7] }))
         }
-    }
-}
-
-fn reachable(kind: JointKind, limit: &JointLimit, bound: f64) -> bool {
-    match kind {
-        JointKind::Revolute => limit.within_a_turn() || bound.abs() < std::f64::consts::PI,
-        _ => bound.is_finite(),
     }
 }
 

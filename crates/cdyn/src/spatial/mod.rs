@@ -48,6 +48,7 @@ mod placing;
 mod posing;
 pub mod rotation;
 mod sketch;
+mod stops;
 #[cfg(feature = "urdf")]
 mod urdf;
 mod visual;
