@@ -11,7 +11,7 @@
 //! joint), and the rod is held at 0.3 rad from then on.
 
 use cdyn::spatial::{Body, Joint, JointKind, JointLimit, Mechanism};
-use cdyn::stops::{Change, Event, run_with_stops};
+use cdyn::stops::{Change, Event, MechanismStops, run_with_stops};
 use cdyn::{Control, Scheme, Settings};
 
 const G: f64 = 9.81;
@@ -68,10 +68,18 @@ fn run(scheme: Scheme, h: f64, limit: JointLimit, t_end: f64) -> (Vec<Event>, Ve
     let built = mechanism.build().unwrap();
     let settings = Settings::new(scheme, h, Control::robust());
     let mut samples = Vec::new();
-    let events = run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, t_end, 1, |t, q, v| {
-        samples.push((t, mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()));
-        Ok(())
-    })
+    let events = run_with_stops::<_, cdyn::Error>(
+        &MechanismStops::new(mechanism.clone()).unwrap(),
+        settings,
+        &built.q0,
+        &built.v0,
+        t_end,
+        1,
+        |t, q, v| {
+            samples.push((t, mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()));
+            Ok(())
+        },
+    )
     .unwrap();
     (events.events, samples)
 }
@@ -144,10 +152,18 @@ fn a_stop_pulled_away_from_is_released() {
         .v0;
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
     let mut theta = Vec::new();
-    let report = run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 1.0, 1, |_, q, v| {
-        theta.push(mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()[0]);
-        Ok(())
-    })
+    let report = run_with_stops::<_, cdyn::Error>(
+        &MechanismStops::new(mechanism.clone()).unwrap(),
+        settings,
+        &built.q0,
+        &built.v0,
+        1.0,
+        1,
+        |_, q, v| {
+            theta.push(mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()[0]);
+            Ok(())
+        },
+    )
     .unwrap();
     let events = report.events;
     let kinds: Vec<_> = events.iter().map(|e| matches!(e.change, Change::Impact { .. })).collect();
