@@ -39,8 +39,9 @@ pub struct Live {
 
 /// What a [`Live`] steps: the case's model, or its joint limits' run.
 enum Run {
-    Free(Simulation<'static>),
-    Limited(StopSimulation<Arc<dyn Unilateral + Send + Sync>>),
+    // Both boxed: kilobytes each, of different sizes.
+    Free(Box<Simulation<'static>>),
+    Limited(Box<StopSimulation<Arc<dyn Unilateral + Send + Sync>>>),
 }
 
 /// A saved [`Live`]: it keeps the case alive, so it stays valid after the
@@ -89,10 +90,9 @@ impl Live {
         let model: &'static cdyn::Model = unsafe { &*std::ptr::from_ref(&case.example.model) };
         let ex = &case.example;
         let run = match &case.limits {
-            Some(limits) => {
-                StopSimulation::new(Arc::clone(&limits.system), case.settings, &ex.q0, &ex.v0).map(Run::Limited)
-            }
-            None => Simulation::new(model, case.settings, &ex.q0, &ex.v0).map(Run::Free),
+            Some(limits) => StopSimulation::new(Arc::clone(&limits.system), case.settings, &ex.q0, &ex.v0)
+                .map(|run| Run::Limited(Box::new(run))),
+            None => Simulation::new(model, case.settings, &ex.q0, &ex.v0).map(|sim| Run::Free(Box::new(sim))),
         };
         let run = run.map_err(|e| anyhow!("{file}: {e}"))?;
         let (n, observables) = (model.n(), ex.observables.len());
