@@ -278,6 +278,8 @@ class Simulation:
     Each Simulation has a model of its own, so two never share inputs. A
     changed input restarts the scheme (AB-3 and ABM-4 take RK-4 steps again)
     and keeps the energy balance (see the book's page on inputs and FMUs).
+    Joint limits are held as ``cdyn run`` holds them (``limits`` lists what
+    they did); a snapshot saves the limits held with the state.
 
     >>> import cdyn
     >>> sim = cdyn.Simulation("examples/pd_pendulum.toml")  # doctest: +SKIP
@@ -342,8 +344,18 @@ class Simulation:
 
     def set_state(self, q: Sequence[float], v: Sequence[float], e: float) -> None:
         """Puts the simulation at the state ``(q, v, e)`` (as ``state()``
-        returns it), at the same time; the scheme starts again from there."""
+        returns it), at the same time; the scheme starts again from there.
+        With joint limits, a state past a limit raises Error, and a held
+        limit the state is away from is let go."""
         self._sim.set_state(np.asarray(q, dtype=float), np.asarray(v, dtype=float), float(e))
+
+    @property
+    def limits(self) -> Optional[Dict[str, Any]]:
+        """What the case's joint limits did so far, as ``summary.json``'s
+        ``limits`` (``events``: each impact and release; ``velocity_exceeded``);
+        None for a case without limits."""
+        text = self._sim.limits_json()
+        return None if text is None else json.loads(text)
 
     def snapshot(self) -> Any:
         """Everything needed to come back to this point of the run

@@ -55,3 +55,31 @@ def test_bad_inputs_raise_with_the_message():
         sim.set_input("torque", 1.0)
     with pytest.raises(cdyn.ScenarioError, match="select: no output"):
         cdyn.Simulation(cdyn.loads(SCENARIO.read_text().replace('"psi"]', '"energy"]')))
+
+
+LIMITED = ROOT / "examples" / "limited_pendulum.toml"
+
+
+def test_a_limited_case_steps_as_cdyn_run_runs_it_and_restores_across_its_impact(cli, tmp_path):
+    # The rod falls onto its limit at t = 0.335 s and is held there.
+    assert cli("run", LIMITED, "--out", tmp_path).returncode == 0
+    header, rows = read_csv(tmp_path / "limited_pendulum.csv")
+    sim = cdyn.Simulation(LIMITED)
+    assert sim.output_names == header
+    saved = None
+    for k, row in enumerate(rows):
+        assert np.array_equal(sim.outputs(), np.array(row)), f"row {k}"
+        if k == 30:
+            saved = sim.snapshot()
+        sim.step(10)
+    events = sim.limits["events"]
+    assert [(e["event"], e["side"], e["held"]) for e in events] == [("impact", "lower", True)]
+    assert abs(events[0]["t"] - 0.33526414955) < 1e-3
+    # Restored after the impact to a snapshot from before it: the same rows.
+    sim.restore(saved)
+    assert sim.steps == 300 and sim.limits["events"] == []
+    for k, row in list(enumerate(rows))[30:60]:
+        assert np.array_equal(sim.outputs(), np.array(row)), f"row {k} after the restore"
+        sim.step(10)
+    assert len(sim.limits["events"]) == 1
+    assert cdyn.Simulation(SCENARIO).limits is None

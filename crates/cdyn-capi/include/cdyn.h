@@ -120,6 +120,14 @@ const char *cdyn_output_name(const struct CdynSimulation *sim,
 // `sim` is null or a live simulation; `values` null or `len` writable doubles.
 enum CdynStatus cdyn_get_outputs(struct CdynSimulation *sim, double *values, size_t len);
 
+// How many joint limits were hit and released so far (0 for null or a
+// case without limits): `cdyn run` lists these events in `summary.json`'s
+// `limits`.
+//
+// # Safety
+// `sim` is null or a live simulation.
+size_t cdyn_limit_events(const struct CdynSimulation *sim);
+
 // Length of the full state: `2n + 1` (positions, velocities, ∫Ė); 0 for null.
 //
 // # Safety

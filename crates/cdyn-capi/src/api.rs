@@ -283,6 +283,18 @@ pub unsafe extern "C" fn cdyn_get_outputs(sim: *mut CdynSimulation, values: *mut
     })
 }
 
+/// How many joint limits were hit and released so far (0 for null or a
+/// case without limits): `cdyn run` lists these events in `summary.json`'s
+/// `limits`.
+///
+/// # Safety
+/// `sim` is null or a live simulation.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn cdyn_limit_events(sim: *const CdynSimulation) -> usize {
+    // SAFETY: the caller's contract.
+    unsafe { sim.as_ref() }.map_or(0, |s| s.live.limit_events())
+}
+
 /// `len` doubles at `values`, which must be `expected`.
 ///
 /// # Safety

@@ -173,3 +173,36 @@ fn an_actuators_input_set_through_the_c_api_moves_the_arm_as_the_same_constant_t
     assert!(outputs(driven)[q] > 0.0 && outputs(idle)[q] < -0.1, "{} {}", outputs(driven)[q], outputs(idle)[q]);
     unsafe { (cdyn_free(driven), cdyn_free(constant), cdyn_free(idle)) };
 }
+
+/// `examples/limited_pendulum.toml` through the C API: the rows `cdyn run`
+/// writes to the bit, its limit held (one impact, counted by
+/// `cdyn_limit_events`), and a state saved before the impact and restored
+/// after it repeating the run to the bit.
+#[test]
+fn a_case_with_joint_limits_runs_as_cdyn_run_runs_it_and_restores_across_its_impact() {
+    let text = include_str!("../../../examples/limited_pendulum.toml");
+    let (parsed, _) = cdyn_cli::case::scenario::parse(text, "<string>").unwrap();
+    let case = parsed.case(std::path::Path::new("<string>")).unwrap();
+    let (_, rows) = cdyn_cli::case::runner::run_case_in_memory(&case, &|| false);
+    let sim = create(text).unwrap();
+    let bits = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let mut saved = null_mut();
+    for (k, row) in rows.values.chunks(rows.columns.len()).enumerate() {
+        assert_eq!(bits(&outputs(sim)), bits(row), "sample {k}");
+        if k == 30 {
+            assert_eq!(unsafe { cdyn_save_state(sim, &mut saved) }, CdynStatus::Ok);
+        }
+        assert_eq!(unsafe { cdyn_step(sim, 10) }, CdynStatus::Ok);
+    }
+    assert_eq!(unsafe { cdyn_limit_events(sim) }, 1);
+    assert_eq!(unsafe { cdyn_restore_state(sim, saved) }, CdynStatus::Ok);
+    assert_eq!(unsafe { cdyn_limit_events(sim) }, 0);
+    for (k, row) in rows.values.chunks(rows.columns.len()).enumerate().skip(30).take(20) {
+        assert_eq!(bits(&outputs(sim)), bits(row), "sample {k} after the restore");
+        assert_eq!(unsafe { cdyn_step(sim, 10) }, CdynStatus::Ok);
+    }
+    assert_eq!(unsafe { cdyn_limit_events(sim) }, 1);
+    assert_eq!(unsafe { cdyn_limit_events(std::ptr::null()) }, 0);
+    unsafe { cdyn_free_state(saved) };
+    unsafe { cdyn_free(sim) };
+}

@@ -205,3 +205,34 @@ fn a_communication_step_allocates_nothing() {
     }
     assert!((outputs[0] - 0.5).abs() < 1e-12);
 }
+
+/// `examples/limited_pendulum.toml` as an FMU: its joint limit held as
+/// `cdyn run` holds it (the angle each communication step equals the
+/// CSV's to the bit), and a communication step allocates nothing but the
+/// one with the impact at t = 0.335 s, which builds the model holding the
+/// limit.
+#[test]
+fn a_limited_case_steps_as_cdyn_run_runs_it_allocating_only_at_its_impact() {
+    let text = include_str!("../../../examples/limited_pendulum.toml");
+    let (_, _, _, variables) = cdyn_cli::export::variables::load(text, std::path::Path::new("x.toml")).unwrap();
+    let vr = |name: &str| variables.iter().position(|v| v.name == name).unwrap() as u32;
+    let (parsed, _) = cdyn_cli::case::scenario::parse(text, "x").unwrap();
+    let case = parsed.case(std::path::Path::new("x")).unwrap();
+    let (_, rows) = cdyn_cli::case::runner::run_case_in_memory(&case, &|| false);
+    let angle = rows.columns.iter().position(|c| c == "joints[0].q").unwrap();
+    let (_dir, uri) = resources(text);
+    let fmu = instantiate(&uri, &guid(text));
+    fmu.start();
+    let mut allocating = Vec::new();
+    for (k, row) in rows.values.chunks(rows.columns.len()).enumerate().skip(1) {
+        let before = thread_allocations();
+        assert_eq!(unsafe { fmi2DoStep(fmu.c, (k - 1) as f64 * 0.01, 0.01, 1) }, OK);
+        let q = fmu.get(vr("joints[0].q"));
+        if thread_allocations() != before {
+            allocating.push(k);
+        }
+        assert_eq!(q.to_bits(), row[angle].to_bits(), "joints[0].q at communication step {k}");
+    }
+    assert_eq!(allocating, [34], "the impact's step, to t = 0.34 s");
+    assert!((fmu.get(vr("joints[0].q")) + 0.9).abs() < 1e-9);
+}

@@ -102,6 +102,13 @@ impl Simulation {
         self.live.set_state(q, v, e).map_err(|e| crate::Error::new_err(e.to_string()))
     }
 
+    /// What the case's joint limits did so far, as `summary.json`'s
+    /// `limits` (JSON text); `None` without limits.
+    fn limits_json(&self) -> PyResult<Option<String>> {
+        let report = self.live.limits();
+        report.map(|r| serde_json::to_string(&r).map_err(|e| crate::Error::new_err(e.to_string()))).transpose()
+    }
+
     /// Everything needed to come back to this point of the run.
     fn snapshot(&self) -> SimulationState {
         SimulationState { snapshot: self.live.snapshot() }

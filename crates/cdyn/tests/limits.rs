@@ -11,7 +11,7 @@
 //! joint), and the rod is held at 0.3 rad from then on.
 
 use cdyn::spatial::{Body, Joint, JointKind, JointLimit, Mechanism};
-use cdyn::stops::{Change, Event, run_with_stops};
+use cdyn::stops::{Change, Event, MechanismStops, run_with_stops};
 use cdyn::{Control, Scheme, Settings};
 
 const G: f64 = 9.81;
@@ -50,10 +50,18 @@ fn run(scheme: Scheme, h: f64, limit: JointLimit, t_end: f64) -> (Vec<Event>, Ve
     let built = mechanism.build().unwrap();
     let settings = Settings::new(scheme, h, Control::robust());
     let mut samples = Vec::new();
-    let events = run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, t_end, 1, |t, q, v| {
-        samples.push((t, mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()));
-        Ok(())
-    })
+    let events = run_with_stops::<_, cdyn::Error>(
+        &MechanismStops::new(mechanism.clone()).unwrap(),
+        settings,
+        &built.q0,
+        &built.v0,
+        t_end,
+        1,
+        |t, q, v| {
+            samples.push((t, mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()));
+            Ok(())
+        },
+    )
     .unwrap();
     (events.events, samples)
 }
@@ -104,9 +112,16 @@ fn a_range_shorter_than_a_turn_is_told_apart_through_pi() {
     let mechanism = pendulum_at(phi0, JointLimit::new(lower, 0.1));
     let built = mechanism.build().unwrap();
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
-    let report =
-        run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 3.0, 100, |_, _, _| Ok(()))
-            .unwrap();
+    let report = run_with_stops::<_, cdyn::Error>(
+        &MechanismStops::new(mechanism).unwrap(),
+        settings,
+        &built.q0,
+        &built.v0,
+        3.0,
+        100,
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
     let (t_star, rate) = (
         cdyn::reference::time_to_swing(k(), phi0, phi0 + lower).unwrap(),
         (2.0 * k() * ((phi0 + lower).cos() - phi0.cos())).sqrt(),
@@ -180,10 +195,18 @@ fn a_stop_pulled_away_from_is_released() {
         .v0;
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
     let mut theta = Vec::new();
-    let report = run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 1.0, 1, |_, q, v| {
-        theta.push(mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()[0]);
-        Ok(())
-    })
+    let report = run_with_stops::<_, cdyn::Error>(
+        &MechanismStops::new(mechanism.clone()).unwrap(),
+        settings,
+        &built.q0,
+        &built.v0,
+        1.0,
+        1,
+        |_, q, v| {
+            theta.push(mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()[0]);
+            Ok(())
+        },
+    )
     .unwrap();
     let events = report.events;
     let kinds: Vec<_> = events.iter().map(|e| matches!(e.change, Change::Impact { .. })).collect();
@@ -237,13 +260,20 @@ fn stops_a_mimic_reaches_with_its_leader_are_held_by_one_row() {
         let mechanism = mimic_pair(k_limit);
         let built = mechanism.build().unwrap();
         let mut joints = Vec::new();
-        let report =
-            run_with_stops::<_, cdyn::Error>(&mechanism, settings, &built.q0, &built.v0, 1.0, 10, |_, q, v| {
+        let report = run_with_stops::<_, cdyn::Error>(
+            &MechanismStops::new(mechanism.clone()).unwrap(),
+            settings,
+            &built.q0,
+            &built.v0,
+            1.0,
+            10,
+            |_, q, v| {
                 let theta = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?;
                 joints.push([theta[0].unwrap()[0], theta[1].unwrap()[0]]);
                 Ok(())
-            })
-            .unwrap();
+            },
+        )
+        .unwrap();
         (report.events, joints)
     };
     let (events, joints) = run(true);

@@ -438,10 +438,11 @@ fn a_urdf_limit_stops_its_joint_and_holds_it() {
     // The effort bound is the actuator's clamp, not an unmodelled element.
     assert!(robot.notes.iter().all(|n| !n.contains("effort")), "{:?}", robot.notes);
     let (mechanism, built) = (&robot.mechanism, robot.mechanism.build().unwrap());
+    let stops = cdyn::stops::MechanismStops::new(mechanism.clone()).unwrap();
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, methods::robust());
     let mut last = [0.0; 3];
     let report =
-        cdyn::stops::run_with_stops::<_, Error>(mechanism, settings, &built.q0, &built.v0, 1.0, 100, |_, q, v| {
+        cdyn::stops::run_with_stops::<_, Error>(&stops, settings, &built.q0, &built.v0, 1.0, 100, |_, q, v| {
             last = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap();
             Ok(())
         })

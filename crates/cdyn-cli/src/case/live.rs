@@ -8,31 +8,54 @@
 //!
 //! Each [`Live`] owns its case, and so its model and the values of the
 //! model's inputs: two of them never share an input.
+//!
+//! A case with joint limits is stepped as `cdyn run` steps it, by the
+//! library's [`StopSimulation`]: the limits are hit, held and released
+//! between steps, a snapshot saves the limits held and the segment's model
+//! with the state, and the models it builds at a hit or a release share the
+//! case's inputs. A step that hits or releases no limit allocates nothing;
+//! one that does builds the model of the limits held then, and allocates.
 
 use crate::case::inputs::selected;
+use crate::case::runner::limits::LimitsReport;
 use crate::case::runner::{Case, columns, row_values};
 use crate::case::scenario::Scenario;
 use anyhow::{Result, anyhow};
 use cdyn::Simulation;
+use cdyn::models::Example;
 use cdyn::record::Sample;
 use cdyn::simulate::Snapshot;
+use cdyn::stops::{StopSimulation, StopSnapshot, Unilateral};
 use std::path::Path;
 use std::sync::Arc;
 
 /// A case being stepped.
 pub struct Live {
-    // Declared first, so dropped first: `sim` borrows the model in `case`.
-    sim: Simulation<'static>,
+    // Declared first, so dropped first: `run` borrows the model in `case`.
+    run: Run,
     outputs: Outputs,
     case: Arc<Case>,
+}
+
+/// What a [`Live`] steps: the case's model, or its joint limits' run.
+enum Run {
+    // Both boxed: kilobytes each, of different sizes.
+    Free(Box<Simulation<'static>>),
+    Limited(Box<StopSimulation<Arc<dyn Unilateral + Send + Sync>>>),
 }
 
 /// A saved [`Live`]: it keeps the case alive, so it stays valid after the
 /// `Live` it was taken of is gone, and restores only into that one.
 #[derive(Clone)]
 pub struct LiveSnapshot {
-    snapshot: Snapshot<'static>,
+    snapshot: Saved,
     _case: Arc<Case>,
+}
+
+#[derive(Clone)]
+enum Saved {
+    Free(Snapshot<'static>),
+    Limited(StopSnapshot),
 }
 
 /// The selected columns and the buffers their values are computed in.
@@ -57,12 +80,6 @@ impl Live {
     /// `case` started at its initial state, with the outputs `select` names
     /// (every column without it); `file` names the scenario in errors.
     pub fn new(case: Case, select: Option<&[String]>, file: &str) -> Result<Self> {
-        if let Some(limits) = &case.limits {
-            return Err(anyhow!(
-                "{file}: joint {}: limit: joint limits are held by cdyn run (and cdyn.run), not yet by a case stepped from outside (cdyn.Simulation, the C API, the FMU)",
-                limits.first_joint()
-            ));
-        }
         let all = columns(&case.example);
         let selected = selected(select, &all, file)?;
         let case = Arc::new(case);
@@ -72,7 +89,12 @@ impl Live {
         // of them, and no reference with the made-up lifetime leaves here.
         let model: &'static cdyn::Model = unsafe { &*std::ptr::from_ref(&case.example.model) };
         let ex = &case.example;
-        let sim = Simulation::new(model, case.settings, &ex.q0, &ex.v0).map_err(|e| anyhow!("{file}: {e}"))?;
+        let run = match &case.limits {
+            Some(limits) => StopSimulation::new(Arc::clone(&limits.system), case.settings, &ex.q0, &ex.v0)
+                .map(|run| Run::Limited(Box::new(run))),
+            None => Simulation::new(model, case.settings, &ex.q0, &ex.v0).map(|sim| Run::Free(Box::new(sim))),
+        };
+        let run = run.map_err(|e| anyhow!("{file}: {e}"))?;
         let (n, observables) = (model.n(), ex.observables.len());
         let outputs = Outputs {
             names: selected.iter().map(|&i| all[i].clone()).collect(),
@@ -81,7 +103,7 @@ impl Live {
             observed: vec![0.0; observables],
             reference: (vec![0.0; n], vec![0.0; n], vec![0.0; observables]),
         };
-        let mut live = Live { sim, outputs, case };
+        let mut live = Live { run, outputs, case };
         live.warm_up().map_err(|e| anyhow!("{file}: {e}"))?;
         Ok(live)
     }
@@ -94,12 +116,12 @@ impl Live {
     /// (the median step: 1.1 µs). A step that fails here fails again when
     /// taken.
     fn warm_up(&mut self) -> cdyn::Result<()> {
-        let start = self.sim.snapshot();
+        let start = self.snapshot();
         let mut outputs = vec![0.0; self.outputs.names.len()];
-        if self.sim.step().is_ok() {
+        if self.step(1).is_ok() {
             self.outputs(&mut outputs);
         }
-        self.sim.restore(&start)
+        self.restore(&start)
     }
 
     /// The case stepped.
@@ -107,47 +129,91 @@ impl Live {
         &self.case
     }
 
+    /// Lends the simulation being stepped (of the current segment, with limits) to `f`.
+    fn simulation<R>(&self, f: impl FnOnce(&Simulation<'_>) -> R) -> R {
+        match &self.run {
+            Run::Free(sim) => f(sim),
+            Run::Limited(run) => run.simulation(f),
+        }
+    }
+
+    /// Lends the simulation being stepped to `f`, mutably.
+    fn simulation_mut<R>(&mut self, f: impl FnOnce(&mut Simulation<'_>) -> R) -> R {
+        match &mut self.run {
+            Run::Free(sim) => f(sim),
+            Run::Limited(run) => run.simulation_mut(f),
+        }
+    }
+
     /// Current time.
     pub fn t(&self) -> f64 {
-        self.sim.t()
+        self.simulation(|sim| sim.t())
     }
 
     /// Steps taken.
     pub fn steps(&self) -> u64 {
-        self.sim.steps()
+        self.simulation(|sim| sim.steps())
     }
 
     /// The step size.
     pub fn h(&self) -> f64 {
-        self.sim.settings().h
+        self.simulation(|sim| sim.settings().h)
     }
 
     /// Current positions.
     pub fn q(&self) -> &[f64] {
-        self.sim.q()
+        match &self.run {
+            Run::Free(sim) => sim.q(),
+            Run::Limited(run) => run.q(),
+        }
     }
 
     /// Current velocities.
     pub fn v(&self) -> &[f64] {
-        self.sim.v()
+        match &self.run {
+            Run::Free(sim) => sim.v(),
+            Run::Limited(run) => run.v(),
+        }
     }
 
-    /// `∫Ė` so far: with `q` and `v`, the full state.
+    /// `∫Ė` so far: with `q` and `v`, the full state. With joint limits,
+    /// since the last hit or release (where the energy reference starts
+    /// afresh, see [`cdyn::stops`]).
     pub fn energy_input(&self) -> f64 {
-        self.sim.energy_input()
+        self.simulation(|sim| sim.energy_input())
     }
 
     /// The current value of input `index`.
     pub fn input(&self, index: usize) -> cdyn::Result<f64> {
-        self.sim.input(index)
+        self.simulation(|sim| sim.input(index))
     }
 
     /// Takes `n` steps; stops at the first that fails.
     pub fn step(&mut self, n: u64) -> cdyn::Result<()> {
         for _ in 0..n {
-            self.sim.step()?;
+            match &mut self.run {
+                Run::Free(sim) => sim.step()?,
+                Run::Limited(run) => run.step()?,
+            }
         }
         Ok(())
+    }
+
+    /// What the case's joint limits did so far (the report `cdyn run`
+    /// writes to `summary.json`'s `limits`), if it has limits.
+    pub fn limits(&self) -> Option<LimitsReport> {
+        match (&self.run, &self.case.limits) {
+            (Run::Limited(run), Some(limits)) => Some(limits.report(run.report())),
+            _ => None,
+        }
+    }
+
+    /// How many limits were hit and released so far (0 without limits).
+    pub fn limit_events(&self) -> usize {
+        match &self.run {
+            Run::Limited(run) => run.report().events.len(),
+            Run::Free(_) => 0,
+        }
     }
 
     /// The inputs' names, in order.
@@ -157,12 +223,12 @@ impl Live {
 
     /// Sets input `index` (see [`Simulation::set_input`]).
     pub fn set_input(&mut self, index: usize, value: f64) -> cdyn::Result<()> {
-        self.sim.set_input(index, value)
+        self.simulation_mut(|sim| sim.set_input(index, value))
     }
 
     /// Sets the input called `name`.
     pub fn set_input_named(&mut self, name: &str, value: f64) -> cdyn::Result<()> {
-        self.sim.set_input_named(name, value)
+        self.simulation_mut(|sim| sim.set_input_named(name, value))
     }
 
     /// The outputs' names, in order.
@@ -172,33 +238,56 @@ impl Live {
 
     /// The outputs at the current state, into `out` (as many as names).
     pub fn outputs(&mut self, out: &mut [f64]) {
-        let (sim, o, ex) = (&mut self.sim, &mut self.outputs, &self.case.example);
-        let measures = sim.measure();
-        let t = sim.t();
-        (ex.observe)(t, sim.q(), sim.v(), &mut o.observed);
-        let (qr, vr, at_ref) = &mut o.reference;
-        let first = o.observed.first().copied().unwrap_or(0.0);
-        let error = ex.error_of(first, t, qr, vr, at_ref);
-        let sample = Sample { step: sim.steps(), t, observables: &o.observed, measures, error };
-        o.row.clear();
-        o.row.extend(row_values(&sample));
-        for (out, &i) in out.iter_mut().zip(&o.selected) {
-            *out = o.row[i];
+        let (o, ex) = (&mut self.outputs, &self.case.example);
+        match &mut self.run {
+            Run::Free(sim) => o.read(sim, ex, out),
+            Run::Limited(run) => run.simulation_mut(|sim| o.read(sim, ex, out)),
         }
     }
 
-    /// Puts the state at `(q, v, ∫Ė)` (see [`Simulation::set_state`]).
+    /// Puts the state at `(q, v, ∫Ė)` (see [`Simulation::set_state`]; with
+    /// joint limits, [`StopSimulation::set_state`]: a limit passed there is
+    /// an error, a held one the state is away from is let go).
     pub fn set_state(&mut self, q: &[f64], v: &[f64], e: f64) -> cdyn::Result<()> {
-        self.sim.set_state(q, v, e)
+        match &mut self.run {
+            Run::Free(sim) => sim.set_state(q, v, e),
+            Run::Limited(run) => run.set_state(q, v, e),
+        }
     }
 
     /// Everything needed to come back to this point.
     pub fn snapshot(&self) -> LiveSnapshot {
-        LiveSnapshot { snapshot: self.sim.snapshot(), _case: Arc::clone(&self.case) }
+        let snapshot = match &self.run {
+            Run::Free(sim) => Saved::Free(sim.snapshot()),
+            Run::Limited(run) => Saved::Limited(run.snapshot()),
+        };
+        LiveSnapshot { snapshot, _case: Arc::clone(&self.case) }
     }
 
     /// Goes back to `snapshot`, taken of this `Live`.
     pub fn restore(&mut self, snapshot: &LiveSnapshot) -> cdyn::Result<()> {
-        self.sim.restore(&snapshot.snapshot)
+        match (&mut self.run, &snapshot.snapshot) {
+            (Run::Free(sim), Saved::Free(saved)) => sim.restore(saved),
+            (Run::Limited(run), Saved::Limited(saved)) => run.restore(saved),
+            _ => Err(cdyn::Error::Unsupported("a snapshot restores the simulation it was taken of")),
+        }
+    }
+}
+
+impl Outputs {
+    /// The selected outputs of `sim`'s current state, computed as a CSV row is, into `out`.
+    fn read(&mut self, sim: &mut Simulation<'_>, ex: &Example, out: &mut [f64]) {
+        let measures = sim.measure();
+        let t = sim.t();
+        (ex.observe)(t, sim.q(), sim.v(), &mut self.observed);
+        let (qr, vr, at_ref) = &mut self.reference;
+        let first = self.observed.first().copied().unwrap_or(0.0);
+        let error = ex.error_of(first, t, qr, vr, at_ref);
+        let sample = Sample { step: sim.steps(), t, observables: &self.observed, measures, error };
+        self.row.clear();
+        self.row.extend(row_values(&sample));
+        for (out, &i) in out.iter_mut().zip(&self.selected) {
+            *out = self.row[i];
+        }
     }
 }

@@ -26,9 +26,7 @@ impl<'m> Simulation<'m> {
             return Err(Error::Unsupported("a snapshot restores a simulation of the model it was taken of"));
         }
         self.clone_from(&snapshot.simulation);
-        for (u, &value) in self.model().inputs().iter().zip(&snapshot.inputs) {
-            u.set(value);
-        }
+        snapshot.set_inputs();
         Ok(())
     }
 }
@@ -47,9 +45,22 @@ impl Simulation<'_> {
     }
 }
 
-impl Snapshot<'_> {
+impl<'m> Snapshot<'m> {
     /// Steps taken when it was taken.
     pub fn steps(&self) -> u64 {
         self.simulation.steps()
+    }
+
+    /// The simulation it saved, its model's inputs set back: to go back to
+    /// it from a simulation of another model ([`crate::stops`]).
+    pub(crate) fn resume(&self) -> Simulation<'m> {
+        self.set_inputs();
+        self.simulation.clone()
+    }
+
+    fn set_inputs(&self) {
+        for (u, &value) in self.simulation.model().inputs().iter().zip(&self.inputs) {
+            u.set(value);
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! its joint's coordinate can meet, their bounds and their gaps at a state
 //! (the rows holding them are `StopRow`s, built by `build_holding`).
 
-use super::joint::{Joint, JointKind};
+use super::joint::JointKind;
 use super::mechanism::Mechanism;
 use crate::error::Result;
 use crate::limit::{JointLimit, Stop};
@@ -50,13 +50,21 @@ impl Mechanism {
             .iter()
             .map(|&s| {
                 let [x, rate, _] = theta[s.joint].expect("a stop's joint has a coordinate");
-                let x = match self.joints[s.joint] {
-                    Joint { kind: JointKind::Revolute, limit: Some(l), .. } if l.within_a_turn() => l.unwrap_angle(x),
-                    _ => x,
-                };
-                self.limit(s).gap(s.upper, x, rate)
+                self.stop_gap(s, x, rate)
             })
             .collect())
+    }
+
+    /// The gap and its rate of `stop` where its joint's coordinate is `θ`
+    /// (as [`Mechanism::joint_coordinates`] reads it) moving at `θ̇`: an
+    /// angle in a range shorter than a turn taken as the range's.
+    pub fn stop_gap(&self, stop: Stop, theta: f64, rate: f64) -> [f64; 2] {
+        let limit = self.limit(stop);
+        let theta = match self.joints[stop.joint].kind {
+            JointKind::Revolute if limit.within_a_turn() => limit.unwrap_angle(theta),
+            _ => theta,
+        };
+        limit.gap(stop.upper, theta, rate)
     }
 }
 

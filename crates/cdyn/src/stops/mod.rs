@@ -30,9 +30,12 @@
 //! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`, `planar`.
 
 mod planar;
+mod snapshot;
 mod spatial;
 mod stepping;
 mod unilateral;
 
+pub use snapshot::StopSnapshot;
+pub use spatial::MechanismStops;
 pub use stepping::{START_SLACK, StopSimulation, run_with_stops};
 pub use unilateral::{Change, Event, Report, Unilateral};

@@ -17,8 +17,11 @@ impl Unilateral for Mechanism {
         Ok(self.build_holding(&held)?.model)
     }
 
-    fn gaps(&self, q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>> {
-        Mechanism::gaps(self, &Mechanism::stops(self), q, v)
+    /// Allocates (the planar mechanism reads each joint's coordinate
+    /// afresh), unlike the spatial [`MechanismStops`](super::MechanismStops).
+    fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()> {
+        gaps.copy_from_slice(&Mechanism::gaps(self, &Mechanism::stops(self), q, v)?);
+        Ok(())
     }
 
     fn restitution(&self, stop: usize) -> f64 {
@@ -26,16 +29,19 @@ impl Unilateral for Mechanism {
     }
 
     /// Joints (by element index) faster than their limit's `velocity`.
-    fn overspeed(&self, q: &[f64], v: &[f64]) -> Result<Vec<(usize, f64)>> {
+    fn speed_bounds(&self) -> usize {
+        self.elements.iter().filter(|e| e.limit().is_some_and(|l| l.velocity.is_finite())).count()
+    }
+
+    fn overspeed(&self, q: &[f64], v: &[f64], exceeded: &mut dyn FnMut(usize, f64)) -> Result<()> {
         let bounded = self.elements.iter().enumerate().filter_map(|(k, e)| Some((k, e.limit()?.velocity)));
-        let mut out = Vec::new();
         for (k, bound) in bounded.filter(|(_, bound)| bound.is_finite()) {
             let ratio = self.joint_coordinate(k, q, v)?[1].abs() / bound;
             if ratio > 1.0 {
-                out.push((k, ratio));
+                exceeded(k, ratio);
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     fn name(&self, stop: usize) -> String {

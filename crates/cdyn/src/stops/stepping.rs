@@ -4,6 +4,12 @@
 //! segment — the model of the stops held and the [`Simulation`] of it —
 //! and after each step hits, holds and releases stops as the module's
 //! head says, starting the next segment where the last one ended.
+//!
+//! A step that hits and releases nothing allocates nothing (with a system
+//! whose [`Unilateral::gaps`] and [`Unilateral::overspeed`] do not): the
+//! gaps, the stops hit and the report's velocity entries live in buffers
+//! kept here. A hit or a release builds the model of the stops held then,
+//! and allocates.
 
 use super::unilateral::{Change, Event, Report, Unilateral};
 use crate::dynamics::assemble::assemble;
@@ -11,58 +17,60 @@ use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Error, Part, Problem, Result};
 use crate::model::Model;
 use crate::simulate::{Settings, Simulation, steps_to};
+use std::ops::Deref;
 use std::sync::Arc;
 
 /// A [`Simulation`] of a system with stops, stepped by the caller; the
 /// stops are hit, held and released between steps.
 ///
+/// `S` holds the system: borrowed (`&U`), or shared (`Arc<U>`) by a run
+/// that must own what it steps.
+///
 /// The simulation of the current segment is lent out by
 /// [`StopSimulation::simulation`] and [`StopSimulation::simulation_mut`]
 /// (to sample it, say); its state is the run's state.
-pub struct StopSimulation<'u, U: Unilateral + ?Sized> {
+pub struct StopSimulation<S: Deref<Target: Unilateral>> {
     // Declared before `model`, so dropped before it: it borrows the model.
-    sim: Simulation<'static>,
-    model: Arc<Model>,
-    system: &'u U,
-    settings: Settings,
+    pub(super) sim: Simulation<'static>,
+    pub(super) model: Arc<Model>,
+    pub(super) system: S,
+    pub(super) settings: Settings,
     /// The stops held, in the order of the model's last rows.
-    held: Vec<usize>,
+    pub(super) held: Vec<usize>,
     /// Stops at their bound that the held rows already hold, so not rows
     /// of their own (see [`StopSimulation::split_implied`]); not hit again
     /// until a release changes what is held.
-    implied: Vec<usize>,
+    pub(super) implied: Vec<usize>,
     /// Each stop's `(g, ġ)` at the start of the step being taken.
-    before: Vec<[f64; 2]>,
+    pub(super) before: Vec<[f64; 2]>,
+    /// Each stop's `(g, ġ)` at the end of the step just taken.
+    after: Vec<[f64; 2]>,
+    /// The stops the step just taken closed.
+    hits: Vec<usize>,
     /// Evaluates the multipliers of the held stops' rows.
-    dynamics: Dynamics,
-    report: Report,
+    pub(super) dynamics: Dynamics,
+    pub(super) report: Report,
 }
 
-impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
+impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     /// Starts `system` at `t = 0` from `(q0, v0)` (no stop passed), no
     /// stop held, as [`Simulation::new`] starts a model.
-    pub fn new(system: &'u U, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
-        let before = system.gaps(q0, v0)?;
-        for (k, [g, _]) in before.iter().enumerate() {
-            if *g < -START_SLACK {
-                let reason = format!("{} is passed by {:.3e} at the start", system.name(k), -g);
-                return Err(Problem::Stop { reason }.at(Part::InitialState));
-            }
+    pub fn new(system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
+        let mut before = vec![[0.0; 2]; system.stops()];
+        system.gaps(q0, v0, &mut before)?;
+        if let Some((k, g)) = passed(&before, |_| false) {
+            let reason = format!("{} is passed by {:.3e} at the start", system.name(k), -g);
+            return Err(Problem::Stop { reason }.at(Part::InitialState));
         }
         let model = Arc::new(system.model_holding(&[])?);
         let sim = start(&model, settings, q0, v0)?;
         let dynamics = Dynamics::new(&model);
-        Ok(Self {
-            sim,
-            model,
-            system,
-            settings,
-            held: Vec::new(),
-            implied: Vec::new(),
-            before,
-            dynamics,
-            report: Report::default(),
-        })
+        let (after, hits) = (before.clone(), Vec::with_capacity(before.len()));
+        let mut report = Report::default();
+        // A velocity bound first exceeded in an ordinary step finds its place.
+        report.overspeed.reserve_exact(system.speed_bounds());
+        let (held, implied) = (Vec::with_capacity(before.len()), Vec::with_capacity(before.len()));
+        Ok(Self { sim, model, system, settings, held, implied, before, after, hits, dynamics, report })
     }
 
     /// One step of size `h`, then the stops: those it closed are hit (the
@@ -72,25 +80,28 @@ impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
         self.sim.step()?;
         let (step, t) = (self.sim.steps(), self.sim.t());
         let (q, v) = (self.sim.q(), self.sim.v());
-        let gaps = self.system.gaps(q, v)?;
-        for (index, ratio) in self.system.overspeed(q, v)? {
-            let overspeed = &mut self.report.overspeed;
-            match overspeed.binary_search_by_key(&index, |o| o.0) {
-                Ok(k) => overspeed[k].1 = overspeed[k].1.max(ratio),
-                Err(k) => overspeed.insert(k, (index, ratio, t)),
-            }
-        }
-        let hits: Vec<usize> = (0..gaps.len())
-            .filter(|k| !self.held.contains(k) && !self.implied.contains(k) && gaps[*k][0] < -START_SLACK)
-            .collect();
-        if !hits.is_empty() {
-            return self.impact(&hits, &gaps, step, t);
+        self.system.gaps(q, v, &mut self.after)?;
+        let overspeed = &mut self.report.overspeed;
+        self.system.overspeed(q, v, &mut |index, ratio| match overspeed.binary_search_by_key(&index, |o| o.0) {
+            Ok(k) => overspeed[k].1 = overspeed[k].1.max(ratio),
+            Err(k) => overspeed.insert(k, (index, ratio, t)),
+        })?;
+        let (held, implied, after) = (&self.held, &self.implied, &self.after);
+        self.hits.clear();
+        self.hits.extend(
+            (0..after.len()).filter(|k| !held.contains(k) && !implied.contains(k) && after[*k][0] < -START_SLACK),
+        );
+        if !self.hits.is_empty() {
+            let (hits, gaps) = (std::mem::take(&mut self.hits), std::mem::take(&mut self.after));
+            let result = self.impact(&hits, &gaps, step, t);
+            (self.hits, self.after) = (hits, gaps);
+            return result;
         }
         if !self.held.is_empty() && self.release(step, t)? {
             let (q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
             return self.restart(&q, &v, true);
         }
-        self.before = gaps;
+        std::mem::swap(&mut self.before, &mut self.after);
         Ok(())
     }
 
@@ -109,7 +120,8 @@ impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
         assemble(&impact, &mut q, &mut plastic, t, ASSEMBLY_TOLERANCE)?;
         let mut free = v;
         assemble(&self.model, &mut q.clone(), &mut free, t, ASSEMBLY_TOLERANCE)?;
-        let rates = self.system.gaps(&q, &free)?;
+        let mut rates = vec![[0.0; 2]; gaps.len()];
+        self.system.gaps(&q, &free, &mut rates)?;
         // A stop whose gap is opening again at the stop crossed and turned
         // within the step (a graze): its position is put back, and the
         // impact is of the stops still closing. Held on the sign of ġ
@@ -213,7 +225,7 @@ impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
     /// Starts the next segment at `(q, v)`, with the model of the stops
     /// held now if they changed: the scheme afresh, the energy reference
     /// the energy there (see the module's head).
-    fn restart(&mut self, q: &[f64], v: &[f64], held_changed: bool) -> Result<()> {
+    pub(super) fn restart(&mut self, q: &[f64], v: &[f64], held_changed: bool) -> Result<()> {
         let model =
             if held_changed { Arc::new(self.system.model_holding(&self.held)?) } else { Arc::clone(&self.model) };
         // The run's state need not meet the start's tolerance: it is the
@@ -227,8 +239,7 @@ impl<'u, U: Unilateral + ?Sized> StopSimulation<'u, U> {
             self.dynamics = Dynamics::new(&model);
         }
         self.model = model;
-        self.before = self.system.gaps(q, v)?;
-        Ok(())
+        self.system.gaps(q, v, &mut self.before)
     }
 
     /// Lends the current segment's simulation to `f`: the run's state,
@@ -306,6 +317,12 @@ pub fn run_with_stops<U: Unilateral + ?Sized, E: From<Error>>(
         }
     }
     Ok(run.into_report())
+}
+
+/// The first stop passed (`g < −START_SLACK`) among those `gaps` that
+/// `held` does not exempt, and its gap.
+pub(super) fn passed(gaps: &[[f64; 2]], held: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
+    gaps.iter().enumerate().map(|(k, [g, _])| (k, *g)).find(|&(k, g)| g < -START_SLACK && !held(k))
 }
 
 /// A simulation of the model in `model`'s allocation.

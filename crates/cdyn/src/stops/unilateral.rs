@@ -5,22 +5,33 @@ use crate::error::Result;
 use crate::model::Model;
 
 /// A system with stops, for [`run_with_stops`](super::run_with_stops).
+///
+/// [`gaps`](Self::gaps) and [`overspeed`](Self::overspeed) are read after
+/// every step, so they write into the caller's buffers: an implementation
+/// that allocates nothing there keeps an ordinary step allocation-free.
 pub trait Unilateral {
     /// How many stops it has.
     fn stops(&self) -> usize;
     /// Its model with the stops `held` (indices, in this order) as its last
     /// rows, each `g = 0`.
     fn model_holding(&self, held: &[usize]) -> Result<Model>;
-    /// Each stop's gap `g` (`≥ 0` allowed) and its rate `ġ` at `(q, v)`.
-    fn gaps(&self, q: &[f64], v: &[f64]) -> Result<Vec<[f64; 2]>>;
+    /// Each stop's gap `g` (`≥ 0` allowed) and its rate `ġ` at `(q, v)`,
+    /// into `gaps` (one entry per stop).
+    fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()>;
     /// Newton's coefficient of restitution of a stop.
     fn restitution(&self, stop: usize) -> f64;
     /// How messages name a stop (`"joint 2's upper limit"`).
     fn name(&self, stop: usize) -> String;
-    /// The coordinates moving faster than their velocity bound at `(q, v)`:
-    /// `(index, |rate| / bound)` with the ratio above 1. Reported, not enforced.
-    fn overspeed(&self, _q: &[f64], _v: &[f64]) -> Result<Vec<(usize, f64)>> {
-        Ok(Vec::new())
+    /// How many coordinates have a velocity bound: the most entries
+    /// [`Report::overspeed`] can hold.
+    fn speed_bounds(&self) -> usize {
+        0
+    }
+    /// Calls `exceeded(index, |rate| / bound)` for each coordinate moving
+    /// faster than its velocity bound at `(q, v)` (the ratio above 1).
+    /// Reported, not enforced.
+    fn overspeed(&self, _q: &[f64], _v: &[f64], _exceeded: &mut dyn FnMut(usize, f64)) -> Result<()> {
+        Ok(())
     }
 }
 

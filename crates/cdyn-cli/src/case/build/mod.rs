@@ -168,7 +168,8 @@ impl Scenario {
             }
         }
         if let Some(limits) = &limits {
-            let gaps = limits.system.gaps(&example.q0, &example.v0).map_err(|e| anyhow!("{file}: [initial]: {e}"))?;
+            let mut gaps = vec![[0.0; 2]; limits.stops.len()];
+            limits.system.gaps(&example.q0, &example.v0, &mut gaps).map_err(|e| anyhow!("{file}: [initial]: {e}"))?;
             if let Some((stop, [g, _])) =
                 limits.stops.iter().zip(gaps).find(|(_, [g, _])| *g < -cdyn::stops::START_SLACK)
             {

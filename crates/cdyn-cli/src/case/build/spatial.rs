@@ -9,6 +9,7 @@ use crate::case::scenario::{GravitySpec, InitialSpec, Scenario};
 use anyhow::{Result, anyhow, bail};
 use cdyn::error::Part;
 use cdyn::models::Example;
+use cdyn::stops::MechanismStops;
 use std::sync::Arc;
 
 impl Scenario {
@@ -45,7 +46,7 @@ impl Scenario {
                 .map(|a| mechanism.joints[a.joint].limit.map_or(f64::INFINITY, |l| l.effort))
                 .collect(),
         });
-        let limits = spatial_limits(mechanism, |k| counts.joint_name(k));
+        let limits = spatial_limits(mechanism, |k| counts.joint_name(k)).map_err(|e| anyhow!("{file}: {e}"))?;
         let notes = counts.notes;
         Ok(Described { example, rows, notes, force_entries: forces, limits, joint_columns })
     }
@@ -86,14 +87,15 @@ impl InitialSpec {
 
 /// The limits of a spatial mechanism's joints, if any has one (a stop, or
 /// a velocity bound to report), its joints named by `name`.
-fn spatial_limits(mechanism: cdyn::spatial::Mechanism, name: impl Fn(usize) -> String) -> Option<Limits> {
-    mechanism.joints.iter().any(|j| j.limit.is_some()).then(|| {
-        let stops = mechanism
-            .stops()
-            .into_iter()
-            .map(|stop| StopName { joint: name(stop.joint), upper: stop.upper, bound: mechanism.stop_bound(stop).0 })
-            .collect();
-        let joints = (0..mechanism.joints.len()).map(name).collect();
-        Limits { system: Arc::new(mechanism), stops, joints }
-    })
+fn spatial_limits(mechanism: cdyn::spatial::Mechanism, name: impl Fn(usize) -> String) -> cdyn::Result<Option<Limits>> {
+    if mechanism.joints.iter().all(|j| j.limit.is_none()) {
+        return Ok(None);
+    }
+    let stops = mechanism
+        .stops()
+        .into_iter()
+        .map(|stop| StopName { joint: name(stop.joint), upper: stop.upper, bound: mechanism.stop_bound(stop).0 })
+        .collect();
+    let joints = (0..mechanism.joints.len()).map(name).collect();
+    Ok(Some(Limits { system: Arc::new(MechanismStops::new(mechanism)?), stops, joints }))
 }

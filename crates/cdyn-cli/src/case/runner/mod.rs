@@ -219,7 +219,7 @@ impl<S: System> Stepped for Stepper<S> {
     }
 }
 
-impl<U: cdyn::stops::Unilateral + ?Sized> Stepped for StopSimulation<'_, U> {
+impl<U: std::ops::Deref<Target: cdyn::stops::Unilateral>> Stepped for StopSimulation<U> {
     fn step(&mut self) -> cdyn::Result<()> {
         StopSimulation::step(self)
     }
