@@ -47,23 +47,36 @@ fn stop_time() -> f64 {
 /// Runs the pendulum to `t_end`, returning the events and the joint's `(θ, θ̇)` at each sample.
 fn run(scheme: Scheme, h: f64, limit: JointLimit, t_end: f64) -> (Vec<Event>, Vec<(f64, [f64; 3])>) {
     let mechanism = pendulum(limit);
+    let (events, samples) = run_mechanism(&mechanism, scheme, h, None, t_end, 1);
+    (events, samples.into_iter().map(|(t, joints)| (t, joints[0])).collect())
+}
+
+/// `(t, each joint's (θ, θ̇, θ̈))` at each sample.
+type Samples = Vec<(f64, Vec<[f64; 3]>)>;
+
+/// Runs `mechanism` with its stops (`robust`) from its built state, its
+/// velocities `v0` where given, to `t_end`; returns the events and, every
+/// `every` steps, `(t, each joint's (θ, θ̇, θ̈ = 0))`.
+fn run_mechanism(
+    mechanism: &Mechanism,
+    scheme: Scheme,
+    h: f64,
+    v0: Option<&[f64]>,
+    t_end: f64,
+    every: u64,
+) -> (Vec<Event>, Samples) {
     let built = mechanism.build().unwrap();
     let settings = Settings::new(scheme, h, Control::robust());
+    let system = MechanismStops::new(mechanism.clone()).unwrap();
     let mut samples = Vec::new();
-    let events = run_with_stops::<_, cdyn::Error>(
-        &MechanismStops::new(mechanism.clone()).unwrap(),
-        settings,
-        &built.q0,
-        &built.v0,
-        t_end,
-        1,
-        |t, q, v| {
-            samples.push((t, mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()));
-            Ok(())
-        },
-    )
+    let v0 = v0.unwrap_or(&built.v0);
+    let report = run_with_stops::<_, cdyn::Error>(&system, settings, &built.q0, v0, t_end, every, |t, q, v| {
+        let joints = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?;
+        samples.push((t, joints.into_iter().map(Option::unwrap).collect()));
+        Ok(())
+    })
     .unwrap();
-    (events.events, samples)
+    (report.events, samples)
 }
 
 #[test]
@@ -110,18 +123,7 @@ fn a_range_shorter_than_a_turn_is_told_apart_through_pi() {
     // pulls the rod back off the stop: released the step after.
     let (phi0, lower) = (3.0, -5.9);
     let mechanism = pendulum_at(phi0, JointLimit::new(lower, 0.1));
-    let built = mechanism.build().unwrap();
-    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
-    let report = run_with_stops::<_, cdyn::Error>(
-        &MechanismStops::new(mechanism).unwrap(),
-        settings,
-        &built.q0,
-        &built.v0,
-        3.0,
-        100,
-        |_, _, _| Ok(()),
-    )
-    .unwrap();
+    let (events, _) = run_mechanism(&mechanism, Scheme::RungeKutta4, 1e-3, None, 3.0, 100);
     let (t_star, rate) = (
         cdyn::reference::time_to_swing(k(), phi0, phi0 + lower).unwrap(),
         (2.0 * k() * ((phi0 + lower).cos() - phi0.cos())).sqrt(),
@@ -129,9 +131,9 @@ fn a_range_shorter_than_a_turn_is_told_apart_through_pi() {
     let [
         Event { stop: 0, step, t, change: Change::Impact { rate: hit, held: true, .. }, .. },
         Event { stop: 0, step: released, change: Change::Release { .. }, .. },
-    ] = report.events[..]
+    ] = events[..]
     else {
-        panic!("{:?}", report.events)
+        panic!("{events:?}")
     };
     assert_eq!(released, step + 1);
     assert!((t - t_star).abs() < 1e-6, "stopped at {t}, by hand {t_star}");
@@ -193,22 +195,8 @@ fn a_stop_pulled_away_from_is_released() {
         .build()
         .unwrap()
         .v0;
-    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
-    let mut theta = Vec::new();
-    let report = run_with_stops::<_, cdyn::Error>(
-        &MechanismStops::new(mechanism.clone()).unwrap(),
-        settings,
-        &built.q0,
-        &built.v0,
-        1.0,
-        1,
-        |_, q, v| {
-            theta.push(mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap()[0]);
-            Ok(())
-        },
-    )
-    .unwrap();
-    let events = report.events;
+    let (events, samples) = run_mechanism(&mechanism, Scheme::RungeKutta4, 1e-3, Some(&built.v0), 1.0, 1);
+    let theta: Vec<f64> = samples.iter().map(|(_, joints)| joints[0][0]).collect();
     let kinds: Vec<_> = events.iter().map(|e| matches!(e.change, Change::Impact { .. })).collect();
     assert_eq!(kinds[..2], [true, false], "{events:?}");
     assert_eq!(events[1].step, events[0].step + 1);
@@ -255,26 +243,9 @@ fn stops_a_mimic_reaches_with_its_leader_are_held_by_one_row() {
     // j's angle, its bound 0.15 at the same instant: the two stops' rows
     // and the mimic row are dependent, so one row holds both. The run is
     // the one with k's limit left out, to round-off.
-    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
     let run = |k_limit: bool| {
-        let mechanism = mimic_pair(k_limit);
-        let built = mechanism.build().unwrap();
-        let mut joints = Vec::new();
-        let report = run_with_stops::<_, cdyn::Error>(
-            &MechanismStops::new(mechanism.clone()).unwrap(),
-            settings,
-            &built.q0,
-            &built.v0,
-            1.0,
-            10,
-            |_, q, v| {
-                let theta = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?;
-                joints.push([theta[0].unwrap()[0], theta[1].unwrap()[0]]);
-                Ok(())
-            },
-        )
-        .unwrap();
-        (report.events, joints)
+        let (events, samples) = run_mechanism(&mimic_pair(k_limit), Scheme::RungeKutta4, 1e-3, None, 1.0, 10);
+        (events, samples.into_iter().map(|(_, j)| [j[0][0], j[1][0]]).collect::<Vec<_>>())
     };
     let (events, joints) = run(true);
     let (alone, reduced) = run(false);
