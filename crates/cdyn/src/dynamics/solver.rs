@@ -98,7 +98,7 @@ impl Blocks {
             plain,
             segments,
             entries,
-            schur: Schur::new(pattern, &weights, solver),
+            schur: Schur::new_for_blocks(pattern, &weights, solver),
         }
     }
 

@@ -128,6 +128,17 @@ impl Dynamics {
         }
     }
 
+    /// Whether `Φ_q M⁻¹ Φ_qᵀ` is factored along a sparse pattern (fewer
+    /// entries of `L` than the full triangle), as [`LinearSolver::Auto`]
+    /// chooses for chains and trees.
+    pub fn sparse_factor(&self) -> bool {
+        match &self.solver {
+            Solver::Constant(schur) => schur.is_sparse(),
+            Solver::General(_) => false,
+            Solver::Blocks(b) => b.schur.is_sparse(),
+        }
+    }
+
     /// Constraint rows the last evaluation dropped as dependent (0 unless tolerated).
     pub fn dependent_rows(&self) -> usize {
         match &self.solver {

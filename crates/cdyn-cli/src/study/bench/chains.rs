@@ -111,7 +111,7 @@ pub(super) fn timed_chain(
         model.constraint_values(sim.q(), sim.t(), &mut phi);
         worst = phi.iter().fold(worst, |a, p| a.max(p.abs()));
     }
-    let solver = if model.m() >= cdyn::dynamics::SPARSE_FROM { "sparse" } else { "dense" };
+    let solver = if cdyn::dynamics::Dynamics::new(model).sparse_factor() { "sparse" } else { "dense" };
     Ok(ChainRun {
         n,
         steps,
