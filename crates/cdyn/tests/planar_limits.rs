@@ -17,7 +17,7 @@ use cdyn::limit::JointLimit;
 use cdyn::model::timefn::TimeFn;
 use cdyn::planar::{BodyId, Element, Mechanism};
 use cdyn::reference::time_to_swing;
-use cdyn::stops::{Change, Event, run_with_stops};
+use cdyn::stops::{Change, Event, PlanarStops, run_with_stops};
 use cdyn::{Control, Scheme, Settings};
 
 const G: f64 = 9.81;
@@ -48,7 +48,8 @@ fn run(m: &Mechanism, scheme: Scheme, h: f64, t_end: f64) -> (Vec<Event>, Vec<[f
     let built = m.build().unwrap();
     let settings = Settings::new(scheme, h, Control::robust());
     let mut samples = Vec::new();
-    let report = run_with_stops::<_, cdyn::Error>(m, settings, &built.q0, &built.v0, t_end, 1, |t, q, v| {
+    let stops = PlanarStops::new(m.clone()).unwrap();
+    let report = run_with_stops::<_, cdyn::Error>(&stops, settings, &built.q0, &built.v0, t_end, 1, |t, q, v| {
         let [theta, rate] = m.joint_coordinate(0, q, v)?;
         samples.push([t, theta, rate]);
         Ok(())

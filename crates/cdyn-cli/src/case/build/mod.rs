@@ -277,7 +277,8 @@ impl Scenario {
                 let built = mechanism.build();
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
-                let limits = self.planar_limits(mechanism);
+                let limits =
+                    self.planar_limits(mechanism).map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 Ok(Described { rows, limits, ..Described::plain(Example::from_mechanism(built, None)) })
             }
             Kind::Spatial => self.spatial_example(file),
