@@ -40,5 +40,5 @@ mod unilateral;
 pub use planar::PlanarStops;
 pub use snapshot::StopSnapshot;
 pub use spatial::MechanismStops;
-pub use stepping::{START_SLACK, StopSimulation, run_with_stops};
+pub use stepping::{START_SLACK, StopSimulation, check_start, run_with_stops};
 pub use unilateral::{Change, Event, Report, Unilateral};

@@ -2,7 +2,7 @@
 //! finite side of a revolute or prismatic joint's limit
 //! ([`Mechanism::stops`]), read at every step without allocating.
 
-use super::reads::{LimitReads, side_name};
+use super::reads::LimitReads;
 use super::unilateral::Unilateral;
 use crate::error::{Problem, Result};
 use crate::limit::JointLimit;
@@ -77,8 +77,13 @@ impl Unilateral for PlanarStops {
         self.reads.overspeed(q, v, |i| self.space.at(i, q, v)[1], exceeded)
     }
 
-    fn name(&self, stop: usize) -> String {
+    fn joint(&self, stop: usize) -> String {
+        let element = self.reads.stop(stop).joint;
+        format!("element {element} ({})", self.mechanism.elements[element].kind())
+    }
+
+    fn side(&self, stop: usize) -> (bool, f64) {
         let stop = self.reads.stop(stop);
-        side_name(&format!("element {} ({})", stop.joint, self.mechanism.elements[stop.joint].kind()), stop)
+        (stop.upper, self.mechanism.stop_bound(stop).0)
     }
 }

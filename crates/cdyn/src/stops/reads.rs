@@ -103,8 +103,3 @@ impl LimitReads {
         Ok(())
     }
 }
-
-/// How messages name one side of a joint's limit: `"{joint}'s upper limit"`.
-pub(super) fn side_name(joint: &str, stop: Stop) -> String {
-    format!("{joint}'s {} limit", if stop.upper { "upper" } else { "lower" })
-}

@@ -2,7 +2,7 @@
 //! finite side of a limit its joint can meet ([`Mechanism::stops`]), read
 //! at every step without allocating.
 
-use super::reads::{LimitReads, side_name};
+use super::reads::LimitReads;
 use super::unilateral::Unilateral;
 use crate::error::{Problem, Result};
 use crate::model::Model;
@@ -76,8 +76,12 @@ impl Unilateral for MechanismStops {
         self.reads.overspeed(q, v, |i| self.at(i, q, v)[1], exceeded)
     }
 
-    fn name(&self, stop: usize) -> String {
+    fn joint(&self, stop: usize) -> String {
+        format!("joint {}", self.reads.stop(stop).joint)
+    }
+
+    fn side(&self, stop: usize) -> (bool, f64) {
         let stop = self.reads.stop(stop);
-        side_name(&format!("joint {}", stop.joint), stop)
+        (stop.upper, self.mechanism.stop_bound(stop).0)
     }
 }
