@@ -335,3 +335,54 @@ fn bad_planar_limits_get_one_line_naming_the_file_and_the_joint() {
     let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
     assert!(line.contains("bad.toml") && line.contains("joints[1]") && line.contains("limit"), "{line}");
 }
+
+/// A rod on a revolute joint about y whose built pose points straight up
+/// (its joint's `θ = φ − π`, `φ` from hanging), limited to `[2, 4.5]`: a
+/// range shorter than a turn that straddles π. Released at rest at
+/// `θ = 2.5`, it swings down through `θ = π` (hanging) to `2π − 2.5` and
+/// back, inside its range, meeting no stop.
+#[test]
+fn a_rods_angle_in_a_range_across_pi_is_reported_in_that_range_without_a_jump() {
+    let text = format!(
+        r#"
+[model]
+kind = "spatial"
+gravity = [0.0, 0.0, -{G}]
+
+[integrator]
+scheme = "rk4"
+h = {H}
+t_end = 1.0
+
+[initial]
+joints = {{ "joints[0]" = 2.5 }}
+
+[[bodies]]
+name = "rod"
+mass = {M}
+inertia = [0.02, {JYY}, 0.005]
+position = [0.0, 0.0, {L}]
+orientation = [0.0, 0.0, 1.0, 0.0]
+
+[[joints]]
+kind = "revolute"
+a = "rod"
+b = "ground"
+point = [0.0, 0.0, 0.0]
+axis = [0.0, 1.0, 0.0]
+limit = {{ lower = 2.0, upper = 4.5 }}
+"#
+    );
+    let (stdout, (header, rows), case) = run(&text, &[]);
+    assert!(stdout.contains("limits: 0 impacts, 0 releases"), "{stdout}");
+    let q = column(&header, "joints[0].q");
+    let (low, high) = rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), r| (l.min(r[q]), h.max(r[q])));
+    // Energy kept: it turns back at 2π − 2.5, sampled within ½ θ̈ (h/2)² of it.
+    assert!((low - 2.5).abs() < 1e-5 && (high - (std::f64::consts::TAU - 2.5)).abs() < 1e-5, "{low} … {high}");
+    // Through π at most |θ̇| h = 2.74e-3 a step (√(2k (1 − cos(π − 2.5))), k = m g L / I).
+    let jump = rows.windows(2).map(|w| (w[1][q] - w[0][q]).abs()).fold(0.0, f64::max);
+    assert!(jump < 2.8e-3, "the angle jumps by {jump}");
+    let reported = case["joint_space"]["joints"].as_array().unwrap();
+    let stats = reported.iter().find(|c| c["column"] == "joints[0].q").unwrap();
+    assert_eq!((stats["min"].as_f64(), stats["max"].as_f64()), (Some(low), Some(high)), "{stats}");
+}

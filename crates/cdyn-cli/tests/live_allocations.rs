@@ -7,7 +7,9 @@
 //! and with actuators (their torques among the outputs) on `examples/arm_pd.toml`,
 //! both with arm.urdf's joint limits held; and the rod of
 //! `examples/limited_pendulum.toml` falling onto its limit and held there,
-//! every step but the impact's.
+//! every step but the impact's; and the same of planar mechanisms: the
+//! block of `examples/limited_slider.toml` (a prismatic joint's limit) and
+//! a planar rod swinging onto a revolute joint's limit.
 
 use cdyn_cli::case::live::Live;
 use cdyn_cli::case::scenario;
@@ -55,8 +57,12 @@ fn a_cosimulation_step_allocates_nothing() {
 
 fn example(name: &str) -> Live {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name);
-    let (parsed, _) = scenario::parse(&std::fs::read_to_string(&path).unwrap(), name).unwrap();
-    Live::from_scenario(&parsed, &path).unwrap()
+    live_of(&std::fs::read_to_string(&path).unwrap(), &path)
+}
+
+fn live_of(text: &str, path: &Path) -> Live {
+    let (parsed, _) = scenario::parse(text, &path.display().to_string()).unwrap();
+    Live::from_scenario(&parsed, path).unwrap()
 }
 
 /// Periods of ten steps, each followed by reading every output: no
@@ -104,4 +110,51 @@ fn a_limited_pendulums_steps_allocate_nothing_but_at_its_impact() {
     let mut live = example("limited_pendulum.toml");
     assert_eq!(steps_and_outputs_allocate_nothing(&mut live, 100), 1);
     assert_eq!(live.limits().unwrap().velocity_exceeded.len(), 1);
+}
+
+#[test]
+fn a_limited_planar_slider_steps_allocate_nothing_but_at_its_impact() {
+    // Free until its impact at t = 0.412 s (its velocity bound of 1.5 m/s
+    // exceeded on the way), then held to t = 1 s.
+    let mut live = example("limited_slider.toml");
+    assert_eq!(steps_and_outputs_allocate_nothing(&mut live, 100), 1);
+    let limits = live.limits().unwrap();
+    assert_eq!((limits.events.len(), limits.velocity_exceeded.len()), (1, 1));
+    assert!((limits.events[0].t.0 - 0.41243).abs() < 1e-3, "{}", limits.events[0].t.0);
+}
+
+#[test]
+fn a_limited_planar_rods_steps_allocate_nothing_but_at_its_impact() {
+    // A rigid rod on a revolute joint to the ground, released at 1.2 rad
+    // from hanging, swings down onto its lower limit of 0.3 rad (a relative
+    // angle, read by dual numbers at every step) and is held there.
+    let text = r#"
+[model]
+kind = "mechanism"
+gravity = [0.0, -9.81]
+
+[integrator]
+scheme = "rk4"
+h = 1e-3
+t_end = 1.0
+
+[[bodies]]
+name = "rod"
+mass = 2.0
+inertia = 0.02
+position = [0.46601954298361314, -0.1811788772383368]
+angle = 1.2
+
+[[joints]]
+kind = "revolute"
+a = "ground"
+b = "rod"
+point_b = [0.0, 0.5]
+limit = { lower = 0.3, velocity = 2.0 }
+"#;
+    let mut live = live_of(text, Path::new("limited_rod.toml"));
+    assert_eq!(steps_and_outputs_allocate_nothing(&mut live, 100), 1);
+    let limits = live.limits().unwrap();
+    assert_eq!((limits.events.len(), limits.velocity_exceeded.len()), (1, 1));
+    assert_eq!((limits.events[0].event, limits.events[0].side), ("impact", "lower"));
 }

@@ -13,11 +13,12 @@
 //! the line at `t* = √(2d / (g sin α))` with rate `g sin α t*`.
 
 use cdyn::dynamics::Dynamics;
+use cdyn::error::{Part, Problem};
 use cdyn::limit::JointLimit;
 use cdyn::model::timefn::TimeFn;
 use cdyn::planar::{BodyId, Element, Mechanism};
 use cdyn::reference::time_to_swing;
-use cdyn::stops::{Change, Event, run_with_stops};
+use cdyn::stops::{Change, Event, PlanarStops, StopSimulation, check_start, run_with_stops};
 use cdyn::{Control, Scheme, Settings};
 
 const G: f64 = 9.81;
@@ -48,7 +49,8 @@ fn run(m: &Mechanism, scheme: Scheme, h: f64, t_end: f64) -> (Vec<Event>, Vec<[f
     let built = m.build().unwrap();
     let settings = Settings::new(scheme, h, Control::robust());
     let mut samples = Vec::new();
-    let report = run_with_stops::<_, cdyn::Error>(m, settings, &built.q0, &built.v0, t_end, 1, |t, q, v| {
+    let stops = PlanarStops::new(m.clone()).unwrap();
+    let report = run_with_stops::<_, cdyn::Error>(&stops, settings, &built.q0, &built.v0, t_end, 1, |t, q, v| {
         let [theta, rate] = m.joint_coordinate(0, q, v)?;
         samples.push([t, theta, rate]);
         Ok(())
@@ -212,4 +214,31 @@ fn bad_limits_are_refused_naming_the_joint() {
     });
     let e = m.build().err().expect("refused").to_string();
     assert!(e.contains("element 0 (revolute)") && e.contains("body bob is a point mass"), "{e}");
+}
+
+#[test]
+fn a_start_past_a_limit_is_refused_naming_the_joint_the_side_the_bound_and_the_distance() {
+    // The rod at 0.2 rad, its lower bound at 0.3: 0.1 past it.
+    let m = rod(0.2, JointLimit::new(PHI_STOP, f64::INFINITY), vec![]);
+    let built = m.build().unwrap();
+    let stops = PlanarStops::new(m).unwrap();
+    let refused = check_start(&stops, &built.q0, &built.v0).unwrap_err();
+    let cdyn::Error::InvalidModel {
+        at: Part::InitialState,
+        problem: Problem::StartsPastLimit { stop, joint, upper, bound, by },
+    } = refused.clone()
+    else {
+        panic!("{refused:?}")
+    };
+    assert_eq!((stop, joint.as_str(), upper, bound), (0, "element 0 (revolute)", false, PHI_STOP));
+    assert!((by - 0.1).abs() < 1e-15, "{by}");
+    let says = "invalid model: initial state: element 0 (revolute): starts 1.000e-1 past its lower limit 0.3";
+    assert_eq!(refused.to_string(), says);
+    // The run refuses it with the same error; at the bound it starts.
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+    let Err(e) = StopSimulation::new(&stops, settings, &built.q0, &built.v0) else { panic!("started past its limit") };
+    assert_eq!(e, refused);
+    let at_bound = rod(PHI_STOP, JointLimit::new(PHI_STOP, f64::INFINITY), vec![]);
+    let built = at_bound.build().unwrap();
+    assert_eq!(check_start(&PlanarStops::new(at_bound).unwrap(), &built.q0, &built.v0), Ok(()));
 }

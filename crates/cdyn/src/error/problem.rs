@@ -83,6 +83,21 @@ pub enum Problem {
         /// Which stop and why.
         reason: String,
     },
+    /// A joint that starts past one side of its limit: a run with stops
+    /// starts within them.
+    #[error("{joint}: starts {by:.3e} past its {} limit {bound}", if *upper { "upper" } else { "lower" })]
+    StartsPastLimit {
+        /// Which stop (its index among the system's).
+        stop: usize,
+        /// The joint, as the system names it (`joint 2`, `element 0 (revolute)`).
+        joint: String,
+        /// The upper bound (else the lower).
+        upper: bool,
+        /// The bound.
+        bound: f64,
+        /// How far past it (`> 0`).
+        by: f64,
+    },
     /// A joint limit whose bounds are not numbers or not ordered.
     #[error("limit lower = {lower}, upper = {upper}: {reason}")]
     BadLimit {

@@ -17,6 +17,7 @@
 mod body;
 mod build;
 mod constraints;
+mod coordinate;
 mod drawing;
 mod element;
 mod ends;
@@ -30,6 +31,7 @@ mod mechanism;
 
 pub use body::{Body, BodyId, GROUND};
 pub use build::Built;
+pub use coordinate::JointSpace;
 pub use drawing::{Anchor, Drawing, Link, Shape};
 pub use element::{Coordinate, Element, Group};
 pub use inputs::{Driven, input_keys};

@@ -4,13 +4,15 @@
 //! along a prismatic joint's axis, both from the initial pose (where the
 //! mechanism is assembled, `θ = 0`). It is what a `<mimic>` coupling ties
 //! ([`Mimic`]), what a joint limit's stop holds ([`StopRow`]) and what joint-space output reports
-//! ([`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates));
+//! ([`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates),
+//! an angle in a limit's range shorter than a turn taken as that range's);
 //! written once, generic over the scalar, so that its rate and
 //! acceleration come by dual numbers.
 
 use super::body::SpatialBody;
 use super::joint_rows::{F, Frame, G, H, Place, Side, dot, pose};
 use crate::ad::scalar::Scalar;
+use crate::limit::JointLimit;
 use crate::model::constraint::Constraint;
 use num_dual::Dual2_64;
 
@@ -99,20 +101,29 @@ pub struct JointSpace {
     read: Vec<Readable>,
 }
 
-/// One joint that has a coordinate: its index, its coordinate and its bodies.
+/// One joint that has a coordinate: its index, its coordinate, its bodies
+/// and, for a revolute joint whose limit is shorter than a turn, that
+/// limit, the range its angle is reported in.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Readable {
     joint: usize,
     coordinate: JointCoordinate,
     a: usize,
     b: Option<usize>,
+    range: Option<JointLimit>,
 }
 
 impl JointSpace {
-    /// From `(joint index, its coordinate, body a, body b)` for each joint that has one.
-    pub(super) fn new(read: impl IntoIterator<Item = (usize, JointCoordinate, usize, Option<usize>)>) -> Self {
-        let read = read.into_iter().map(|(joint, coordinate, a, b)| Readable { joint, coordinate, a, b }).collect();
-        Self { read }
+    /// From `(joint index, its coordinate, body a, body b, its limit)` for
+    /// each joint that has one.
+    pub(super) fn new(
+        read: impl IntoIterator<Item = (usize, JointCoordinate, usize, Option<usize>, Option<JointLimit>)>,
+    ) -> Self {
+        let read = read.into_iter().map(|(joint, coordinate, a, b, limit)| {
+            let range = limit.filter(|l| coordinate.rotary && l.within_a_turn());
+            Readable { joint, coordinate, a, b, range }
+        });
+        Self { read: read.collect() }
     }
 
     /// The index in [`Mechanism::joints`](super::Mechanism::joints) of each joint read, in order.
@@ -122,13 +133,15 @@ impl JointSpace {
 
     /// `(θ, θ̇, θ̈)` of the `i`-th joint read at the state `(q, v)` with
     /// accelerations `a` (all of the mechanism's length; see
-    /// [`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates)).
+    /// [`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates)
+    /// for the range an angle is in).
     /// Panics if `i` is not below [`JointSpace::joints`]' count or a slice is short.
     pub fn at(&self, i: usize, q: &[f64], v: &[f64], a: &[f64]) -> [f64; 3] {
         let r = &self.read[i];
         let body = |k: usize| SpatialBody::of(if k < 7 { r.a } else { r.b.unwrap_or(r.a) }).first + k % 7;
         let x: [Dual2_64; 14] = std::array::from_fn(|k| Dual2_64::new(q[body(k)], v[body(k)], a[body(k)]));
         let theta = r.coordinate.at(&x, [Some(0), r.b.map(|_| 1)], Dual2_64::from(0.0));
-        [theta.re, theta.v1, theta.v2]
+        let angle = r.range.map_or(theta.re, |range| range.unwrap_angle(theta.re));
+        [angle, theta.v1, theta.v2]
     }
 }

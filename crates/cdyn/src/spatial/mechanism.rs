@@ -286,10 +286,14 @@ impl Mechanism {
 
     /// The coordinate `θ` of every revolute and prismatic joint (`None` for
     /// the others) at the state `(q, v)` with accelerations `a`: `(θ, θ̇, θ̈)`,
-    /// the angle of `a` relative to `b` about the axis (in `(−π, π]`) or
-    /// the displacement along it, from the initial pose, as URDF counts
-    /// them. One place for joint-space output and for tests against
-    /// joint-space dynamics.
+    /// the angle of `a` relative to `b` about the axis or the displacement
+    /// along it, from the initial pose, as URDF counts them. An angle is
+    /// in `(−π, π]`, but for a joint whose limit is shorter than a turn,
+    /// in that range (or past its nearer bound: `[lower, lower + 2π)`
+    /// split halfway between the bounds; Panda's joint 6 turns from −0.0175
+    /// to 3.75 rad), as its stops read it. One place for joint-space output
+    /// (the CSV, `summary.json`, the C API, the FMU, Python), for the stops
+    /// and for tests against joint-space dynamics.
     pub fn joint_coordinates(&self, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Option<[f64; 3]>>> {
         let n = 7 * self.bodies.len();
         if q.len() != n || v.len() != n || a.len() != n {
@@ -310,7 +314,7 @@ impl Mechanism {
         let poses = self.poses()?;
         let read = (0..self.joints.len()).filter_map(|k| {
             let c = self.coordinate(k, &poses).ok()?;
-            Some((k, c, self.joints[k].a, self.joints[k].b))
+            Some((k, c, self.joints[k].a, self.joints[k].b, self.joints[k].limit))
         });
         Ok(JointSpace::new(read))
     }

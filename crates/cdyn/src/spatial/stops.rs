@@ -56,15 +56,10 @@ impl Mechanism {
     }
 
     /// The gap and its rate of `stop` where its joint's coordinate is `θ`
-    /// (as [`Mechanism::joint_coordinates`] reads it) moving at `θ̇`: an
-    /// angle in a range shorter than a turn taken as the range's.
+    /// (as [`Mechanism::joint_coordinates`] reads it: an angle in a range
+    /// shorter than a turn taken as the range's) moving at `θ̇`.
     pub fn stop_gap(&self, stop: Stop, theta: f64, rate: f64) -> [f64; 2] {
-        let limit = self.limit(stop);
-        let theta = match self.joints[stop.joint].kind {
-            JointKind::Revolute if limit.within_a_turn() => limit.unwrap_angle(theta),
-            _ => theta,
-        };
-        limit.gap(stop.upper, theta, rate)
+        self.limit(stop).gap(stop.upper, theta, rate)
     }
 }
 

@@ -1,6 +1,7 @@
 //! One-sided constraints: stops that hold a coordinate on one side
 //! (`g(q) ≥ 0`), joint limits being the first (of spatial and planar
-//! mechanisms, each a [`Unilateral`] system). A stop is a row of the
+//! mechanisms: [`MechanismStops`], [`PlanarStops`], each a [`Unilateral`]
+//! system read at every step without allocating). A stop is a row of the
 //! model only while it holds: the run steps the model of the stops held,
 //! and between two steps
 //!
@@ -27,15 +28,17 @@
 //! which the projection removes), and the crossing time the event reports
 //! is the root of the cubic through `(g, ġ)` at the step's two ends.
 //!
-//! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`, `planar`.
+//! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`, `planar`, `limit`.
 
 mod planar;
+mod reads;
 mod snapshot;
 mod spatial;
 mod stepping;
 mod unilateral;
 
+pub use planar::PlanarStops;
 pub use snapshot::StopSnapshot;
 pub use spatial::MechanismStops;
-pub use stepping::{START_SLACK, StopSimulation, run_with_stops};
+pub use stepping::{START_SLACK, StopSimulation, check_start, run_with_stops};
 pub use unilateral::{Change, Event, Report, Unilateral};

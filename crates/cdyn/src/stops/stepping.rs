@@ -58,10 +58,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     pub fn new(system: S, settings: Settings, q0: &[f64], v0: &[f64]) -> Result<Self> {
         let mut before = vec![[0.0; 2]; system.stops()];
         system.gaps(q0, v0, &mut before)?;
-        if let Some((k, g)) = passed(&before, |_| false) {
-            let reason = format!("{} is passed by {:.3e} at the start", system.name(k), -g);
-            return Err(Problem::Stop { reason }.at(Part::InitialState));
-        }
+        refuse_passed(&*system, &before)?;
         let model = Arc::new(system.model_holding(&[])?);
         let sim = start(&model, settings, q0, v0)?;
         let dynamics = Dynamics::new(&model);
@@ -317,6 +314,24 @@ pub fn run_with_stops<U: Unilateral + ?Sized, E: From<Error>>(
         }
     }
     Ok(run.into_report())
+}
+
+/// Refuses `(q0, v0)` as a start of `system` if it is past a stop (by more
+/// than [`START_SLACK`]): [`Problem::StartsPastLimit`], naming the first
+/// such stop's joint, side and bound and how far past it the state is.
+/// [`StopSimulation::new`] refuses such a start; this tells it beforehand.
+pub fn check_start<U: Unilateral + ?Sized>(system: &U, q0: &[f64], v0: &[f64]) -> Result<()> {
+    let mut gaps = vec![[0.0; 2]; system.stops()];
+    system.gaps(q0, v0, &mut gaps)?;
+    refuse_passed(system, &gaps)
+}
+
+/// [`check_start`] of the stops' `gaps` at the start.
+fn refuse_passed<U: Unilateral + ?Sized>(system: &U, gaps: &[[f64; 2]]) -> Result<()> {
+    let Some((stop, g)) = passed(gaps, |_| false) else { return Ok(()) };
+    let (upper, bound) = system.side(stop);
+    let joint = system.joint(stop);
+    Err(Problem::StartsPastLimit { stop, joint, upper, bound, by: -g }.at(Part::InitialState))
 }
 
 /// The first stop passed (`g < −START_SLACK`) among those `gaps` that

@@ -20,8 +20,14 @@ pub trait Unilateral {
     fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()>;
     /// Newton's coefficient of restitution of a stop.
     fn restitution(&self, stop: usize) -> f64;
+    /// How messages name a stop's joint (`"joint 2"`).
+    fn joint(&self, stop: usize) -> String;
+    /// Which side of its joint's limit a stop is (`true`: the upper) and its bound.
+    fn side(&self, stop: usize) -> (bool, f64);
     /// How messages name a stop (`"joint 2's upper limit"`).
-    fn name(&self, stop: usize) -> String;
+    fn name(&self, stop: usize) -> String {
+        format!("{}'s {} limit", self.joint(stop), if self.side(stop).0 { "upper" } else { "lower" })
+    }
     /// How many coordinates have a velocity bound: the most entries
     /// [`Report::overspeed`] can hold.
     fn speed_bounds(&self) -> usize {

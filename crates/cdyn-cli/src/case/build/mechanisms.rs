@@ -9,6 +9,7 @@ use anyhow::{Result, anyhow, bail};
 use cdyn::error::Part;
 use cdyn::planar::{Element, Group, Mechanism};
 use cdyn::spatial::{Actuator, JointKind};
+use cdyn::stops::PlanarStops;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -110,24 +111,25 @@ impl Scenario {
 
     /// The joint limits of a planar mechanism of the entries, if any joint
     /// has one: its stops and joints named as `joints[k]`.
-    pub(super) fn planar_limits(&self, mechanism: Mechanism) -> Option<Limits> {
-        mechanism.elements.iter().any(|e| e.limit().is_some()).then(|| {
-            let names: Vec<String> = self
-                .element_lists()
-                .into_iter()
-                .flat_map(|(group, list)| (0..list.len()).map(move |i| format!("{}[{i}]", group.name())))
-                .collect();
-            let stops = mechanism
-                .stops()
-                .into_iter()
-                .map(|stop| StopName {
-                    joint: names[stop.joint].clone(),
-                    upper: stop.upper,
-                    bound: mechanism.stop_bound(stop).0,
-                })
-                .collect();
-            Limits { system: Arc::new(mechanism), stops, joints: names }
-        })
+    pub(super) fn planar_limits(&self, mechanism: Mechanism) -> cdyn::Result<Option<Limits>> {
+        if mechanism.elements.iter().all(|e| e.limit().is_none()) {
+            return Ok(None);
+        }
+        let names: Vec<String> = self
+            .element_lists()
+            .into_iter()
+            .flat_map(|(group, list)| (0..list.len()).map(move |i| format!("{}[{i}]", group.name())))
+            .collect();
+        let stops = mechanism
+            .stops()
+            .into_iter()
+            .map(|stop| StopName {
+                joint: names[stop.joint].clone(),
+                upper: stop.upper,
+                bound: mechanism.stop_bound(stop).0,
+            })
+            .collect();
+        Ok(Some(Limits { system: Arc::new(PlanarStops::new(mechanism)?), stops, joints: names }))
     }
 }
 

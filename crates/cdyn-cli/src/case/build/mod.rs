@@ -168,19 +168,7 @@ impl Scenario {
             }
         }
         if let Some(limits) = &limits {
-            let mut gaps = vec![[0.0; 2]; limits.stops.len()];
-            limits.system.gaps(&example.q0, &example.v0, &mut gaps).map_err(|e| anyhow!("{file}: [initial]: {e}"))?;
-            if let Some((stop, [g, _])) =
-                limits.stops.iter().zip(gaps).find(|(_, [g, _])| *g < -cdyn::stops::START_SLACK)
-            {
-                let side = if stop.upper { "upper" } else { "lower" };
-                bail!(
-                    "{file}: joint {}: starts {:.3e} past its {side} limit {} (limits hold a joint within its range from the start)",
-                    stop.joint,
-                    -g,
-                    stop.bound
-                );
-            }
+            limits.check_start(&example.q0, &example.v0).map_err(|e| anyhow!("{file}: {e}"))?;
         }
         if !self.inputs.is_empty() && !matches!(self.model.kind, Kind::Mechanism | Kind::Spatial) {
             bail!(
@@ -277,7 +265,8 @@ impl Scenario {
                 let built = mechanism.build();
                 let built = built.map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 let rows = built.row_elements.iter().map(|&k| entries[k].clone()).collect();
-                let limits = self.planar_limits(mechanism);
+                let limits =
+                    self.planar_limits(mechanism).map_err(|e| anyhow!("{file}: {}", name_entry(e, &entries)))?;
                 Ok(Described { rows, limits, ..Described::plain(Example::from_mechanism(built, None)) })
             }
             Kind::Spatial => self.spatial_example(file),

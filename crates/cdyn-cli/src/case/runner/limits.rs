@@ -2,6 +2,7 @@
 //! ([`cdyn::stops`]), the names a report gives them, and what a run did at
 //! them as `summary.json` and the terminal report it.
 
+use cdyn::error::Problem;
 use cdyn::json_float::JsonFloat;
 use cdyn::stops::{Change, Report, Unilateral};
 use serde::Serialize;
@@ -73,6 +74,23 @@ pub struct Overspeed {
 }
 
 impl Limits {
+    /// Refuses a start past a limit ([`cdyn::stops::check_start`]) in one
+    /// line naming the joint as the CSV does: `joint elbow: starts 2.000e-1
+    /// past its upper limit 1 (…)`.
+    pub fn check_start(&self, q0: &[f64], v0: &[f64]) -> Result<(), String> {
+        match cdyn::stops::check_start(&*self.system, q0, v0) {
+            Ok(()) => Ok(()),
+            Err(cdyn::Error::InvalidModel {
+                problem: Problem::StartsPastLimit { stop, upper, bound, by, .. }, ..
+            }) => {
+                let joint = format!("joint {}", self.stops[stop].joint);
+                let problem = Problem::StartsPastLimit { stop, joint, upper, bound, by };
+                Err(format!("{problem} (limits hold a joint within its range from the start)"))
+            }
+            Err(e) => Err(format!("[initial]: {e}")),
+        }
+    }
+
     /// The library's report of a run, in the names of the case's joints.
     pub fn report(&self, report: &Report) -> LimitsReport {
         let events = report
