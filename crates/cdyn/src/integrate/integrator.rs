@@ -11,6 +11,10 @@ use super::scheme::{Application, Formula, Scheme};
 #[derive(Clone)]
 pub struct Integrator<B = Vec<f64>> {
     scheme: Scheme,
+    /// The formulas of the scheme and of its start-up scheme (the scheme's
+    /// own without one), looked up once: a step only chooses between them.
+    formula: Formula,
+    startup: Formula,
     application: Application,
     /// Past evaluations, a ring: the newest at `newest`, older ones after it.
     history: Vec<B>,
@@ -51,6 +55,8 @@ impl<B: Buffer> Integrator<B> {
             .unwrap_or(1);
         Self {
             scheme,
+            formula: info.formula,
+            startup: info.startup.map_or(info.formula, |s| s.info().formula),
             application,
             history: vec![zero.clone(); info.history],
             newest: 0,
@@ -80,7 +86,7 @@ impl<B: Buffer> Integrator<B> {
     /// The evaluation `j` steps back (0: the newest).
     #[inline(always)]
     fn past(&self, j: usize) -> &[f64] {
-        self.history[(self.newest + j) % self.history.len()].as_slice()
+        self.history[ring(self.newest, j, self.history.len())].as_slice()
     }
 
     /// Advances `x` from `t` to `t + h`.
@@ -91,17 +97,17 @@ impl<B: Buffer> Integrator<B> {
     /// (a [`Simulation`](crate::simulate::Simulation) takes it).
     #[inline]
     pub fn step<R: Rhs>(&mut self, rhs: &mut R, x: &mut [f64], t: f64, h: f64) -> Result<(), R::Error> {
-        let active = self.active_scheme().info();
+        let formula = if self.filled + 1 < self.history.len() { self.startup } else { self.formula };
         let control = rhs.has_control();
         let split = control && self.application != Application::InRhs;
         // F(x_k): f + U in the right-hand side, f alone when split; U(x_k) kept for forward Euler.
-        self.newest = (self.newest + self.history.len() - 1) % self.history.len();
+        self.newest = ring(self.newest, self.history.len() - 1, self.history.len());
         if !std::mem::take(&mut self.evaluated) {
             self.evaluate_first(rhs, x, t, control)?;
         }
         self.filled = (self.filled + 1).min(self.history.len());
         let mut control_pending = true;
-        match active.formula {
+        match formula {
             Formula::Multistep(w) => {
                 // The forward Euler control step joins the same pass over memory.
                 let joined = split && self.application == Application::ForwardEuler;
@@ -111,7 +117,7 @@ impl<B: Buffer> Integrator<B> {
             }
             Formula::PredictorCorrector { predictor, corrector } => {
                 let (history, newest) = (&self.history, self.newest);
-                let past = |j: usize| history[(newest + j) % history.len()].as_slice();
+                let past = |j: usize| history[ring(newest, j, history.len())].as_slice();
                 let f = [past(0), past(1), past(2), past(3)];
                 let stage_x = self.stage_x.as_mut_slice();
                 stage_x.copy_from_slice(x);
@@ -124,7 +130,7 @@ impl<B: Buffer> Integrator<B> {
                     // U(x_k) stays in `u` for the forward Euler control step.
                     rhs.eval(self.stage_x.as_slice(), t + h, predicted, None)?;
                 }
-                let past = |j: usize| self.history[(self.newest + j) % self.history.len()].as_slice();
+                let past = |j: usize| self.history[ring(self.newest, j, self.history.len())].as_slice();
                 let f = [self.stages[0].as_slice(), past(0), past(1), past(2)];
                 accumulate(x, h, corrector, f);
             }
@@ -165,7 +171,7 @@ impl<B: Buffer> Integrator<B> {
                 }
                 Application::PostStep => {
                     // f(x̂_{k+1}) goes where the next step reads its newest evaluation.
-                    let next = (self.newest + self.history.len() - 1) % self.history.len();
+                    let next = ring(self.newest, self.history.len() - 1, self.history.len());
                     rhs.eval(x, t + h, self.history[next].as_mut_slice(), Some(self.u.as_mut_slice()))?;
                     self.evaluated = true;
                 }
@@ -195,6 +201,16 @@ impl<B: Buffer> Integrator<B> {
 
 /// `x += h Σ_j w_j f_j (+ h u)` in one pass (at most three past evaluations,
 /// newest first; entries past `w` are not read).
+/// Slot `newest + back` of a ring of `len` slots, for `newest, back < len`:
+/// one comparison, not the division of `%` (four a step, each some 20–40
+/// cycles of latency on the path of a small model's step).
+#[inline(always)]
+fn ring(newest: usize, back: usize, len: usize) -> usize {
+    debug_assert!(newest < len && back < len, "a slot of the ring");
+    let i = newest + back;
+    if i >= len { i - len } else { i }
+}
+
 #[inline(always)]
 fn advance(x: &mut [f64], h: f64, w: &[f64], f: [&[f64]; 3], u: Option<&[f64]>) {
     assert!(w.len() <= 3, "multistep formulas read at most three past evaluations");

@@ -16,7 +16,7 @@ use crate::model::unit_vector::{UnitNorm, UnitVector};
 use crate::linalg::sparse::Pattern;
 /// The sparsity of `Φ_q`, as [`Model::pattern`] returns it (defined with the
 /// other sparse structures in `sparse.rs`).
-use crate::model::definition::{Direction, Inertia, Model, check_rows, checked_direction};
+use crate::model::definition::{BlockSpan, Direction, Inertia, Model, check_rows, checked_direction};
 
 impl Model {
     /// Starts a model whose coordinates have these (diagonal) masses.
@@ -306,7 +306,8 @@ impl ModelBuilder {
         let mut pattern = Pattern { start: vec![0], cols: Vec::with_capacity(nnz), read: Vec::with_capacity(nnz) };
         let mut offsets = Vec::with_capacity(self.constraints.len());
         for b in &self.constraints {
-            offsets.push((pattern.start.len() - 1, pattern.cols.len()));
+            let (r0, j0) = (pattern.start.len() - 1, pattern.cols.len());
+            offsets.push(BlockSpan { rows: (r0, r0 + b.rows()), entries: (j0, j0 + b.rows() * b.width()) });
             b.columns(&mut pattern.cols);
             b.reads(&mut pattern.read);
             for _ in 0..b.rows() {

@@ -16,6 +16,14 @@ use crate::model::unit_vector::UnitVector;
 /// other sparse structures in `sparse.rs`).
 pub use crate::linalg::sparse::Pattern;
 
+/// Where one constraint block's values lie: its rows `[start, end)` and
+/// its Jacobian entries `[start, end)`, fixed when the model is built.
+#[derive(Clone, Copy)]
+pub(super) struct BlockSpan {
+    pub rows: (usize, usize),
+    pub entries: (usize, usize),
+}
+
 /// A constrained mechanical system, ready to simulate.
 ///
 /// Built with [`Model::builder`] from the coordinates' masses and elements
@@ -45,8 +53,8 @@ pub struct Model {
     pub(super) potentials: Vec<Box<dyn PotentialBlock>>,
     pub(super) forces: Vec<Box<dyn ForceBlock>>,
     pub(super) pattern: Pattern,
-    /// First row and first Jacobian entry of each constraint block.
-    pub(super) offsets: Vec<(usize, usize)>,
+    /// The rows and Jacobian entries of each constraint block.
+    pub(super) offsets: Vec<BlockSpan>,
     pub(super) unit_vectors: Vec<UnitVector>,
     pub(super) momenta: Vec<Direction>,
     pub(super) rotations: Vec<Generator>,
@@ -260,8 +268,9 @@ impl Model {
     }
     /// `Φ`, `Φ̇`, `Φ_t`, `γ`, the Jacobian values (in [`Pattern`] order) and `Φ_q a − γ`.
     pub(crate) fn constraints(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
-        for (b, &(r0, j0)) in self.constraints.iter().zip(&self.offsets) {
-            let (r1, j1) = (r0 + b.rows(), j0 + b.rows() * b.width());
+        // The spans are read, not recomputed: a block's `rows` and `width`
+        // are calls through its vtable (three a block, each step).
+        for (b, &BlockSpan { rows: (r0, r1), entries: (j0, j1) }) in self.constraints.iter().zip(&self.offsets) {
             b.evaluate(
                 q,
                 v,
@@ -281,8 +290,8 @@ impl Model {
 
     /// `Φ(q, t)` alone (zero on nonholonomic rows, which have no position-level value).
     pub fn constraint_values(&self, q: &[f64], t: f64, phi: &mut [f64]) {
-        for (b, &(r0, _)) in self.constraints.iter().zip(&self.offsets) {
-            b.values(q, t, &mut phi[r0..r0 + b.rows()]);
+        for (b, &BlockSpan { rows: (r0, r1), .. }) in self.constraints.iter().zip(&self.offsets) {
+            b.values(q, t, &mut phi[r0..r1]);
         }
     }
 
@@ -341,8 +350,8 @@ impl Model {
     /// [`curvature_entries`](Self::curvature_entries).
     pub(crate) fn curvature_values(&self, q: &[f64], t: f64, lambda: &[f64], scale: f64, out: &mut [f64]) {
         let mut at = 0;
-        for (b, &(r0, _)) in self.constraints.iter().zip(&self.offsets) {
-            at += b.curvatures(q, t, &lambda[r0..r0 + b.rows()], scale, &mut out[at..]);
+        for (b, &BlockSpan { rows: (r0, r1), .. }) in self.constraints.iter().zip(&self.offsets) {
+            at += b.curvatures(q, t, &lambda[r0..r1], scale, &mut out[at..]);
         }
     }
 
