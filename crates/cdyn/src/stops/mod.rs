@@ -34,11 +34,13 @@ mod planar;
 mod reads;
 mod snapshot;
 mod spatial;
+mod start;
 mod stepping;
 mod unilateral;
 
 pub use planar::PlanarStops;
 pub use snapshot::StopSnapshot;
 pub use spatial::MechanismStops;
-pub use stepping::{START_SLACK, StopSimulation, check_start, run_with_stops};
+pub use start::{START_SLACK, check_start};
+pub use stepping::{StopSimulation, run_with_stops};
 pub use unilateral::{Change, Event, Report, Unilateral};

@@ -8,7 +8,8 @@
 //! repeats the steps that followed bit for bit, across the hits and
 //! releases among them.
 
-use super::stepping::{START_SLACK, StopSimulation, passed};
+use super::start::{START_SLACK, passed};
+use super::stepping::StopSimulation;
 use super::unilateral::{Report, Unilateral};
 use crate::error::{Error, Part, Problem, Result};
 use crate::model::Model;

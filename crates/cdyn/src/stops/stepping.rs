@@ -11,6 +11,7 @@
 //! kept here. A hit or a release builds the model of the stops held then,
 //! and allocates.
 
+use super::start::{START_SLACK, refuse_passed};
 use super::unilateral::{Change, Event, Report, Unilateral};
 use crate::dynamics::assemble::assemble;
 use crate::dynamics::{Breakdown, Dynamics};
@@ -316,30 +317,6 @@ pub fn run_with_stops<U: Unilateral + ?Sized, E: From<Error>>(
     Ok(run.into_report())
 }
 
-/// Refuses `(q0, v0)` as a start of `system` if it is past a stop (by more
-/// than [`START_SLACK`]): [`Problem::StartsPastLimit`], naming the first
-/// such stop's joint, side and bound and how far past it the state is.
-/// [`StopSimulation::new`] refuses such a start; this tells it beforehand.
-pub fn check_start<U: Unilateral + ?Sized>(system: &U, q0: &[f64], v0: &[f64]) -> Result<()> {
-    let mut gaps = vec![[0.0; 2]; system.stops()];
-    system.gaps(q0, v0, &mut gaps)?;
-    refuse_passed(system, &gaps)
-}
-
-/// [`check_start`] of the stops' `gaps` at the start.
-fn refuse_passed<U: Unilateral + ?Sized>(system: &U, gaps: &[[f64; 2]]) -> Result<()> {
-    let Some((stop, g)) = passed(gaps, |_| false) else { return Ok(()) };
-    let (upper, bound) = system.side(stop);
-    let joint = system.joint(stop);
-    Err(Problem::StartsPastLimit { stop, joint, upper, bound, by: -g }.at(Part::InitialState))
-}
-
-/// The first stop passed (`g < −START_SLACK`) among those `gaps` that
-/// `held` does not exempt, and its gap.
-pub(super) fn passed(gaps: &[[f64; 2]], held: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
-    gaps.iter().enumerate().map(|(k, [g, _])| (k, *g)).find(|&(k, g)| g < -START_SLACK && !held(k))
-}
-
 /// A simulation of the model in `model`'s allocation.
 fn start(model: &Arc<Model>, settings: Settings, q: &[f64], v: &[f64]) -> Result<Simulation<'static>> {
     // SAFETY: the model lives in the `Arc`'s allocation, which neither
@@ -360,15 +337,6 @@ fn breakdown(b: Breakdown, step: u64, t: f64) -> Error {
         Breakdown::Mass(coordinate) => Error::MassNotPositive { step, t, coordinate },
     }
 }
-
-/// How far past a stop a joint is still at it, not past it: where a run may
-/// start (a pose placed at a bound, a robot's zero pose at a limit of 0,
-/// lands there only to round-off: 2.8e-17 seen) and where a step's end
-/// is not a hit. A joint resting at a stop that no row holds (Panda's
-/// second finger, a `<mimic>` of the first, held) wanders across it by
-/// round-off, ±1e-16: seen as hits, each took a rebuild of the model —
-/// 3 900 in Panda's first second.
-pub const START_SLACK: f64 = 1e-12;
 
 /// The multiplier a held stop's row must exceed, relative to the largest
 /// the rows carry, to be released: far above round-off (1e-19 relative seen
