@@ -15,7 +15,7 @@ use super::start::{START_SLACK, refuse_passed};
 use super::unilateral::{Change, Event, Report, Unilateral};
 use crate::dynamics::assemble::assemble;
 use crate::dynamics::{Breakdown, Dynamics};
-use crate::error::{Error, Part, Problem, Result};
+use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::simulate::{Settings, Simulation, steps_to};
 use std::ops::Deref;
