@@ -72,6 +72,36 @@ fn a_torque_turns_the_pendulum_at_the_hand_computed_rate_and_the_clamp_holds_it_
     assert!((acc - exact).abs() < 1e-12 * exact.abs(), "clamped servo θ̈ = {acc} vs {exact}");
 }
 
+#[test]
+fn a_servo_turns_within_a_limit_shorter_than_a_turn_and_the_short_way_without_one() {
+    // Panda's joint 6 ranges over −0.0175..3.7525 rad, through π. From
+    // θ = 0.2 to a target of 3.5 (kp = 8, no gravity, at rest) the servo in
+    // that range asks τ = 8·3.3 = 26.4 (up, through π). The unlimited joint
+    // turns the short way: θ − θ_ref = −3.3 is 2π − 3.3 in (−π, π], so
+    // τ = −8·(2π − 3.3) (down). At θ = 3.3, which reads 3.3 − 2π, both ask
+    // 8·0.2 = 1.6.
+    let servo = Actuator::servo(0, TimeFn::constant(3.5), 8.0, 0.0);
+    let range = JointLimit::new(-0.0175, 3.7525);
+    let limited = pendulum(0.0, servo.clone(), Some(range));
+    let free = pendulum(0.0, servo, None);
+    let tau = |mechanism: &Mechanism, theta: f64| {
+        let (q, v) = turned(theta, 0.0);
+        let applied = mechanism.actuator_torques().unwrap().at(0, &q, &v, 0.0);
+        let [_, _, acc] = joint_at_start(mechanism, &q, &v, 0.0);
+        assert!((acc - applied / pivot_inertia()).abs() < 1e-12 * (1.0 + acc.abs()), "θ̈ {acc} for τ {applied}");
+        applied
+    };
+    for (mechanism, theta, exact) in [
+        (&limited, 0.2, 26.4),
+        (&free, 0.2, -8.0 * (std::f64::consts::TAU - 3.3)),
+        (&limited, 3.3, 1.6),
+        (&free, 3.3, 1.6),
+    ] {
+        let applied = tau(mechanism, theta);
+        assert!((applied - exact).abs() < 1e-12, "θ = {theta}: τ = {applied}, hand-computed {exact}");
+    }
+}
+
 /// The rod's state turned by `theta` about y with rate `rate`.
 fn turned(theta: f64, rate: f64) -> (Vec<f64>, Vec<f64>) {
     let (s, c) = (theta.sin(), theta.cos());

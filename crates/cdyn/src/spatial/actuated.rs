@@ -40,8 +40,10 @@ impl Mechanism {
     /// Actuator `actuator`'s element, checked: on a revolute or prismatic joint.
     fn joint_actuator(&self, actuator: &Actuator, poses: &[Pose]) -> Result<JointActuator> {
         let coordinate = self.coordinate(actuator.joint, poses)?;
-        let effort = self.joints[actuator.joint].limit.map_or(f64::INFINITY, |l| l.effort);
-        Ok(JointActuator { law: actuator.law(effort)?, coordinate })
+        let limit = self.joints[actuator.joint].limit;
+        let effort = limit.map_or(f64::INFINITY, |l| l.effort);
+        let range = limit.filter(|l| coordinate.rotary && l.within_a_turn());
+        Ok(JointActuator { law: actuator.law(effort)?, coordinate, range })
     }
 
     /// The reader of the torque each actuator applies (see

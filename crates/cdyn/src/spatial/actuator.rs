@@ -18,6 +18,7 @@ use super::load::{apply, body_end, ground_end};
 use super::rotation::{rotate_fixed, space_rate, torque_on_parameters};
 use crate::ad::scalar::Scalar;
 use crate::error::{Problem, Result};
+use crate::limit::JointLimit;
 use crate::model::force::Force;
 use crate::model::timefn::TimeFn;
 
@@ -27,8 +28,10 @@ use crate::model::timefn::TimeFn;
 /// torque (force) `τ(t)`, or a PD servo
 /// `τ = kp (θ_ref(t) − θ) + kd (θ̇_ref(t) − θ̇)` to the target `θ_ref`
 /// (`θ − θ_ref` of a revolute joint taken in `(−π, π]`: the servo turns the
-/// short way), `θ̇_ref` the target's derivative (an input's term, constant
-/// between steps, has none).
+/// short way; but where the joint's limit is a range shorter than a turn,
+/// `θ` is taken in that range and the servo turns within it, never through
+/// the range's gap), `θ̇_ref` the target's derivative (an input's term,
+/// constant between steps, has none).
 ///
 /// Where the joint's [`limit`](super::Joint::limit) has a finite `effort`,
 /// `τ` is clamped to `±effort`. The clamp is continuous but not smooth:
@@ -135,6 +138,11 @@ pub(crate) struct Law {
 pub(crate) struct JointActuator {
     pub law: Law,
     pub coordinate: JointCoordinate,
+    /// A revolute joint's limit shorter than a turn: the range its servo
+    /// reads `θ` in (Panda's joint 6, −0.0175 to 3.7525, servoed from 0.2
+    /// to 3.5 turns up, where the short way would drive it down into its
+    /// lower stop).
+    pub range: Option<JointLimit>,
 }
 
 impl JointActuator {
@@ -143,7 +151,14 @@ impl JointActuator {
         let tau = match &self.law.drive {
             Drive::Torque(f) => f.eval(t),
             Drive::Servo { target, rate, kp, kd } => {
-                let error = self.coordinate.at(x, self.sides::<K>(), target.eval(t));
+                let error = match self.range {
+                    Some(range) => {
+                        // θ read in (−π, π], shifted by whole turns into the range.
+                        let theta = self.coordinate.at(x, self.sides::<K>(), D::zero());
+                        theta + (range.unwrap_angle(theta.re()) - theta.re()) - target.eval(t)
+                    }
+                    None => self.coordinate.at(x, self.sides::<K>(), target.eval(t)),
+                };
                 (rate.eval(t) - self.rate(x, xd)) * *kd - error * *kp
             }
         };
