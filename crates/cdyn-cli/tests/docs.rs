@@ -2,9 +2,8 @@
 //! README's commands do what it says, `cdyn paper` prints the README's
 //! table to the last digit, and every link between the pages resolves.
 
-mod common;
 
-use common::{cdyn, path_str, scenario};
+use crate::common::{cdyn, path_str, scenario};
 use std::path::{Path, PathBuf};
 
 /// The repository's root.

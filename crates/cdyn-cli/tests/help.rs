@@ -2,9 +2,8 @@
 //! example of it, the exit codes are in `cdyn --help`, and completions and
 //! man pages are generated for every command.
 
-mod common;
 
-use common::{cdyn, path_str};
+use crate::common::{cdyn, path_str};
 
 /// The commands, as `cdyn --help` lists them.
 fn commands() -> Vec<String> {

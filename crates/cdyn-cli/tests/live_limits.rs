@@ -6,11 +6,10 @@
 //! it repeats the run to the bit; an input set survives the models rebuilt
 //! at a hit and a release; a state set past a limit is refused.
 
-mod common;
 
 use cdyn_cli::case::live::Live;
 use cdyn_cli::case::scenario;
-use common::{cdyn, path_str, scenario, table};
+use crate::common::{cdyn, path_str, scenario, table};
 use std::path::{Path, PathBuf};
 
 fn example_path() -> PathBuf {

@@ -2,9 +2,8 @@
 //! each scheme at its order on Example 1 against the closed form, the
 //! reference of a model without one bounded, and bad input on one line.
 
-mod common;
 
-use common::{cdyn, one_error_line, path_str, scenario};
+use crate::common::{cdyn, one_error_line, path_str, scenario};
 use serde_json::Value;
 
 const EXAMPLE1: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/suite/example1.toml");

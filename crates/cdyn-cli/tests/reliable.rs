@@ -7,8 +7,7 @@
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
-mod common;
-use common::{cdyn, one_error_line, path_str, scenario};
+use crate::common::{cdyn, one_error_line, path_str, scenario};
 
 const PENDULUM: &str = r#"
 [model]

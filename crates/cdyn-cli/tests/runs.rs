@@ -10,8 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-use common::{cdyn, one_error_line, path_str, scenario};
+use crate::common::{cdyn, one_error_line, path_str, scenario};
 
 /// The pendulum of the paper's Example 1 under CVSGF; `t_end` and `every` are substituted.
 const PENDULUM: &str = r#"

@@ -2,9 +2,8 @@
 //! examples run and reproduce their references, and bad entries get one
 //! line naming the entry.
 
-mod common;
 
-use common::{cdyn, one_error_line, path_str, scenario, summary_case, table};
+use crate::common::{cdyn, one_error_line, path_str, scenario, summary_case, table};
 use std::path::{Path, PathBuf};
 
 fn example(name: &str) -> String {
