@@ -2,7 +2,6 @@
 //! README's commands do what it says, `cdyn paper` prints the README's
 //! table to the last digit, and every link between the pages resolves.
 
-
 use crate::common::{cdyn, path_str, scenario};
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,6 @@
 //! example of it, the exit codes are in `cdyn --help`, and completions and
 //! man pages are generated for every command.
 
-
 use crate::common::{cdyn, path_str};
 
 /// The commands, as `cdyn --help` lists them.

@@ -9,7 +9,6 @@
 //! `t* = (F(π/2 | m) − F(ψ* | m)) / √k`, `m = sin²(φ₀/2)`, `sin ψ* =
 //! sin(φ*/2) / sin(φ₀/2)`, and the rate there `√(2k (cos φ* − cos φ₀))`.
 
-
 use crate::common::{Table, cdyn, one_error_line, path_str, scenario, summary_case, table};
 
 const G: f64 = 9.81;

@@ -6,10 +6,9 @@
 //! it repeats the run to the bit; an input set survives the models rebuilt
 //! at a hit and a release; a state set past a limit is refused.
 
-
+use crate::common::{cdyn, path_str, scenario, table};
 use cdyn_cli::case::live::Live;
 use cdyn_cli::case::scenario;
-use crate::common::{cdyn, path_str, scenario, table};
 use std::path::{Path, PathBuf};
 
 fn example_path() -> PathBuf {

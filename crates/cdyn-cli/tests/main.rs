@@ -4,9 +4,9 @@
 //! 50 binaries). The allocation-counting tests, which install their own
 //! global allocator, stay binaries of their own.
 
-mod common;
 mod bench;
 mod builtin;
+mod common;
 mod docs;
 mod errors;
 mod help;

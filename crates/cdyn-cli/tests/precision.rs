@@ -2,7 +2,6 @@
 //! each scheme at its order on Example 1 against the closed form, the
 //! reference of a model without one bounded, and bad input on one line.
 
-
 use crate::common::{cdyn, one_error_line, path_str, scenario};
 use serde_json::Value;
 

@@ -2,7 +2,6 @@
 //! examples run and reproduce their references, and bad entries get one
 //! line naming the entry.
 
-
 use crate::common::{cdyn, one_error_line, path_str, scenario, summary_case, table};
 use std::path::{Path, PathBuf};
 

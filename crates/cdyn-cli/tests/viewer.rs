@@ -2,7 +2,6 @@
 //! cases), that it needs nothing from the network, and the GIF's frames.
 //! The page in a real browser is tested by `.ci/browser-test.sh`.
 
-
 use crate::common::{cdyn, one_error_line, path_str, scenario};
 use image::AnimationDecoder;
 use serde_json::Value;
