@@ -492,6 +492,17 @@ start = 0.0
 "#;
 
 /// A run's CSV header and rows, and summary.json's case.
+#[test]
+fn a_scenario_may_name_a_urdf_link_merged_into_another_links_body() {
+    // arm.urdf's massless tool is part of the hand's body: the tethered
+    // arm's rod on "tool" is the same run, to the bit, as on "hand".
+    let tethered = example("arm_tethered.toml");
+    let (on_hand, on_tool) =
+        (run_arm(&tethered).unwrap(), run_arm(&tethered.replace("a = \"hand\"", "a = \"tool\"")).unwrap());
+    assert!(tethered.contains("a = \"hand\""));
+    assert_eq!((on_hand.0, on_hand.1), (on_tool.0, on_tool.1));
+}
+
 type ArmRun = (Vec<String>, Vec<Vec<f64>>, serde_json::Value);
 
 /// Runs `text` beside arm.urdf, or gives the error line.

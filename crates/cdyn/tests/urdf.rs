@@ -380,7 +380,7 @@ fn links_without_mass_or_inertia_join_the_link_they_are_fixed_to_and_a_welds_zer
     for (k, own) in [0.01, 0.02 + parallel, 0.02 + parallel].into_iter().enumerate() {
         assert!((body.inertia[k][k] - own).abs() < 1e-15, "{k}: {:?}", body.inertia);
     }
-    assert!(robot.notes.iter().any(|n| n.contains("2 massless or zero-inertia links merged")), "{:?}", robot.notes);
+    assert!(robot.notes.iter().any(|n| n.contains("2 links merged")), "{:?}", robot.notes);
     m.build().unwrap();
     // Moved by a joint, a point mass with nothing fixed to it is refused.
     let point = one_joint("revolute", "0 1 0", "", "").replace(
@@ -389,6 +389,63 @@ fn links_without_mass_or_inertia_join_the_link_they_are_fixed_to_and_a_welds_zer
     );
     let error = from_urdf(&point, [0.0; 3]).unwrap_err().to_string();
     assert!(error.contains("link \"block\": inertia must be positive definite, and joint \"j\" moves it"), "{error}");
+}
+
+#[test]
+fn a_massive_link_welded_to_a_moving_one_joins_its_body_with_the_same_dynamics_and_keeps_its_name() {
+    // A tool of 1 kg, its own inertia turned (rpy), welded 0.4 m out on the
+    // swinging block: from URDF one body; built by hand, the block and the
+    // tool as two bodies held by a fixed joint. The joint's acceleration at
+    // a turned, moving state is the same to round-off.
+    let tool = r#"<joint name="mount" type="fixed"><parent link="block"/><child link="tool"/>
+          <origin xyz="0.4 0 0" rpy="0.3 0 0"/></joint>
+        <link name="tool"><inertial><origin xyz="0 0.05 0" rpy="0 0.2 0"/><mass value="1"/>
+          <inertia ixx="0.003" ixy="0" ixz="0" iyy="0.004" iyz="0" izz="0.005"/></inertial></link>"#;
+    let g = [0.0, 0.0, -G];
+    let robot = cdyn::spatial::read_urdf(&one_joint("revolute", "0 1 0", "", tool), g).unwrap();
+    assert_eq!(robot.mechanism.bodies.len(), 1, "{:?}", robot.mechanism.bodies);
+    assert!(robot.notes.iter().any(|n| n.contains("1 links merged")), "{:?}", robot.notes);
+    let merged = &robot.merged;
+    assert_eq!(merged.iter().map(|l| (l.name.as_str(), l.body.as_str())).collect::<Vec<_>>(), [("tool", "block")]);
+    // The tool's centre: 0.4 along x from the joint at z = 0.5, then 0.05
+    // along the mount's y turned by roll 0.3 about x.
+    let centre = [0.4, 0.05 * 0.3f64.cos(), 0.5 + 0.05 * 0.3f64.sin()];
+    let found = merged[0].centre.unwrap();
+    assert!((0..3).all(|k| (found[k] - centre[k]).abs() < 1e-15), "{found:?} vs {centre:?}");
+
+    // By hand: the tool's body at its centre, in the axes roll 0.3 then pitch 0.2.
+    let block = from_urdf(&one_joint("revolute", "0 1 0", "", ""), g).unwrap();
+    let half = |a: f64| ((a / 2.0).cos(), (a / 2.0).sin());
+    let ((cr, sr), (cp, sp)) = (half(0.3), half(0.2));
+    let axes = [cr * cp, sr * cp, cr * sp, sr * sp];
+    let body =
+        cdyn::spatial::Body::new("tool", 1.0, [0.003, 0.004, 0.005]).with_position(centre).with_orientation(axes);
+    let weld = cdyn::spatial::Joint::new(cdyn::spatial::JointKind::Fixed, 1, Some(0), [0.4, 0.0, 0.5])
+        .with_axis([0.0, 0.0, 1.0]);
+    let two =
+        block.clone().with_bodies(vec![block.bodies[0].clone(), body]).with_joints(vec![block.joints[0].clone(), weld]);
+    let acceleration = |m: &cdyn::spatial::Mechanism| {
+        let (q, v) = m.state_at_joints(&[(0, 0.3)], &[(0, -0.7)]).unwrap();
+        let built = m.build().unwrap();
+        let mut d = cdyn::dynamics::Dynamics::new(&built.model);
+        d.evaluate(&built.model, &q, &v, 0.0).unwrap();
+        m.joint_coordinates(&q, &v, d.acc()).unwrap()[0].unwrap()
+    };
+    let (one, apart) = (acceleration(&robot.mechanism), acceleration(&two));
+    println!("welded tool: θ, θ̇, θ̈ merged {one:?}, two bodies {apart:?}");
+    assert!((0..3).all(|k| (one[k] - apart[k]).abs() < 1e-12 * (1.0 + apart[k].abs())), "{one:?} vs {apart:?}");
+
+    // A force on the tool without a point acts at the tool's centre of mass.
+    use cdyn::spatial::{Load, Mechanism};
+    let named = |load: Load<String>| {
+        let m = &robot.mechanism;
+        let joints = m.joints.iter().map(|j| j.clone().map_bodies(|b| m.bodies[b].name.clone())).collect();
+        Mechanism::named_with_links(m.bodies.clone(), joints, vec![load], g, merged).unwrap()
+    };
+    let on_tool = named(Load::Force { body: "tool".into(), force: [0.0, 0.0, 5.0], point: None });
+    let at_centre = named(Load::Force { body: "block".into(), force: [0.0, 0.0, 5.0], point: Some(found) });
+    assert_eq!(on_tool.loads, at_centre.loads);
+    assert_ne!(acceleration(&on_tool), one, "the force acts");
 }
 
 #[test]

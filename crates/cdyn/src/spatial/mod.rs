@@ -61,6 +61,7 @@ pub use coordinate::JointSpace;
 pub use joint::{FRICTION_SLIP, Joint, JointKind};
 pub use load::Load;
 pub use mechanism::{Built, Coupling, Mechanism};
+pub use named::MergedLink;
 pub use sketch::{Anchor, Limb, Sketch};
 #[cfg(feature = "urdf")]
 pub use urdf::{UrdfRobot, from_urdf, read_urdf};

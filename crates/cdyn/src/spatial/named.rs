@@ -10,6 +10,20 @@ use crate::error::{Error, Part, Problem, Result};
 use crate::limit::JointLimit;
 use std::collections::HashMap;
 
+/// A part of a body that joints and loads may name as if it were a body:
+/// a URDF link welded to another link's body ([`super::UrdfRobot::merged`]).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct MergedLink {
+    /// Its name.
+    pub name: String,
+    /// The name of the body it is part of (`"ground"`: the ground's).
+    pub body: String,
+    /// Its own centre of mass, in space at the initial pose, where a force
+    /// on it without a `point` acts (`None`: massless, the body's).
+    pub centre: Option<[f64; 3]>,
+}
+
 impl Mechanism {
     /// A mechanism whose joints name their bodies (`"ground"`, or `b`
     /// omitted, for the ground), as scenario files do.
@@ -19,20 +33,37 @@ impl Mechanism {
         loads: Vec<Load<String>>,
         gravity: [f64; 3],
     ) -> Result<Self> {
+        Self::named_with_links(bodies, joints, loads, gravity, &[])
+    }
+
+    /// [`Mechanism::named`], where joints and loads may also name the
+    /// `merged` links, each standing for its body (a force on one without a
+    /// `point` acting at the link's own centre of mass).
+    pub fn named_with_links(
+        bodies: Vec<Body>,
+        joints: Vec<Joint<String>>,
+        loads: Vec<Load<String>>,
+        gravity: [f64; 3],
+        merged: &[MergedLink],
+    ) -> Result<Self> {
         let mut index = HashMap::new();
         for (i, body) in bodies.iter().enumerate() {
             let at = || Part::Body { index: i, name: body.name.clone() };
             if body.name.is_empty() || body.name == crate::planar::GROUND {
                 return Err(Problem::ReservedName { name: body.name.clone() }.at(at()));
             }
-            if index.insert(body.name.as_str(), i).is_some() {
+            if index.insert(body.name.as_str(), i).is_some() || merged.iter().any(|l| l.name == body.name) {
                 return Err(Problem::DuplicateName.at(at()));
             }
         }
-        let resolve = |key: &'static str, name: &str| match index.get(name) {
-            Some(&i) => Ok(Some(i)),
-            None if name == crate::planar::GROUND => Ok(None),
-            None => Err(Error::from(Problem::UnknownBody { key, name: name.to_string() })),
+        let link = |name: &str| merged.iter().find(|l| l.name == name);
+        let resolve = |key: &'static str, given: &str| {
+            let name = link(given).map_or(given, |l| l.body.as_str());
+            match index.get(name) {
+                Some(&i) => Ok(Some(i)),
+                None if name == crate::planar::GROUND => Ok(None),
+                None => Err(Error::from(Problem::UnknownBody { key, name: given.to_string() })),
+            }
         };
         let joints = joints
             .into_iter()
@@ -105,7 +136,10 @@ impl Mechanism {
                         (None, Some(b)) => Load::RotaryDamper { a: b, b: None, axis, damping },
                         (None, None) => return Err(ground().at(at)),
                     },
-                    Load::Force { body, force, point } => Load::Force { body: one(&body)?, force, point },
+                    Load::Force { body, force, point } => {
+                        let point = point.or_else(|| link(&body).and_then(|l| l.centre));
+                        Load::Force { body: one(&body)?, force, point }
+                    }
                     Load::Torque { body, torque } => Load::Torque { body: one(&body)?, torque },
                 })
             })

@@ -12,12 +12,15 @@
 //! 3-D views (meshes are not read: a body without primitive visuals is
 //! drawn as the box of its inertia).
 //!
-//! A link that cannot be a body on its own — no mass, or an inertia that
-//! is not positive definite and physical (a sensor frame, a point mass) —
-//! is merged into the link it is fixed to (its mass, centre of mass and
-//! inertia added to that link's), and a link moved by a joint takes in the
-//! links fixed to it while it cannot be a body alone. A link fixed to the
-//! root is part of the ground. Refused, with the element named: a moved
+//! A link welded by a `fixed` joint to a link that moves is merged into
+//! that link's body (its mass, centre of mass and inertia added to the
+//! body's): one rigid body, not two held together by six rows (Kinova's
+//! fingers, Panda's hand). A link welded to the root is part of the ground
+//! if it cannot be a body on its own — no mass, or an inertia that is not
+//! positive definite and physical (a sensor frame, a point mass) — and
+//! otherwise keeps its own body, which its visuals are drawn on (a base
+//! link). Joints and loads of a scenario may name a merged link
+//! ([`UrdfRobot::merged`]). Refused, with the element named: a moved
 //! link that has no mass or no usable inertia even then, `planar` and
 //! `spherical` joints, a `<mimic>` of a joint that is not revolute or
 //! prismatic, a zero axis on a moving joint, and several root links.
@@ -34,6 +37,7 @@
 use super::body::Body;
 use super::joint::{Joint, JointKind};
 use super::mechanism::{Coupling, Mechanism};
+use super::named::MergedLink;
 use super::rotation::{about, compose, rotate, unrotate};
 use super::visual::{Shape, Visual};
 use crate::error::{Error, Part, Problem, Result};
@@ -75,6 +79,9 @@ pub struct UrdfRobot {
     /// What the file holds that cdyn does not model, one phrase each
     /// (`"collision (12 elements)"`), for a run to print.
     pub notes: Vec<String>,
+    /// The links merged into other links' bodies or the ground, for
+    /// [`Mechanism::named_with_links`].
+    pub merged: Vec<MergedLink>,
 }
 
 /// The elements of a URDF file that cdyn reads past without modelling them.
@@ -223,18 +230,19 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
         let up = head[link_index[j.parent.link.as_str()]];
-        // The ground takes what cannot be a body; a body what cannot be one, or all while it cannot.
-        let merge = !usable(l) || (up != root && !usable(up));
+        // A moving body takes all that is welded to it; the ground what cannot be a body.
+        let merge = up != root || !usable(l);
         if j.joint_type == urdf_rs::JointType::Fixed && merge {
             head[l] = up;
         }
     }
     let mut bodies = Vec::new();
     let mut body_of: Vec<Option<usize>> = vec![None; robot.links.len()];
-    let mut merges = 0;
+    let mut merges = Vec::new();
     for &h in order[1..].iter().filter(|&&l| head[l] == l) {
         let members: Vec<usize> = order.iter().copied().filter(|&l| head[l] == h).collect();
-        merges += members.len() - 1;
+        let centre = |l: usize| own[l].as_ref().map(|b| b.position);
+        merges.extend(members[1..].iter().map(|&l| (l, robot.links[h].name.clone(), centre(l))));
         let parts: Vec<Body> = members.iter().filter_map(|&l| own[l].clone()).collect();
         let name = &robot.links[h].name;
         let axes = own[h].as_ref().map_or(pose[h].1, |b| b.orientation);
@@ -267,9 +275,15 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
             n => Some(format!("{what} ({n} element{})", if n == 1 { "" } else { "s" })),
         })
         .collect();
-    if merges > 0 {
-        notes.push(format!("{merges} massless or zero-inertia links merged into the links they are fixed to"));
+    if !merges.is_empty() {
+        notes.push(format!("{} links merged into the bodies they are fixed to", merges.len()));
     }
+    let grounded = order[1..].iter().filter(|&&l| head[l] == root);
+    merges.extend(grounded.map(|&l| (l, crate::planar::GROUND.to_string(), None)));
+    let merged = merges
+        .into_iter()
+        .map(|(l, body, centre)| MergedLink { name: robot.links[l].name.clone(), body, centre })
+        .collect();
     let (mut joints, mut joint_names, mut mimics) = (Vec::new(), Vec::new(), Vec::new());
     let mut still = 0;
     for &l in &order[1..] {
@@ -347,7 +361,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
             "{unreachable} revolute limit bounds at or beyond ±π of ranges of a turn or more (no stop: the angle is measured in (−π, π])"
         ));
     }
-    Ok(UrdfRobot { mechanism, joint_names, notes })
+    Ok(UrdfRobot { mechanism, joint_names, notes, merged })
 }
 
 /// A link's `<visual>` boxes, cylinders and spheres (a capsule as the

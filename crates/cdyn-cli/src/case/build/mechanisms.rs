@@ -25,7 +25,7 @@ impl Scenario {
         gravity: [f64; 3],
     ) -> Result<(cdyn::Result<cdyn::spatial::Mechanism>, Counts)> {
         let mut robot = cdyn::spatial::Mechanism::default();
-        let (mut joint_names, mut notes) = (Vec::new(), Vec::new());
+        let (mut joint_names, mut notes, mut merged) = (Vec::new(), Vec::new(), Vec::new());
         match self.model.pendulum_keys.get("urdf") {
             None => {}
             Some(toml::Value::String(name)) => {
@@ -33,7 +33,7 @@ impl Scenario {
                 let text = read_bounded(&path).map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
                 let read = cdyn::spatial::read_urdf(&text, gravity)
                     .map_err(|e| anyhow!("{file}: [model] urdf = {name:?}: {e}"))?;
-                (robot, joint_names) = (read.mechanism, read.joint_names);
+                (robot, joint_names, merged) = (read.mechanism, read.joint_names, read.merged);
                 if robot.bodies.is_empty() {
                     bail!(
                         "{file}: [model] urdf = {name:?}: no link but the root (the fixed base) has a mass: nothing moves"
@@ -66,7 +66,7 @@ impl Scenario {
         let actuators = counts.actuated_joints(&entries.actuators, &joints, file)?;
         let mut bodies = robot.bodies;
         bodies.extend(entries.bodies);
-        let mechanism = cdyn::spatial::Mechanism::named(bodies, joints, entries.forces, gravity)
+        let mechanism = cdyn::spatial::Mechanism::named_with_links(bodies, joints, entries.forces, gravity, &merged)
             .map(|m| m.with_couplings(couplings).with_actuators(actuators));
         Ok((mechanism, counts))
     }
