@@ -11,7 +11,7 @@ use crate::limit::JointLimit;
 use std::collections::HashMap;
 
 /// A part of a body that joints and loads may name as if it were a body:
-/// a URDF link welded to another link's body ([`super::UrdfRobot::merged`]).
+/// a URDF link welded to another link's body (`UrdfRobot::merged`, feature `urdf`).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct MergedLink {
