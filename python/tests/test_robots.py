@@ -253,7 +253,7 @@ def test_panda_at_its_zero_pose_is_refused_past_joint_4s_limit():
         cdyn.run(scenario)
 
 
-# example-robot-data 6.0.0 holds 69 URDF files; 59 load. A handful of each
+# example-robot-data 6.0.0 holds 69 URDF files; 60 load. A handful of each
 # kind, with what cdyn counts as their joints (revolute and prismatic,
 # a <mimic> one included) against Pinocchio's.
 LOADS = [
@@ -266,10 +266,11 @@ LOADS = [
     "double_pendulum_description/urdf/double_pendulum.urdf",
     "talos_data/robots/talos_left_arm.urdf",
     "tiago_description/robots/tiago.urdf",
+    "pr2_description/urdf/pr2.urdf",  # links of unphysical inertia welded into physical bodies
 ]
 REFUSED = [
     ("human_description/robots/human.urdf", 'link "left_upperleg_virtual": has no mass'),
-    ("pr2_description/urdf/pr2.urdf", 'link "head_plate_frame": inertia is not physical'),
+    ("romeo_description/urdf/romeo_small.urdf", 'link "RShoulderYawLink": inertia is not physical'),
     ("ur_description/urdf/ur3.urdf", "no root link (the joints form a loop)"),
     ("icub_description/robots/icub.urdf", "not a valid URDF: custom: missing field `filename`"),
 ]
