@@ -46,6 +46,13 @@ const H: f64 = 1e-3;
 
 fn rod(limit: &str) -> String {
     let (s, c) = (PHI0.sin(), PHI0.cos());
+    let orientation = [(PHI0 / 2.0).cos(), 0.0, (PHI0 / 2.0).sin(), 0.0];
+    rod_at(limit, [-L * s, 0.0, -L * c], orientation, "")
+}
+
+/// The rod of [`rod`] built at `position` and `orientation`, with `more`
+/// sections (an `[initial]`) before its body.
+fn rod_at(limit: &str, [x, y, z]: [f64; 3], [q0, q1, q2, q3]: [f64; 4], more: &str) -> String {
     format!(
         r#"
 [model]
@@ -56,13 +63,13 @@ gravity = [0.0, 0.0, -{G}]
 scheme = "rk4"
 h = {H}
 t_end = 1.0
-
+{more}
 [[bodies]]
 name = "rod"
 mass = {M}
 inertia = [0.02, {JYY}, 0.005]
-position = [{x}, 0.0, {z}]
-orientation = [{q0}, 0.0, {q2}, 0.0]
+position = [{x}, {y}, {z}]
+orientation = [{q0}, {q1}, {q2}, {q3}]
 
 [[joints]]
 kind = "revolute"
@@ -71,11 +78,7 @@ b = "ground"
 point = [0.0, 0.0, 0.0]
 axis = [0.0, 1.0, 0.0]
 limit = {limit}
-"#,
-        x = -L * s,
-        z = -L * c,
-        q0 = (PHI0 / 2.0).cos(),
-        q2 = (PHI0 / 2.0).sin(),
+"#
     )
 }
 
@@ -341,36 +344,8 @@ fn bad_planar_limits_get_one_line_naming_the_file_and_the_joint() {
 /// back, inside its range, meeting no stop.
 #[test]
 fn a_rods_angle_in_a_range_across_pi_is_reported_in_that_range_without_a_jump() {
-    let text = format!(
-        r#"
-[model]
-kind = "spatial"
-gravity = [0.0, 0.0, -{G}]
-
-[integrator]
-scheme = "rk4"
-h = {H}
-t_end = 1.0
-
-[initial]
-joints = {{ "joints[0]" = 2.5 }}
-
-[[bodies]]
-name = "rod"
-mass = {M}
-inertia = [0.02, {JYY}, 0.005]
-position = [0.0, 0.0, {L}]
-orientation = [0.0, 0.0, 1.0, 0.0]
-
-[[joints]]
-kind = "revolute"
-a = "rod"
-b = "ground"
-point = [0.0, 0.0, 0.0]
-axis = [0.0, 1.0, 0.0]
-limit = {{ lower = 2.0, upper = 4.5 }}
-"#
-    );
+    let initial = "\n[initial]\njoints = { \"joints[0]\" = 2.5 }\n";
+    let text = rod_at("{ lower = 2.0, upper = 4.5 }", [0.0, 0.0, L], [0.0, 0.0, 1.0, 0.0], initial);
     let (stdout, (header, rows), case) = run(&text, &[]);
     assert!(stdout.contains("limits: 0 impacts, 0 releases"), "{stdout}");
     let q = column(&header, "joints[0].q");
