@@ -42,8 +42,7 @@ impl Mechanism {
         let coordinate = self.coordinate(actuator.joint, poses)?;
         let limit = self.joints[actuator.joint].limit;
         let effort = limit.map_or(f64::INFINITY, |l| l.effort);
-        let range = limit.filter(|l| coordinate.rotary && l.within_a_turn());
-        Ok(JointActuator { law: actuator.law(effort)?, coordinate, range })
+        Ok(JointActuator { law: actuator.law(effort)?, coordinate, range: coordinate.range(limit) })
     }
 
     /// The reader of the torque each actuator applies (see

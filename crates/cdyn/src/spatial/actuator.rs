@@ -152,11 +152,7 @@ impl JointActuator {
             Drive::Torque(f) => f.eval(t),
             Drive::Servo { target, rate, kp, kd } => {
                 let error = match self.range {
-                    Some(range) => {
-                        // θ read in (−π, π], shifted by whole turns into the range.
-                        let theta = self.coordinate.at(x, self.sides::<K>(), D::zero());
-                        theta + (range.unwrap_angle(theta.re()) - theta.re()) - target.eval(t)
-                    }
+                    Some(_) => self.coordinate.in_range(x, self.sides::<K>(), self.range) - target.eval(t),
                     None => self.coordinate.at(x, self.sides::<K>(), target.eval(t)),
                 };
                 (rate.eval(t) - self.rate(x, xd)) * *kd - error * *kp

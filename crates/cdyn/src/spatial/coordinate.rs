@@ -27,6 +27,27 @@ pub(crate) struct JointCoordinate {
 }
 
 impl JointCoordinate {
+    /// The range a revolute joint's angle is read in: its `limit`, where
+    /// that is shorter than a turn ([`JointLimit::within_a_turn`]).
+    pub(super) fn range(&self, limit: Option<JointLimit>) -> Option<JointLimit> {
+        limit.filter(|l| self.rotary && l.within_a_turn())
+    }
+
+    /// `θ` read in `(−π, π]` ([`at`](Self::at) from 0), shifted by whole
+    /// turns into `range` if there is one: its derivatives are unchanged.
+    pub(super) fn in_range<D: Scalar, const K: usize>(
+        &self,
+        x: &[D; K],
+        sides: [Option<usize>; 2],
+        range: Option<JointLimit>,
+    ) -> D {
+        let theta = self.at(x, sides, D::zero());
+        match range {
+            Some(range) => theta + (range.unwrap_angle(theta.re()) - theta.re()),
+            None => theta,
+        }
+    }
+
     /// `θ − reference` at the sides' poses; for an angle, wrapped into
     /// `(−π, π]`, so that a reference near ±π is met without a jump.
     ///
@@ -119,9 +140,12 @@ impl JointSpace {
     pub(super) fn new(
         read: impl IntoIterator<Item = (usize, JointCoordinate, usize, Option<usize>, Option<JointLimit>)>,
     ) -> Self {
-        let read = read.into_iter().map(|(joint, coordinate, a, b, limit)| {
-            let range = limit.filter(|l| coordinate.rotary && l.within_a_turn());
-            Readable { joint, coordinate, a, b, range }
+        let read = read.into_iter().map(|(joint, coordinate, a, b, limit)| Readable {
+            joint,
+            coordinate,
+            a,
+            b,
+            range: coordinate.range(limit),
         });
         Self { read: read.collect() }
     }
@@ -140,8 +164,7 @@ impl JointSpace {
         let r = &self.read[i];
         let body = |k: usize| SpatialBody::of(if k < 7 { r.a } else { r.b.unwrap_or(r.a) }).first + k % 7;
         let x: [Dual2_64; 14] = std::array::from_fn(|k| Dual2_64::new(q[body(k)], v[body(k)], a[body(k)]));
-        let theta = r.coordinate.at(&x, [Some(0), r.b.map(|_| 1)], Dual2_64::from(0.0));
-        let angle = r.range.map_or(theta.re, |range| range.unwrap_angle(theta.re));
-        [angle, theta.v1, theta.v2]
+        let theta = r.coordinate.in_range(&x, [Some(0), r.b.map(|_| 1)], r.range);
+        [theta.re, theta.v1, theta.v2]
     }
 }

@@ -280,7 +280,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
     }
     let grounded = order[1..].iter().filter(|&&l| head[l] == root);
     merges.extend(grounded.map(|&l| (l, crate::planar::GROUND.to_string(), None)));
-    let merged = merges
+    let merged_links = merges
         .into_iter()
         .map(|(l, body, centre)| MergedLink { name: robot.links[l].name.clone(), body, centre })
         .collect();
@@ -361,7 +361,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
             "{unreachable} revolute limit bounds at or beyond ±π of ranges of a turn or more (no stop: the angle is measured in (−π, π])"
         ));
     }
-    Ok(UrdfRobot { mechanism, joint_names, notes, merged })
+    Ok(UrdfRobot { mechanism, joint_names, notes, merged: merged_links })
 }
 
 /// A link's `<visual>` boxes, cylinders and spheres (a capsule as the

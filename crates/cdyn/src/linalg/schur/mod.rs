@@ -171,7 +171,7 @@ impl Schur {
             LinearSolver::Auto if m >= SPARSE_FROM => analyse(),
             LinearSolver::Auto if fewest_below => {
                 let sparse = analyse();
-                if sparse.row_idx.len() < m * (m - 1) / 2 { sparse } else { Structure::dense(m) }
+                if below_triangle(sparse.row_idx.len(), m) { sparse } else { Structure::dense(m) }
             }
             LinearSolver::Auto => Structure::dense(m),
         };
@@ -277,8 +277,14 @@ impl Schur {
 
     /// Whether `L`'s pattern has fewer entries than the full triangle.
     pub fn is_sparse(&self) -> bool {
-        self.lower.len() < self.m * self.m.saturating_sub(1) / 2
+        below_triangle(self.lower.len(), self.m)
     }
+}
+
+/// Whether `entries` strictly-lower entries of `L` are fewer than the full
+/// triangle of `m` rows has.
+fn below_triangle(entries: usize, m: usize) -> bool {
+    entries < m * m.saturating_sub(1) / 2
 }
 
 /// The most right-hand sides [`Schur::solve_many`] takes at once.
