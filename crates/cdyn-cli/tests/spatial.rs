@@ -80,7 +80,7 @@ fn a_spatial_runs_page_and_gif_animate_it_in_3d() {
     assert!(!std::fs::read_to_string(out.join("report.html")).unwrap().contains("CDYN_3D"));
     gif_moves(&out.join("animation.gif"), 21);
 
-    // The URDF arm: its links' own primitives, the massless tool's sphere on the hand.
+    // The URDF arm: its links' own primitives, the massless tool's sphere on the hand, the base's on the ground.
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let out = dir.join("arm");
     let r = cdyn(&["run", path_str(&examples.join("arm.urdf")), "--out", path_str(&out), "--html"]);
@@ -93,6 +93,11 @@ fn a_spatial_runs_page_and_gif_animate_it_in_3d() {
         .collect();
     assert_eq!(counts, [(18, 0, true), (6, 0, true), (0, 1, true)], "cylinder, box, sphere");
     assert_eq!(bodies[2]["spheres"][0]["radius"].as_f64(), Some(0.05));
+    // The base's cylinder on the ground, in space: its top at z = 0.1.
+    let ground = &data["sketch"]["ground"]["faces"];
+    assert_eq!(ground.as_array().unwrap().len(), 18, "{ground}");
+    let top = ground.as_array().unwrap().iter().find(|f| f["normal"][2].as_f64() == Some(1.0)).unwrap();
+    assert!(top["corners"].as_array().unwrap().iter().all(|c| (c[2].as_f64().unwrap() - 0.1).abs() < 1e-15), "{top}");
 }
 
 /// The GIF at `path` has `n` frames of 480 × 360 pixels, and many pixels change between the first and the middle one.

@@ -543,3 +543,47 @@ fn the_arm_started_at_given_joint_angles_and_rates_reads_them_back() {
     let error = mechanism.state_at_joints(&[(mechanism.joints.len(), 0.1)], &[]).unwrap_err().to_string();
     assert!(error.contains("joint"), "{error}");
 }
+
+#[test]
+fn a_base_welded_to_the_root_is_part_of_the_ground_and_drawn_there() {
+    use cdyn::spatial::Shape;
+    // world → (fixed, 0.2 up, turned 1 rad about z) → base, 4 kg, a box
+    // 0.1 out along its x; base → (fixed) → plate, 6 kg, only a mesh; the
+    // block swings on a revolute joint from the base.
+    let base = r#"<link name="world"/>
+        <joint name="mount" type="fixed"><parent link="world"/><child link="base"/><origin xyz="0 0 0.2" rpy="0 0 1"/></joint>
+        <link name="base"><inertial><mass value="4"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+          <visual><origin xyz="0.1 0 0"/><geometry><box size="0.3 0.2 0.1"/></geometry></visual></link>
+        <joint name="bolt" type="fixed"><parent link="base"/><child link="plate"/><origin xyz="0 0 -0.1"/></joint>
+        <link name="plate"><inertial><mass value="6"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial>
+          <visual><geometry><mesh filename="plate.stl"/></geometry></visual></link>"#;
+    let massless = one_joint("revolute", "0 1 0", "", "");
+    let text = massless
+        .replace(r#"<link name="base"/>"#, base)
+        .replace(r#"<parent link="base"/><child link="block"/>"#, r#"<parent link="plate"/><child link="block"/>"#);
+    let robot = cdyn::spatial::read_urdf(&text, [0.0, 0.0, -G]).unwrap();
+    let m = &robot.mechanism;
+    assert_eq!(m.bodies.iter().map(|b| b.name.as_str()).collect::<Vec<_>>(), ["block"]);
+    assert_eq!((m.joints.len(), m.joints[0].b), (1, None), "the block's joint is to the ground");
+    let grounded: Vec<(&str, &str)> = robot.merged.iter().map(|l| (l.name.as_str(), l.body.as_str())).collect();
+    assert_eq!(grounded, [("base", "ground"), ("plate", "ground")]);
+    // On the ground, in space: the base's box, turned with it; the plate's
+    // box of uniform density with its inertia (sides² = 6 (J₂ + J₃ − J₁) / m
+    // and cyclically: 0.04, 0.02, 0), at its centre.
+    let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+    let [boxed, plate] = &m.ground[..] else { panic!("{:?}", m.ground) };
+    assert_eq!(boxed.shape, Shape::Box { size: [0.3, 0.2, 0.1] });
+    assert!(close(&boxed.position, &[0.1 * 1f64.cos(), 0.1 * 1f64.sin(), 0.2]), "{boxed:?}");
+    assert!(close(&boxed.orientation, &[0.5f64.cos(), 0.0, 0.0, 0.5f64.sin()]), "{boxed:?}");
+    let Shape::Box { mut size } = plate.shape else { panic!("{plate:?}") };
+    size.sort_by(f64::total_cmp);
+    assert!(close(&size, &[0.0, 0.02f64.sqrt(), 0.2]) && close(&plate.position, &[0.0, 0.0, 0.1]), "{plate:?}");
+    assert_eq!(m.sketch().ground, m.ground);
+    // Nothing of the base moves, so its masses change nothing: the same
+    // motion, to the bit, as with a massless base and plate.
+    let weightless = text
+        .replace(r#"<inertial><mass value="4"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>"#, "")
+        .replace(r#"<inertial><mass value="6"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial>"#, "");
+    assert_eq!(from_urdf(&weightless, [0.0; 3]).unwrap().bodies.len(), 1);
+    assert_eq!(joint_after(&text, 0.5, 1e-3), joint_after(&weightless, 0.5, 1e-3));
+}

@@ -1,6 +1,6 @@
 //! `animation.gif` of a spatial run: each frame drawn as the page draws it
 //! from the default view ([`YAW`], [`PITCH`]) — the
-//! floor's edges, the bodies' solids shaded and painted far to near, then on top
+//! floor's edges, the bodies' and the ground's solids shaded and painted far to near, then on top
 //! the skeleton: lines from each centre of mass to its joints' points,
 //! joints, rods, ground points, and each body's axes (x red, y green, z
 //! blue) at its centre of mass.
@@ -19,6 +19,9 @@ pub fn write(path: &Path, sketch: &Sketch, frames: &Frames) -> Result<()> {
     let camera = Camera::new(&scene, YAW, PITCH, 1.0, SIZE);
     encode(path, frames, |area, q, t| draw(area, sketch, &scene, &camera, q, t).map_err(|e| anyhow!("{e:?}")))
 }
+
+/// The ground's colour (a robot's base).
+const GROUND: RGBColor = RGBColor(0xaa, 0xaa, 0xaa);
 
 /// A pixel of a projected point.
 fn px(p: [f64; 2]) -> (i32, i32) {
@@ -60,13 +63,16 @@ fn draw(
     }
     // The solids, far to near.
     let mut paints: Vec<(f64, Paint)> = Vec::new();
-    for (b, (limb, solid)) in sketch.bodies.iter().zip(&scene.solids).enumerate() {
-        let (r, p) = (limb.at.position(q), limb.at.orientation(q));
+    let bodies =
+        sketch.bodies.iter().zip(&scene.solids).enumerate().map(|(b, (limb, solid))| {
+            ((limb.at.position(q), limb.at.orientation(q)), solid, COLOURS[b % COLOURS.len()])
+        });
+    let ground = (([0.0; 3], [1.0, 0.0, 0.0, 0.0]), &scene.ground, GROUND);
+    for ((r, p), solid, colour) in bodies.chain(std::iter::once(ground)) {
         let to_space = |x: [f64; 3]| -> [f64; 3] {
             let y = rotate(p, x);
             std::array::from_fn(|i| r[i] + y[i])
         };
-        let colour = COLOURS[b % COLOURS.len()];
         for face in &solid.faces {
             let corners: Vec<[f64; 3]> = face.corners.iter().map(|&x| to_space(x)).collect();
             let normal = rotate(p, face.normal);

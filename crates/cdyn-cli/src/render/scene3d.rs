@@ -36,11 +36,23 @@ pub struct Solid {
     pub spheres: Vec<([f64; 3], f64)>,
 }
 
+impl Solid {
+    /// Its faces and spheres as the page's data.
+    fn json(&self) -> Value {
+        json!({
+            "faces": self.faces.iter().map(|f| json!({ "corners": f.corners, "normal": f.normal })).collect::<Vec<_>>(),
+            "spheres": self.spheres.iter().map(|(c, r)| json!({ "centre": c, "radius": r })).collect::<Vec<_>>(),
+        })
+    }
+}
+
 /// What the run shows: the bodies' solids, and the sphere around every frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     /// One per body of the sketch.
     pub solids: Vec<Solid>,
+    /// The ground's, in space.
+    pub ground: Solid,
     /// Centre of the sphere around the bodies and joints in every frame.
     pub centre: [f64; 3],
     /// Its radius.
@@ -69,27 +81,27 @@ impl Scene {
                 take(sketch.place(q, anchor));
             }
         }
+        for v in &sketch.ground {
+            take(v.position);
+        }
         if !lo[0].is_finite() {
             (lo, hi) = ([-1.0; 3], [1.0; 3]);
         }
         let centre = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
         let half = (0..3).map(|i| (0.5 * (hi[i] - lo[i])).powi(2)).sum::<f64>().sqrt();
         // The shapes reach beyond the points: a body alone is at least its own size.
-        let size = sketch.bodies.iter().flat_map(|l| &l.shapes).map(extent).fold(0.0, f64::max);
+        let size = sketch.bodies.iter().flat_map(|l| &l.shapes).chain(&sketch.ground).map(extent).fold(0.0, f64::max);
         let radius = (half + 0.5 * size).max(1e-6);
         let smallest = SMALLEST * radius;
-        let solids = sketch
-            .bodies
-            .iter()
-            .map(|limb| {
-                let mut solid = Solid::default();
-                for v in &limb.shapes {
-                    add(&mut solid, v, smallest);
-                }
-                solid
-            })
-            .collect();
-        Scene { solids, centre, radius, floor: lo[2] }
+        let solid = |shapes: &[Visual]| {
+            let mut solid = Solid::default();
+            for v in shapes {
+                add(&mut solid, v, smallest);
+            }
+            solid
+        };
+        let solids = sketch.bodies.iter().map(|limb| solid(&limb.shapes)).collect();
+        Scene { solids, ground: solid(&sketch.ground), centre, radius, floor: lo[2] }
     }
 
     /// The scene and the sketch's bodies and joints as the page's data.
@@ -99,14 +111,12 @@ impl Scene {
             .iter()
             .zip(&self.solids)
             .map(|(limb, solid)| {
-                json!({
-                    "name": limb.name,
-                    "first": limb.at.first,
-                    "points": limb.points,
-                    "shaped": limb.shaped,
-                    "faces": solid.faces.iter().map(|f| json!({ "corners": f.corners, "normal": f.normal })).collect::<Vec<_>>(),
-                    "spheres": solid.spheres.iter().map(|(c, r)| json!({ "centre": c, "radius": r })).collect::<Vec<_>>(),
-                })
+                let mut body = solid.json();
+                body["name"] = json!(limb.name);
+                body["first"] = json!(limb.at.first);
+                body["points"] = json!(limb.points);
+                body["shaped"] = json!(limb.shaped);
+                body
             })
             .collect();
         let joints: Vec<Value> = sketch
@@ -117,6 +127,7 @@ impl Scene {
         json!({
             "bodies": bodies,
             "joints": joints,
+            "ground": self.ground.json(),
             "centre": self.centre,
             "radius": self.radius,
             "grid": self.floor_grid(),
@@ -297,8 +308,25 @@ mod tests {
     }
 
     #[test]
+    fn the_grounds_shapes_are_in_the_scene_and_its_data() {
+        let plate = Visual::new(Shape::Box { size: [0.4, 0.4, 0.1] }, [1.0, 2.0, 0.05], [1.0, 0.0, 0.0, 0.0]);
+        let sketch = Sketch { ground: vec![plate], ..Sketch::default() };
+        let scene = Scene::of(&sketch, &[]);
+        // Alone, the plate is the scene: centred on it, as large as it.
+        let size = (0.4f64 * 0.4 + 0.4 * 0.4 + 0.1 * 0.1).sqrt();
+        assert_eq!((scene.centre, scene.radius), ([1.0, 2.0, 0.05], 0.5 * size));
+        let json = scene.json(&sketch);
+        let faces = json["ground"]["faces"].as_array().unwrap();
+        assert_eq!(faces.len(), 6);
+        // Its faces in space: the top at z = 0.1.
+        let top = faces.iter().find(|f| f["normal"] == json!([0.0, 0.0, 1.0])).unwrap();
+        assert!(top["corners"].as_array().unwrap().iter().all(|c| c[2] == json!(0.1)), "{top}");
+    }
+
+    #[test]
     fn the_camera_sees_the_centre_in_the_middle_and_the_near_face() {
-        let scene = Scene { solids: Vec::new(), centre: [1.0, 2.0, 3.0], radius: 2.0, floor: 0.0 };
+        let scene =
+            Scene { solids: Vec::new(), ground: Solid::default(), centre: [1.0, 2.0, 3.0], radius: 2.0, floor: 0.0 };
         let cam = Camera::new(&scene, YAW, PITCH, 1.0, (400, 300));
         let (p, depth) = cam.project(scene.centre);
         assert!((p[0] - 200.0).abs() < 1e-9 && (p[1] - 150.0).abs() < 1e-9 && (depth - 6.0).abs() < 1e-12);

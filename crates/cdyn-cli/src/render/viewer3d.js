@@ -61,20 +61,22 @@ function drawFrame3d(c, k) {
   ctx.fillText("t = " + fmt(cs.frames.t[k], 4), 8, 16);
   if (q.some((x) => !isFinite(x))) { ctx.fillText("positions not finite", 8, 32); return []; }
   for (const [a, b] of sketch.grid) line(px(a), px(b), "#ddd", 1);
-  // The solids, far to near, faces turned away dropped.
+  // The solids, far to near, faces turned away dropped; the ground's (a robot's base) grey, in space.
   const paints = [];
-  sketch.bodies.forEach((b, i) => {
-    const [r, p] = pose3(b, q), to = (x) => { const y = rotate3(p, x); return [r[0] + y[0], r[1] + y[1], r[2] + y[2]]; };
+  const solids = sketch.bodies.map((b, i) => [b, pose3(b, q), bodyColour(i)]);
+  solids.push([sketch.ground, [[0, 0, 0], [1, 0, 0, 0]], "#aaaaaa"]);
+  solids.forEach(([b, [r, p], colour]) => {
+    const to = (x) => { const y = rotate3(p, x); return [r[0] + y[0], r[1] + y[1], r[2] + y[2]]; };
     for (const f of b.faces) {
       const corners = f.corners.map(to), n = rotate3(p, f.normal);
       if (dot3(n, [0, 1, 2].map((j) => cam.eye[j] - corners[0][j])) <= 0) continue;
       const pr = corners.map((x) => project3(cam, x));
       const depth = pr.reduce((s, x) => s + x[1], 0) / pr.length;
-      paints.push({ depth, face: pr.map((x) => x[0]), colour: shade3(bodyColour(i), 0.45 + 0.55 * Math.abs(dot3(n, cam.light))) });
+      paints.push({ depth, face: pr.map((x) => x[0]), colour: shade3(colour, 0.45 + 0.55 * Math.abs(dot3(n, cam.light))) });
     }
     for (const s of b.spheres) {
       const [centre, depth] = project3(cam, to(s.centre));
-      paints.push({ depth, ball: centre, radius: Math.max(1, cam.focal * s.radius / Math.max(depth, 1e-9)), colour: shade3(bodyColour(i), 0.85) });
+      paints.push({ depth, ball: centre, radius: Math.max(1, cam.focal * s.radius / Math.max(depth, 1e-9)), colour: shade3(colour, 0.85) });
     }
   });
   paints.sort((a, b) => b.depth - a.depth);
@@ -131,5 +133,6 @@ function setView3d(hash) {
   $("view3d").hidden = false;
   $("view3d").textContent = "3-D, perspective, z up: drag to orbit, wheel to zoom, double click for the start view. Bodies as their URDF boxes, cylinders and spheres" +
     (drawn.length ? "; " + drawn.join(", ") + " as the box of uniform density with its inertia" : "") +
+    (sketch.ground.faces.length + sketch.ground.spheres.length ? "; the ground's parts (a base) grey" : "") +
     "; a dark line from each centre of mass to each joint point, joints as white rings, ground points as black squares, body axes x red, y green, z blue.";
 }

@@ -27,5 +27,13 @@ pub fn chain(n: usize, theta0: f64, g: f64) -> Mechanism {
         })
         .collect();
     let joints = (0..n).map(|i| Joint::new(JointKind::Spherical, i, i.checked_sub(1), end(i))).collect();
-    Mechanism { bodies, joints, gravity: [0.0, 0.0, -g], loads: vec![], couplings: vec![], actuators: vec![] }
+    Mechanism {
+        bodies,
+        joints,
+        gravity: [0.0, 0.0, -g],
+        loads: vec![],
+        couplings: vec![],
+        actuators: vec![],
+        ground: vec![],
+    }
 }

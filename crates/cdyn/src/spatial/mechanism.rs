@@ -8,6 +8,7 @@ use super::joint::{Joint, JointKind};
 use super::load::Load;
 use super::placing::{add_joint, add_load, joint_frames};
 use super::rotation::rate_from_body;
+use super::visual::Visual;
 use crate::ad::scalar::Scalar;
 use crate::error::{Part, Problem, Result};
 use crate::limit::Stop;
@@ -50,6 +51,9 @@ pub struct Mechanism {
     pub couplings: Vec<Coupling>,
     /// Torques (forces) on revolute (prismatic) joints.
     pub actuators: Vec<Actuator>,
+    /// What the ground looks like in 3-D views: shapes placed in space (a
+    /// robot's base, welded to the ground, is part of it).
+    pub ground: Vec<Visual>,
 }
 
 /// A `<mimic>` coupling, one constraint row: joint `follower`'s coordinate
@@ -122,6 +126,8 @@ crate::setters!(Mechanism {
     with_couplings => couplings: Vec<Coupling>,
     /// With these joint actuators.
     with_actuators => actuators: Vec<Actuator>,
+    /// With these shapes drawn on the ground (in space).
+    with_ground => ground: Vec<Visual>,
 });
 
 impl Mechanism {

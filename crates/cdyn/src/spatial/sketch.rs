@@ -39,6 +39,8 @@ pub struct Sketch {
     pub bodies: Vec<Limb>,
     /// Each joint's two points (the same place for all but distance joints).
     pub joints: Vec<[Anchor; 2]>,
+    /// The ground's shapes, in space ([`Mechanism::ground`]).
+    pub ground: Vec<Visual>,
 }
 
 impl Sketch {
@@ -90,6 +92,6 @@ impl Mechanism {
             .iter()
             .map(|j| [anchor(Some(j.a), j.point), anchor(j.b, j.point_b.unwrap_or(j.point))])
             .collect();
-        Sketch { bodies, joints }
+        Sketch { bodies, joints, ground: self.ground.clone() }
     }
 }

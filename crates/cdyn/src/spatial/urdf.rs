@@ -15,12 +15,11 @@
 //! A link welded by a `fixed` joint to a link that moves is merged into
 //! that link's body (its mass, centre of mass and inertia added to the
 //! body's): one rigid body, not two held together by six rows (Kinova's
-//! fingers, Panda's hand). A link welded to the root is part of the ground
-//! if it cannot be a body on its own — no mass, or an inertia that is not
-//! positive definite and physical (a sensor frame, a point mass) — and
-//! otherwise keeps its own body, which its visuals are drawn on (a base
-//! link). Joints and loads of a scenario may name a merged link
-//! ([`UrdfRobot::merged`]). Refused, with the element named: a moved
+//! fingers, Panda's hand). A link welded to the root (a base link) is part
+//! of the ground, as Pinocchio and MuJoCo take it; its visuals, or the box
+//! of its inertia if it has none but meshes, are drawn on the ground
+//! ([`Mechanism::ground`]). Joints and loads of a scenario may name a
+//! merged link ([`UrdfRobot::merged`]). Refused, with the element named: a moved
 //! link that has no mass or no usable inertia even then, `planar` and
 //! `spherical` joints, a `<mimic>` of a joint that is not revolute or
 //! prismatic, a zero axis on a moving joint, and several root links.
@@ -46,6 +45,9 @@ use std::collections::HashMap;
 
 /// A pose: position and unit quaternion.
 type Pose = ([f64; 3], [f64; 4]);
+
+/// Space's own axes, as a pose.
+const SPACE: Pose = ([0.0; 3], [1.0, 0.0, 0.0, 0.0]);
 
 /// `R = Rz(yaw) Ry(pitch) Rx(roll)`, URDF's convention, as a quaternion.
 fn rpy([roll, pitch, yaw]: [f64; 3]) -> [f64; 4] {
@@ -203,7 +205,7 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         }
     };
     // Link poses at zero joint positions, parents first.
-    let mut pose: Vec<Pose> = vec![([0.0; 3], [1.0, 0.0, 0.0, 0.0]); robot.links.len()];
+    let mut pose: Vec<Pose> = vec![SPACE; robot.links.len()];
     let mut order = vec![root];
     let mut next = 0;
     while next < order.len() {
@@ -222,18 +224,13 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
         .into());
     }
     // Which link's body each link joins (`head`): its own, unless it is
-    // fixed to its parent and cannot be a body alone, or its parent's
-    // head cannot; the root's is the ground.
+    // fixed to its parent, whose head it joins; the root's is the ground.
     let own: Vec<Option<Body>> = robot.links.iter().zip(&pose).map(|(l, &p)| own_body(l, p)).collect();
-    let usable = |l: usize| own[l].as_ref().is_some_and(|b| b.check().is_ok());
     let mut head: Vec<usize> = (0..robot.links.len()).collect();
     for &l in &order[1..] {
         let j = &robot.joints[parent_joint[l].expect("not the root")];
-        let up = head[link_index[j.parent.link.as_str()]];
-        // A moving body takes all that is welded to it; the ground what cannot be a body.
-        let merge = up != root || !usable(l);
-        if j.joint_type == urdf_rs::JointType::Fixed && merge {
-            head[l] = up;
+        if j.joint_type == urdf_rs::JointType::Fixed {
+            head[l] = head[link_index[j.parent.link.as_str()]];
         }
     }
     let mut bodies = Vec::new();
@@ -346,15 +343,27 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
             }
         })
         .collect::<Result<Vec<_>>>()?;
-    // What each link looks like, on the body it joins (none on the ground's).
-    for &l in &order[1..] {
-        if let Some(b) = body_of[head[l]] {
-            let body = (bodies[b].position, bodies[b].orientation);
-            let at = pose[l];
-            bodies[b].visuals.extend(visuals(&robot.links[l]).map(|(v, origin)| v.into_body(then(at, origin), body)));
+    // What each link looks like, on the body it joins or on the ground (in
+    // space; a base link drawn only by meshes as the box of its inertia).
+    let mut ground = Vec::new();
+    for &l in &order {
+        let at = |(v, origin): (Visual, &urdf_rs::Pose), body| v.into_body(then(pose[l], origin), body);
+        match body_of[head[l]] {
+            Some(b) => {
+                let body = (bodies[b].position, bodies[b].orientation);
+                bodies[b].visuals.extend(visuals(&robot.links[l]).map(|v| at(v, body)));
+            }
+            None => {
+                let before = ground.len();
+                ground.extend(visuals(&robot.links[l]).map(|v| at(v, SPACE)));
+                if let Some(b) = own[l].as_ref().filter(|b| ground.len() == before && b.check().is_ok()) {
+                    ground.push(Visual::of_inertia(b.mass, &b.inertia).into_body((b.position, b.orientation), SPACE));
+                }
+            }
         }
     }
-    let mechanism = Mechanism::new(gravity).with_bodies(bodies).with_joints(joints).with_couplings(couplings);
+    let mechanism =
+        Mechanism::new(gravity).with_bodies(bodies).with_joints(joints).with_couplings(couplings).with_ground(ground);
     let unreachable = mechanism.unreachable_limits();
     if unreachable > 0 {
         notes.push(format!(

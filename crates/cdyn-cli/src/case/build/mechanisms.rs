@@ -67,7 +67,7 @@ impl Scenario {
         let mut bodies = robot.bodies;
         bodies.extend(entries.bodies);
         let mechanism = cdyn::spatial::Mechanism::named_with_links(bodies, joints, entries.forces, gravity, &merged)
-            .map(|m| m.with_couplings(couplings).with_actuators(actuators));
+            .map(|m| m.with_couplings(couplings).with_actuators(actuators).with_ground(robot.ground));
         Ok((mechanism, counts))
     }
 
