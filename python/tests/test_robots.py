@@ -253,7 +253,7 @@ def test_panda_at_its_zero_pose_is_refused_past_joint_4s_limit():
         cdyn.run(scenario)
 
 
-# example-robot-data 6.0.0 holds 69 URDF files; 60 load. A handful of each
+# example-robot-data 6.0.0 holds 69 URDF files; 59 load. A handful of each
 # kind, with what cdyn counts as their joints (revolute and prismatic,
 # a <mimic> one included) against Pinocchio's.
 LOADS = [

@@ -346,6 +346,13 @@ fn bad_urdf_references_get_one_line_naming_the_file_and_element() {
             &["joints[0] (distance): a = \"palm\": no body of that name"],
         ),
         (
+            "still",
+            // Every joint welded: the links with a mass join the fixed base.
+            arm.replace("type=\"revolute\"", "type=\"fixed\"").replace("type=\"continuous\"", "type=\"fixed\""),
+            scenario_text.clone(),
+            &["nothing moves: every link with a mass is the root or welded to it"],
+        ),
+        (
             "key",
             arm.clone(),
             scenario_text.replace("urdf = \"arm.urdf\"", "urdf = \"arm.urdf\"\nscale = 2.0"),

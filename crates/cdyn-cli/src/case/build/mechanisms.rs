@@ -36,7 +36,7 @@ impl Scenario {
                 (robot, joint_names, merged) = (read.mechanism, read.joint_names, read.merged);
                 if robot.bodies.is_empty() {
                     bail!(
-                        "{file}: [model] urdf = {name:?}: no link but the root (the fixed base) has a mass: nothing moves"
+                        "{file}: [model] urdf = {name:?}: nothing moves: every link with a mass is the root or welded to it (the fixed base)"
                     );
                 }
                 if !read.notes.is_empty() {
