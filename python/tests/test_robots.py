@@ -273,6 +273,7 @@ REFUSED = [
     ("romeo_description/urdf/romeo_small.urdf", 'link "RShoulderYawLink": inertia is not physical'),
     ("ur_description/urdf/ur3.urdf", "no root link (the joints form a loop)"),
     ("icub_description/robots/icub.urdf", "not a valid URDF: custom: missing field `filename`"),
+    ("iris_description/robots/iris_simple.urdf", "no body moves"),  # every link welded to the root
 ]
 
 

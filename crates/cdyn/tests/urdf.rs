@@ -586,4 +586,10 @@ fn a_base_welded_to_the_root_is_part_of_the_ground_and_drawn_there() {
         .replace(r#"<inertial><mass value="6"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial>"#, "");
     assert_eq!(from_urdf(&weightless, [0.0; 3]).unwrap().bodies.len(), 1);
     assert_eq!(joint_after(&text, 0.5, 1e-3), joint_after(&weightless, 0.5, 1e-3));
+    // With the block welded too, nothing moves: refused, saying so.
+    let still = from_urdf(&text.replace(r#"type="revolute""#, r#"type="fixed""#), [0.0; 3]).unwrap();
+    assert!(still.bodies.is_empty() && still.ground.len() == 3, "the block drawn on the ground too");
+    let Err(error) = still.build() else { panic!("nothing moves, yet it built") };
+    let error = error.to_string();
+    assert!(error.contains("no body moves") && !error.contains('\n'), "{error}");
 }

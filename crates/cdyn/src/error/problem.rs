@@ -32,6 +32,12 @@ pub enum Problem {
     /// A model without coordinates.
     #[error("a model needs at least one coordinate")]
     NoCoordinates,
+    /// A spatial mechanism without bodies (a URDF whose links are all
+    /// welded to its root).
+    #[error(
+        "no body moves: a spatial mechanism needs at least one (a URDF's links with a mass welded to its root are part of the ground)"
+    )]
+    NoBodies,
     /// More coordinates or Jacobian entries than 32-bit indices can hold.
     #[error("{n} coordinates and {nnz} Jacobian entries: at most 2³² − 1 of each are supported")]
     TooLarge {

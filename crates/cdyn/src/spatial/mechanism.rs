@@ -146,6 +146,9 @@ impl Mechanism {
     /// [`Mechanism::build`] with the stops `held` as rows `g = 0` after all
     /// others, in that order (see [`Mechanism::stops`]).
     pub fn build_holding(&self, held: &[Stop]) -> Result<Built> {
+        if self.bodies.is_empty() {
+            return Err(Problem::NoBodies.into());
+        }
         let n = 7 * self.bodies.len();
         let mut mass = vec![0.0; n];
         let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
