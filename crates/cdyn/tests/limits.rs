@@ -394,3 +394,55 @@ fn multi_turn_limits_read_from_the_state_alone_are_in_the_range_nearest_0_or_the
     // A joint that does not exist is refused.
     assert!(stops.clone().starting_at(&[(1, 0.0)]).is_err());
 }
+
+#[test]
+fn multi_turn_limits_keep_their_turn_across_a_state_set_between_steps() {
+    // The finger of the test above, stepped to 2 s (θ = 4.0, read −2.28 in
+    // (−π, π]) and put at its own state: read from the state alone its
+    // upper gap would be 6.28 + 2.28, and 6.28 missed; set between steps,
+    // it is taken nearest the run's, 2.28, and the stop met at 3.14 s.
+    let (lower, upper) = FINGER;
+    let mut mechanism = pendulum_at(0.0, JointLimit::new(lower, upper));
+    mechanism.gravity = [0.0; 3];
+    let (q0, v0) = mechanism.state_at_joints(&[], &[(0, 2.0)]).unwrap();
+    let system = MechanismStops::new(mechanism).unwrap();
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+    let mut run = cdyn::stops::StopSimulation::new(&system, settings, &q0, &v0).unwrap();
+    while run.steps() < 2000 {
+        run.step().unwrap();
+    }
+    let (q, v, e) = run.simulation(|s| (s.q().to_vec(), s.v().to_vec(), s.energy_input()));
+    run.set_state(&q, &v, e).unwrap();
+    while run.steps() < 3500 {
+        run.step().unwrap();
+    }
+    let [Event { stop: 1, t, change: Change::Impact { held: true, .. }, .. }, ..] = run.report().events[..] else {
+        panic!("{:?}", run.report().events)
+    };
+    assert!((t - upper / 2.0).abs() < 1e-9, "stopped at {t}");
+}
+
+#[test]
+fn multi_turn_limits_an_elastic_finger_rebounds_from_one_stop_through_pi_to_the_other() {
+    // e = 1: thrown back from 6.28 at 3.14 s, the finger turns down the
+    // whole range, 8.9 rad, through π and 0 onto −2.62. The rebound starts
+    // at the impact's step end, from the bound, at the rate the sample there
+    // reads (2 rad/s less the projection's 4e-6). Read from the state alone
+    // after the impact (θ = 6.28 read as 6.28 − 2π = −0.003), the gaps lost
+    // a turn, and the lower stop was met a turn early, at 4.45 s (seen).
+    let (lower, upper) = FINGER;
+    let (events, samples) = turning(JointLimit::new(lower, upper).with_restitution(1.0), 0.0, 2.0, false, 8.0);
+    let [
+        Event { stop: 1, step, t: up, change: Change::Impact { held: false, .. }, .. },
+        Event { stop: 0, t: down, change: Change::Impact { held: false, .. }, .. },
+    ] = events[..]
+    else {
+        panic!("{events:?}")
+    };
+    assert!((up - upper / 2.0).abs() < 1e-9, "{up}");
+    let (start, [_, back]) = samples[step as usize];
+    assert!((back + 2.0).abs() < 1e-5, "{back}");
+    let expected = start + (upper - lower) / -back;
+    eprintln!("upper stop at {up}, rebound at {back}, lower stop at {down} (by hand {expected})");
+    assert!((down - expected).abs() < 1e-6, "hit the lower stop at {down}, by hand {expected}");
+}
