@@ -175,3 +175,27 @@ impl JointLimit {
         [false, true].into_iter().filter(move |&upper| self.side(upper).0.is_finite())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn an_angle_in_a_range_of_a_turn_or_more_is_the_one_nearest_the_reference() {
+        let finger = JointLimit::new(-2.62, 6.2);
+        // In range and nearest 0: kept; below −2.62, a turn up.
+        assert_eq!(finger.turn_nearest(2.0, 0.0), 2.0);
+        assert_eq!(finger.turn_nearest(-3.0, 0.0), -3.0 + TAU);
+        // Nearest the start 5.0: a turn up, where that is in range.
+        assert_eq!(finger.turn_nearest(5.0 - TAU, 5.0), 5.0 - TAU + TAU);
+        assert_eq!(finger.turn_nearest(-1.0, 9.0), -1.0 + TAU);
+        // π from 0 (a tie with −π) stays π.
+        assert_eq!(JointLimit::new(-TAU, TAU).turn_nearest(PI, 0.0), PI);
+        // A joint resting at its bound 0 by round-off is at it, not a turn away.
+        assert_eq!(JointLimit::new(0.0, TAU).turn_nearest(-1e-17, 0.0), -1e-17);
+        assert_eq!(JointLimit::new(0.0, TAU).turn_nearest(-1e-9, 0.0), -1e-9 + TAU);
+        // One bound only: the nearest angle on its side.
+        assert_eq!(JointLimit::new(f64::NEG_INFINITY, 1.0).turn_nearest(2.0, 0.0), 2.0 - TAU);
+    }
+}
