@@ -359,3 +359,35 @@ fn a_rods_angle_in_a_range_across_pi_is_reported_in_that_range_without_a_jump() 
     let stats = reported.iter().find(|c| c["column"] == "joints[0].q").unwrap();
     assert_eq!((stats["min"].as_f64(), stats["max"].as_f64()), (Some(low), Some(high)), "{stats}");
 }
+
+/// TIAGo's fingers' upper bound, its URDF's.
+#[allow(clippy::approx_constant)] // 6.28, not 2π
+const FINGER_UPPER: f64 = 6.28;
+
+/// The rod of [`rod_at`] hanging, without gravity, limited to TIAGo's
+/// fingers' −2.62 … 6.28 rad (more than a turn), started at the joint
+/// angle `theta0` turning up at 2 rad/s, run to `t_end`.
+fn turning_finger(theta0: f64, t_end: f64) -> String {
+    let initial = format!("\n[initial]\njoints = {{ \"joints[0]\" = {theta0} }}\nrates = {{ \"joints[0]\" = 2.0 }}\n");
+    let limit = format!("{{ lower = -2.62, upper = {FINGER_UPPER} }}");
+    rod_at(&limit, [0.0, 0.0, -L], [1.0, 0.0, 0.0, 0.0], &initial)
+        .replace(&format!("gravity = [0.0, 0.0, -{G}]"), "gravity = [0.0, 0.0, 0.0]")
+        .replace("t_end = 1.0", &format!("t_end = {t_end}"))
+}
+
+#[test]
+fn multi_turn_limits_a_finger_turning_past_pi_meets_its_upper_stop_at_the_turn_it_started_in() {
+    // θ = θ₀ + 2t: from 0 it passes π and 3.66 (read −2.62 in (−π, π],
+    // its lower bound: a spurious stop before) to 6.28 at 3.14 s; from
+    // 5.0 (read −1.28 from the state alone) to 6.28 at 0.64 s.
+    for (theta0, t_end) in [(0.0, 3.5), (5.0, 1.0)] {
+        let t_star = (FINGER_UPPER - theta0) / 2.0;
+        let (_, _, case) = run(&turning_finger(theta0, t_end), &[]);
+        let events = case["limits"]["events"].as_array().unwrap();
+        let impacts: Vec<_> = events.iter().filter(|e| e["event"] == "impact").collect();
+        let [impact] = impacts[..] else { panic!("from {theta0}: {events:?}") };
+        assert_eq!((impact["side"].as_str(), impact["held"].as_bool()), (Some("upper"), Some(true)), "{impact}");
+        let t = impact["t"].as_f64().unwrap();
+        assert!((t - t_star).abs() < 1e-9, "from {theta0}: stopped at {t}, by hand {t_star}");
+    }
+}

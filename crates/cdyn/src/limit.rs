@@ -12,14 +12,14 @@
 //! released is the run's business ([`crate::stops`]), as it changes which
 //! rows the model has.
 //!
-//! What `θ` is depends on the mechanism: a spatial joint's angle (in
+//! What `θ` is depends on the mechanism: a spatial joint's angle (read in
 //! `(−π, π]`: a range shorter than a turn is told apart from it wherever
-//! its bounds lie, Panda's joint 6 going to 3.75 rad, but in a range of a
-//! turn or more, URDF's ±2π of a multi-turn joint, a bound at or beyond ±π
-//! makes no stop: [`crate::spatial::Mechanism::unreachable_limits`]) or
-//! displacement from the initial pose; a planar joint's relative angle
-//! `φ_b − φ_a` (not wrapped) or the displacement of `point_b` from
-//! `point_a` along the axis.
+//! its bounds lie, Panda's joint 6 going to 3.75 rad; in a range of a turn
+//! or more, URDF's ±2π of a multi-turn joint or TIAGo's fingers' −2.62 …
+//! 6.28, a state alone cannot tell the turns apart, and a run's stops
+//! follow them from step to step, [`crate::stops`]) or displacement from
+//! the initial pose; a planar joint's relative angle `φ_b − φ_a` (not
+//! wrapped) or the displacement of `point_b` from `point_a` along the axis.
 //!
 //! May import: `error`.
 
@@ -85,6 +85,20 @@ impl JointLimit {
         if theta - self.upper > self.lower + TAU - theta { theta - TAU } else { theta }
     }
 
+    /// A revolute joint's angle `θ` as the angle `θ + 2πk` of a range of a
+    /// turn or more (not [`within_a_turn`](Self::within_a_turn), which
+    /// always holds one) nearest `reference`. A bound is in the range to
+    /// [`AT_BOUND`]: a joint resting at a bound of 0 at `−1e-17` is read at
+    /// it, not a turn away at the other bound.
+    pub(crate) fn turn_nearest(&self, angle: f64, reference: f64) -> f64 {
+        let lowest = ((self.lower - AT_BOUND - angle) / TAU).ceil();
+        let highest = ((self.upper + AT_BOUND - angle) / TAU).floor();
+        // Ties (θ = π from 0) keep θ; `max`/`min`, unlike `clamp`, do not
+        // panic should round-off leave the range without a whole turn.
+        let turns = ((reference - angle) / TAU).round_ties_even().max(lowest).min(highest);
+        angle + TAU * turns
+    }
+
     /// `lower ≤ θ ≤ upper`, stopped without rebound, no velocity or effort bound.
     pub fn new(lower: f64, upper: f64) -> Self {
         Self { lower, upper, restitution: 0.0, velocity: f64::INFINITY, effort: f64::INFINITY }
@@ -114,6 +128,10 @@ impl JointLimit {
         Ok(())
     }
 }
+
+/// How far past a bound a coordinate is still at it: round-off of a pose
+/// placed there (see [`crate::stops::START_SLACK`], which it is).
+pub(crate) const AT_BOUND: f64 = 1e-12;
 
 /// `+∞` is no bound, not an error.
 fn infinite_is_none(e: crate::Error, value: f64) -> Result<f64> {
@@ -152,9 +170,32 @@ impl JointLimit {
         [sign * (theta - bound), sign * rate]
     }
 
-    /// The finite sides, lower before upper: the stops a coordinate that
-    /// can take any value meets (a spatial angle takes only `(−π, π]`).
+    /// The finite sides, lower before upper: the joint's stops.
     pub fn finite_sides(self) -> impl Iterator<Item = bool> {
         [false, true].into_iter().filter(move |&upper| self.side(upper).0.is_finite())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn an_angle_in_a_range_of_a_turn_or_more_is_the_one_nearest_the_reference() {
+        let finger = JointLimit::new(-2.62, 6.2);
+        // In range and nearest 0: kept; below −2.62, a turn up.
+        assert_eq!(finger.turn_nearest(2.0, 0.0), 2.0);
+        assert_eq!(finger.turn_nearest(-3.0, 0.0), -3.0 + TAU);
+        // Nearest the start 5.0: a turn up, where that is in range.
+        assert_eq!(finger.turn_nearest(5.0 - TAU, 5.0), 5.0 - TAU + TAU);
+        assert_eq!(finger.turn_nearest(-1.0, 9.0), -1.0 + TAU);
+        // π from 0 (a tie with −π) stays π.
+        assert_eq!(JointLimit::new(-TAU, TAU).turn_nearest(PI, 0.0), PI);
+        // A joint resting at its bound 0 by round-off is at it, not a turn away.
+        assert_eq!(JointLimit::new(0.0, TAU).turn_nearest(-1e-17, 0.0), -1e-17);
+        assert_eq!(JointLimit::new(0.0, TAU).turn_nearest(-1e-9, 0.0), -1e-9 + TAU);
+        // One bound only: the nearest angle on its side.
+        assert_eq!(JointLimit::new(f64::NEG_INFINITY, 1.0).turn_nearest(2.0, 0.0), 2.0 - TAU);
     }
 }

@@ -13,6 +13,7 @@
 use cdyn::spatial::{Body, Joint, JointKind, JointLimit, Mechanism};
 use cdyn::stops::{Change, Event, MechanismStops, run_with_stops};
 use cdyn::{Control, Scheme, Settings};
+use std::f64::consts::{PI, TAU};
 
 const G: f64 = 9.81;
 const M: f64 = 2.0;
@@ -260,4 +261,188 @@ fn stops_a_mimic_reaches_with_its_leader_are_held_by_one_row() {
     let worst =
         joints.iter().zip(&reduced).map(|(a, b)| (a[0] - b[0]).abs().max((a[1] - b[1]).abs())).fold(0.0, f64::max);
     assert!(worst < 1e-12, "{worst}");
+}
+
+/// TIAGo's finger joints' range, more than a turn: −2.62 … 6.28 rad.
+#[allow(clippy::approx_constant)] // its URDF's bound, 6.28, not 2π
+const FINGER: (f64, f64) = (-2.62, 6.28);
+
+/// The rod of [`pendulum_at`] hanging (`φ = 0`), without gravity, its
+/// joint limited by `limit`, turning from `θ₀` at the constant rate `ω`
+/// (`I ω²/2` its kinetic energy, I about the pivot) to `t_end`; its stops
+/// read from `θ₀`'s turn where `from_start`, else from the state alone.
+/// Returns the events and each step's `(t, (θ, θ̇))`, θ as the output
+/// reads it (in (−π, π] for a range of a turn or more).
+fn turning(
+    limit: JointLimit,
+    theta0: f64,
+    omega: f64,
+    from_start: bool,
+    t_end: f64,
+) -> (Vec<Event>, Vec<(f64, [f64; 2])>) {
+    let mut mechanism = pendulum_at(0.0, limit);
+    mechanism.gravity = [0.0; 3];
+    let (q0, v0) = mechanism.state_at_joints(&[(0, theta0)], &[(0, omega)]).unwrap();
+    let mut system = MechanismStops::new(mechanism.clone()).unwrap();
+    if from_start {
+        system = system.starting_at(&[(0, theta0)]).unwrap();
+    }
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+    let mut samples = Vec::new();
+    let report = run_with_stops::<_, cdyn::Error>(&system, settings, &q0, &v0, t_end, 1, |t, q, v| {
+        let [x, rate, _] = mechanism.joint_coordinates(q, v, &vec![0.0; q.len()])?[0].unwrap();
+        samples.push((t, [x, rate]));
+        Ok(())
+    })
+    .unwrap();
+    (report.events, samples)
+}
+
+/// That the run of [`turning`] at `ω` hit stop `stop` (0 lower, 1 upper)
+/// of bound `bound` once, at `t*`, took all the kinetic energy there and
+/// left the rod at the bound, at rest.
+fn stopped_once_at(events: &[Event], samples: &[(f64, [f64; 2])], stop: usize, bound: f64, omega: f64, t_star: f64) {
+    let Event { stop: hit, step, t, change: Change::Impact { rate, kinetic_lost, held: true }, .. } = events[0] else {
+        panic!("{events:?}")
+    };
+    eprintln!("stop {hit} at {t} (t* = {t_star}), rate {rate}, lost {kinetic_lost}");
+    assert_eq!(hit, stop, "{events:?}");
+    // θ = θ₀ + ω t exactly (no load), and the crossing is the root of the
+    // cubic through the step's ends: a straight line here.
+    assert!((t - t_star).abs() < 1e-9, "stopped at {t}, by hand {t_star}");
+    // Seen at the step's end, δ = |ω| (step h − t*) past the stop, and put
+    // back onto it: the velocities projected there in the kinetic-energy
+    // metric keep, of the centre's m L ω, its part along the circle there
+    // (cos δ), and of the Euler parameters' rate the part that turns the
+    // rod about y (cos δ/2): ġ = −|ω| (m L² cos δ + J cos δ/2) / (m L² + J)
+    // (δ = 2e-3 rad: 3.9e-6 rad/s less than |ω|), all of it then taken.
+    let delta = omega.abs() * (step as f64 * 1e-3 - t_star);
+    let expected = omega.abs() * (M * L * L * delta.cos() + JYY * (delta / 2.0).cos()) / (M * L * L + JYY);
+    assert!((rate + expected).abs() < 1e-9, "{rate} against {expected}");
+    let energy = 0.5 * (JYY + M * L * L) * expected * expected;
+    assert!((kinetic_lost - energy).abs() < 1e-9 * energy, "{kinetic_lost} against {energy}");
+    // Nothing presses the rod into the stop: its row's multiplier is
+    // round-off (1.6e-115), which may release it; nothing else happens.
+    assert!(events[1..].iter().all(|e| matches!(e.change, Change::Release { multiplier } if multiplier < 1e-80)));
+    // At the bound (a turn away from the (−π, π] the output reads), at rest.
+    let after: Vec<_> = samples.iter().filter(|(s, _)| *s > t + 1e-3).collect();
+    assert!(after.len() > 300);
+    let off = |x: f64| ((x - bound + PI).rem_euclid(TAU) - PI).abs();
+    let worst = after.iter().fold(0.0_f64, |w, (_, [x, r])| w.max(off(*x)).max(r.abs()));
+    assert!(worst < 1e-9, "off the stop by {worst}");
+}
+
+#[test]
+fn multi_turn_limits_a_finger_turning_up_passes_pi_and_its_lower_bound_a_turn_on_to_its_upper_stop() {
+    // From 0 at 2 rad/s, θ passes π at 1.57 s and 3.66 = −2.62 + 2π at
+    // 1.83 s (read in (−π, π] as −2.62: the spurious lower stop of before),
+    // and meets its upper stop 6.28 at 3.14 s.
+    let (lower, upper) = FINGER;
+    let (events, samples) = turning(JointLimit::new(lower, upper), 0.0, 2.0, false, 3.5);
+    stopped_once_at(&events, &samples, 1, upper, 2.0, upper / 2.0);
+    // Down from 0 at 2 rad/s it meets −2.62 at 1.31 s, as before.
+    let (events, samples) = turning(JointLimit::new(lower, upper), 0.0, -2.0, false, 1.7);
+    stopped_once_at(&events, &samples, 0, lower, -2.0, -lower / 2.0);
+}
+
+#[test]
+fn multi_turn_limits_a_joint_of_range_two_pi_each_way_turns_twice_and_stops() {
+    // ±2π, started at −6.0: up at 2 rad/s it turns 2π + 6 = 12.28 rad,
+    // nearly two turns, to its upper stop at 6.14 s.
+    let (events, samples) = turning(JointLimit::new(-TAU, TAU), -6.0, 2.0, true, 6.5);
+    stopped_once_at(&events, &samples, 1, TAU, 2.0, (TAU + 6.0) / 2.0);
+    // Its stops read from the state alone take −6.0 as the angle of the
+    // range nearest 0, −6.0 + 2π = 0.283: a turn less to go.
+    let (events, samples) = turning(JointLimit::new(-TAU, TAU), -6.0, 2.0, false, 3.5);
+    stopped_once_at(&events, &samples, 1, TAU, 2.0, (TAU - (TAU - 6.0)) / 2.0);
+}
+
+#[test]
+fn multi_turn_limits_read_from_the_state_alone_are_in_the_range_nearest_0_or_the_start() {
+    use cdyn::stops::{Unilateral, check_start};
+    let (lower, upper) = FINGER;
+    let mut mechanism = pendulum_at(0.0, JointLimit::new(lower, upper));
+    mechanism.gravity = [0.0; 3];
+    let stops = MechanismStops::new(mechanism.clone()).unwrap();
+    let gaps = |stops: &MechanismStops, theta: f64| {
+        let (q, v) = mechanism.state_at_joints(&[(0, theta)], &[(0, 1.0)]).unwrap();
+        let mut gaps = [[0.0; 2]; 2];
+        stops.gaps(&q, &v, &mut gaps).unwrap();
+        (gaps, check_start(stops, &q, &v))
+    };
+    let close = |a: [[f64; 2]; 2], b: [[f64; 2]; 2]| {
+        a.iter().flatten().zip(b.iter().flatten()).all(|(x, y)| (x - y).abs() < 1e-12)
+    };
+    // Both stops have period 2π; read (−π, π] from the state, the angle is
+    // taken in the range nearest 0: 5.0 as 5.0 − 2π = −1.283, −3.0 (below
+    // −2.62) as −3.0 + 2π = 3.283. Gaps θ + 2.62 and 6.28 − θ, rates 1, −1.
+    assert_eq!((stops.period(0), stops.period(1)), (Some(TAU), Some(TAU)));
+    for (theta, read) in [(5.0, 5.0 - TAU), (-3.0, -3.0 + TAU), (2.0, 2.0)] {
+        let (g, start) = gaps(&stops, theta);
+        assert!(close(g, [[read - lower, 1.0], [upper - read, -1.0]]), "{theta}: {g:?}");
+        start.unwrap();
+    }
+    // Started at 5.0 (or 7.0), its stops read that turn: 7.0 is past 6.28.
+    let started = |theta: f64| stops.clone().starting_at(&[(0, theta)]).unwrap();
+    let (g, start) = gaps(&started(5.0), 5.0);
+    assert!(close(g, [[5.0 - lower, 1.0], [upper - 5.0, -1.0]]), "{g:?}");
+    start.unwrap();
+    let (g, start) = gaps(&started(7.0), 7.0);
+    assert!(close(g, [[7.0 - lower, 1.0], [upper - 7.0, -1.0]]), "{g:?}");
+    let refused = start.unwrap_err().to_string();
+    assert!(refused.contains("starts 7.200e-1 past its upper limit 6.28"), "{refused}");
+    // A joint that does not exist is refused.
+    assert!(stops.clone().starting_at(&[(1, 0.0)]).is_err());
+}
+
+#[test]
+fn multi_turn_limits_keep_their_turn_across_a_state_set_between_steps() {
+    // The finger of the test above, stepped to 2 s (θ = 4.0, read −2.28 in
+    // (−π, π]) and put at its own state: read from the state alone its
+    // upper gap would be 6.28 + 2.28, and 6.28 missed; set between steps,
+    // it is taken nearest the run's, 2.28, and the stop met at 3.14 s.
+    let (lower, upper) = FINGER;
+    let mut mechanism = pendulum_at(0.0, JointLimit::new(lower, upper));
+    mechanism.gravity = [0.0; 3];
+    let (q0, v0) = mechanism.state_at_joints(&[], &[(0, 2.0)]).unwrap();
+    let system = MechanismStops::new(mechanism).unwrap();
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::robust());
+    let mut run = cdyn::stops::StopSimulation::new(&system, settings, &q0, &v0).unwrap();
+    while run.steps() < 2000 {
+        run.step().unwrap();
+    }
+    let (q, v, e) = run.simulation(|s| (s.q().to_vec(), s.v().to_vec(), s.energy_input()));
+    run.set_state(&q, &v, e).unwrap();
+    while run.steps() < 3500 {
+        run.step().unwrap();
+    }
+    let [Event { stop: 1, t, change: Change::Impact { held: true, .. }, .. }, ..] = run.report().events[..] else {
+        panic!("{:?}", run.report().events)
+    };
+    assert!((t - upper / 2.0).abs() < 1e-9, "stopped at {t}");
+}
+
+#[test]
+fn multi_turn_limits_an_elastic_finger_rebounds_from_one_stop_through_pi_to_the_other() {
+    // e = 1: thrown back from 6.28 at 3.14 s, the finger turns down the
+    // whole range, 8.9 rad, through π and 0 onto −2.62. The rebound starts
+    // at the impact's step end, from the bound, at the rate the sample there
+    // reads (2 rad/s less the projection's 4e-6). Read from the state alone
+    // after the impact (θ = 6.28 read as 6.28 − 2π = −0.003), the gaps lost
+    // a turn, and the lower stop was met a turn early, at 4.45 s (seen).
+    let (lower, upper) = FINGER;
+    let (events, samples) = turning(JointLimit::new(lower, upper).with_restitution(1.0), 0.0, 2.0, false, 8.0);
+    let [
+        Event { stop: 1, step, t: up, change: Change::Impact { held: false, .. }, .. },
+        Event { stop: 0, t: down, change: Change::Impact { held: false, .. }, .. },
+    ] = events[..]
+    else {
+        panic!("{events:?}")
+    };
+    assert!((up - upper / 2.0).abs() < 1e-9, "{up}");
+    let (start, [_, back]) = samples[step as usize];
+    assert!((back + 2.0).abs() < 1e-5, "{back}");
+    let expected = start + (upper - lower) / -back;
+    eprintln!("upper stop at {up}, rebound at {back}, lower stop at {down} (by hand {expected})");
+    assert!((down - expected).abs() < 1e-6, "hit the lower stop at {down}, by hand {expected}");
 }

@@ -300,7 +300,8 @@ impl Mechanism {
     /// in `(−π, π]`, but for a joint whose limit is shorter than a turn,
     /// in that range (or past its nearer bound: `[lower, lower + 2π)`
     /// split halfway between the bounds; Panda's joint 6 turns from −0.0175
-    /// to 3.75 rad), as its stops read it. One place for joint-space output
+    /// to 3.75 rad), as its stops read it (a range of a turn or more's stops
+    /// follow the joint's turns: [`crate::stops`]). One place for joint-space output
     /// (the CSV, `summary.json`, the C API, the FMU, Python), for the stops
     /// and for tests against joint-space dynamics.
     pub fn joint_coordinates(&self, q: &[f64], v: &[f64], a: &[f64]) -> Result<Vec<Option<[f64; 3]>>> {

@@ -1,35 +1,29 @@
-//! A spatial mechanism's joint limits as stops: the sides of each limit
-//! its joint's coordinate can meet, their bounds and their gaps at a state
-//! (the rows holding them are `StopRow`s, built by `build_holding`).
+//! A spatial mechanism's joint limits as stops: each finite side of each
+//! limit, its bound and its gap at a state (the rows holding them are
+//! `StopRow`s, built by `build_holding`).
+//!
+//! A revolute joint's angle is read in `(−π, π]`. In a range shorter than
+//! a turn that tells where the joint is ([`JointLimit::unwrap_angle`]); in
+//! a range of a turn or more (UR5's ±2π, TIAGo's fingers' −2.62 … 6.28) it
+//! does not: a stop there reads the angle of the range nearest a reference
+//! (0 unless told), and its gap is periodic ([`Mechanism::stop_period`]),
+//! its turns followed from step to step by the run ([`crate::stops`]).
 
 use super::joint::JointKind;
 use super::mechanism::Mechanism;
 use crate::error::Result;
 use crate::limit::{JointLimit, Stop};
+use std::f64::consts::TAU;
 
 impl Mechanism {
-    /// Every finite side of every joint's limit that the joint's coordinate
-    /// can meet (an angle is in `(−π, π]`: in a range of a turn or more, a
-    /// bound at or beyond ±π is not a stop), lower before upper, joints in order.
+    /// Every finite side of every joint's limit, lower before upper, joints in order.
     pub fn stops(&self) -> Vec<Stop> {
         let mut out = Vec::new();
         for (joint, j) in self.joints.iter().enumerate() {
             let Some(l) = j.limit else { continue };
-            for upper in l.finite_sides().filter(|&upper| reachable(j.kind, &l, l.side(upper).0)) {
-                out.push(Stop { joint, upper });
-            }
+            out.extend(l.finite_sides().map(|upper| Stop { joint, upper }));
         }
         out
-    }
-
-    /// How many finite bounds no stop stands for: a revolute joint's at or
-    /// beyond ±π in a range of a turn or more.
-    pub fn unreachable_limits(&self) -> usize {
-        let bounds = self.joints.iter().filter_map(|j| j.limit.map(|l| (j.kind, l)));
-        bounds
-            .flat_map(|(kind, l)| [l.lower, l.upper].map(|b| b.is_finite() && !reachable(kind, &l, b)))
-            .filter(|&x| x)
-            .count()
     }
 
     /// The stop's bound, its sign `s` (1 lower, −1 upper) and its joint's restitution.
@@ -41,6 +35,14 @@ impl Mechanism {
 
     fn limit(&self, stop: Stop) -> JointLimit {
         self.joints[stop.joint].limit.expect("a stop's joint has a limit")
+    }
+
+    /// The period of the stop's gap: `Some(2π)` for a revolute joint whose
+    /// range is a turn or more, where an angle read from the state alone
+    /// is the joint's only up to whole turns; `None` otherwise.
+    pub fn stop_period(&self, stop: Stop) -> Option<f64> {
+        let multi_turn = self.joints[stop.joint].kind == JointKind::Revolute && !self.limit(stop).within_a_turn();
+        multi_turn.then_some(TAU)
     }
 
     /// The gap `g = s (θ − bound)` and its rate `ġ` of each stop at `(q, v)`.
@@ -56,19 +58,12 @@ impl Mechanism {
     }
 
     /// The gap and its rate of `stop` where its joint's coordinate is `θ`
-    /// (as [`Mechanism::joint_coordinates`] reads it: an angle in a range
-    /// shorter than a turn taken as the range's) moving at `θ̇`.
+    /// (as [`Mechanism::joint_coordinates`] reads it) moving at `θ̇`; a
+    /// periodic stop's ([`Mechanism::stop_period`]) at the angle `θ + 2πk`
+    /// of its joint's range nearest 0.
     pub fn stop_gap(&self, stop: Stop, theta: f64, rate: f64) -> [f64; 2] {
-        self.limit(stop).gap(stop.upper, theta, rate)
-    }
-}
-
-/// Whether a bound of `limit` is a stop: a revolute joint's angle, measured
-/// in `(−π, π]`, meets any bound of a range shorter than a turn, and in a
-/// longer range only one inside ±π.
-fn reachable(kind: JointKind, limit: &JointLimit, bound: f64) -> bool {
-    match kind {
-        JointKind::Revolute => limit.within_a_turn() || bound.abs() < std::f64::consts::PI,
-        _ => bound.is_finite(),
+        let limit = self.limit(stop);
+        let theta = if self.stop_period(stop).is_some() { limit.turn_nearest(theta, 0.0) } else { theta };
+        limit.gap(stop.upper, theta, rate)
     }
 }

@@ -364,12 +364,6 @@ pub fn read_urdf(text: &str, gravity: [f64; 3]) -> Result<UrdfRobot> {
     }
     let mechanism =
         Mechanism::new(gravity).with_bodies(bodies).with_joints(joints).with_couplings(couplings).with_ground(ground);
-    let unreachable = mechanism.unreachable_limits();
-    if unreachable > 0 {
-        notes.push(format!(
-            "{unreachable} revolute limit bounds at or beyond ±π of ranges of a turn or more (no stop: the angle is measured in (−π, π])"
-        ));
-    }
     Ok(UrdfRobot { mechanism, joint_names, notes, merged: merged_links })
 }
 

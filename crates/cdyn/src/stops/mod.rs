@@ -23,6 +23,12 @@
 //! Velocity bounds are watched, not enforced: [`Report::overspeed`] lists
 //! each coordinate that exceeded its bound, by how much and from when.
 //!
+//! A stop's gap may be periodic ([`Unilateral::period`]): a revolute
+//! joint whose range is a turn or more (UR5's ±2π) has its angle, read
+//! from the state, only up to whole turns. The run takes each new reading
+//! of such a gap as the one nearest the stop's last (one step turns a
+//! joint far less than half a turn), so that its stops follow the turns.
+//!
 //! The stops are seen at the end of a step: the impact is applied there
 //! (up to one step `h` late, the joint past its stop by at most `|ġ| h`,
 //! which the projection removes), and the crossing time the event reports
@@ -36,6 +42,7 @@ mod snapshot;
 mod spatial;
 mod start;
 mod stepping;
+mod turns;
 mod unilateral;
 
 pub use planar::PlanarStops;

@@ -10,6 +10,7 @@
 
 use super::start::{START_SLACK, passed};
 use super::stepping::StopSimulation;
+use super::turns::read_following;
 use super::unilateral::{Report, Unilateral};
 use crate::error::{Error, Part, Problem, Result};
 use crate::model::Model;
@@ -98,16 +99,17 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         let held_tolerance = self.settings.consistency_tolerance.unwrap_or(START_SLACK);
         crate::simulate::check_initial_state(self.sim.model().n(), q, v)?;
         crate::error::finite("energy input", e)?;
-        let mut gaps = std::mem::take(&mut self.before);
-        let read = self.system.gaps(q, v, &mut gaps);
+        // A multi-turn joint's gaps are taken at the turn nearest the run's
+        // (a state set between steps is near the last).
+        read_following(&*self.system, q, v, &self.before, &mut self.after)?;
+        let gaps = &self.after;
         let is_held = |k: usize| self.held.contains(&k) || self.implied.contains(&k);
         let passed_held = self.held.iter().map(|&k| (k, gaps[k][0])).find(|&(_, g)| g < -held_tolerance);
-        let passed = read.and(Ok(passed(&gaps, is_held).or(passed_held)));
-        self.before = gaps;
-        if let Some((k, g)) = passed? {
+        if let Some((k, g)) = passed(gaps, is_held).or(passed_held) {
             let reason = format!("{} is passed by {:.3e}", self.system.name(k), -g);
             return Err(Problem::Stop { reason }.at(Part::InitialState));
         }
+        std::mem::swap(&mut self.before, &mut self.after);
         let before = &self.before;
         let held = self.held.len();
         self.held.retain(|&k| before[k][0] <= held_tolerance);

@@ -1,8 +1,12 @@
 //! A spatial mechanism's joint limits as stops ([`MechanismStops`]): each
-//! finite side of a limit its joint can meet ([`Mechanism::stops`]), read
-//! at every step without allocating.
+//! finite side of a limit ([`Mechanism::stops`]), read at every step
+//! without allocating. A revolute joint whose range is a turn or more
+//! (UR5's ±2π) has periodic gaps ([`Unilateral::period`]): read from the
+//! state alone, its angle is the one of its range nearest 0, or the one
+//! nearest the angle it was started at ([`MechanismStops::starting_at`]).
 
 use super::reads::LimitReads;
+use super::turns::nearest;
 use super::unilateral::Unilateral;
 use crate::error::{Problem, Result};
 use crate::model::Model;
@@ -19,6 +23,9 @@ pub struct MechanismStops {
     reads: LimitReads,
     /// The accelerations the coordinates are read with (not used: zeros).
     zeros: Vec<f64>,
+    /// Each joint's coordinate at the start, where given: a periodic stop's
+    /// gap is read nearest its gap there.
+    start: Vec<Option<f64>>,
 }
 
 impl MechanismStops {
@@ -31,7 +38,24 @@ impl MechanismStops {
         let no_coordinate =
             |index: usize| Problem::NoCoordinate { index, kind: mechanism.joints[index].kind.name() }.into();
         let reads = LimitReads::new(mechanism.stops(), space.joints(), limits, n, no_coordinate)?;
-        Ok(Self { zeros: vec![0.0; n], mechanism, space, reads })
+        let start = vec![None; mechanism.joints.len()];
+        Ok(Self { zeros: vec![0.0; n], mechanism, space, reads, start })
+    }
+
+    /// The stops of a mechanism started at the joint coordinates `start`
+    /// (`(joint index, θ)`, as [`Mechanism::state_at_joints`] takes them):
+    /// a revolute joint whose range is a turn or more is read at the turn
+    /// of its `θ` (5.0 in −2.62 … 6.28 is 5.0, not −1.28; 7.0 is 7.0, past
+    /// the upper bound, a start a run refuses) where its stops are read
+    /// from the state alone (a run's start). Other joints are as they
+    /// were; a joint that does not exist, or a `θ` that is not finite, is
+    /// an error.
+    pub fn starting_at(mut self, start: &[(usize, f64)]) -> Result<Self> {
+        for &(joint, theta) in start {
+            *self.start.get_mut(joint).ok_or(Problem::NoSuchJoint { index: joint })? =
+                Some(crate::error::finite("joint coordinate", theta)?);
+        }
+        Ok(self)
     }
 
     /// The mechanism.
@@ -55,12 +79,27 @@ impl Unilateral for MechanismStops {
         Ok(self.mechanism.build_holding(&self.reads.held(held))?.model)
     }
 
-    /// `g = s (θ − bound)` and `ġ = s θ̇` (see [`Mechanism::stop_gap`]).
+    /// `g = s (θ − bound)` and `ġ = s θ̇` (see [`Mechanism::stop_gap`]), a
+    /// periodic stop's gap the one nearest its gap at its joint's start
+    /// where given ([`MechanismStops::starting_at`]).
     fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()> {
         self.reads.gaps(q, v, gaps, |i, stop| {
             let [x, rate] = self.at(i, q, v);
-            self.mechanism.stop_gap(stop, x, rate)
+            let [g, rate] = self.mechanism.stop_gap(stop, x, rate);
+            match (self.start[stop.joint], self.mechanism.stop_period(stop)) {
+                (Some(start), Some(period)) => {
+                    let (bound, sign, _) = self.mechanism.stop_bound(stop);
+                    [nearest(g, sign * (start - bound), period), rate]
+                }
+                _ => [g, rate],
+            }
         })
+    }
+
+    /// 2π for the stops of a revolute joint whose range is a turn or more
+    /// ([`Mechanism::stop_period`]).
+    fn period(&self, stop: usize) -> Option<f64> {
+        self.mechanism.stop_period(self.reads.stop(stop))
     }
 
     fn restitution(&self, stop: usize) -> f64 {

@@ -10,8 +10,9 @@ use crate::error::{Part, Problem, Result};
 /// is not a hit. A joint resting at a stop that no row holds (Panda's
 /// second finger, a `<mimic>` of the first, held) wanders across it by
 /// round-off, ±1e-16: seen as hits, each took a rebuild of the model —
-/// 3 900 in Panda's first second.
-pub const START_SLACK: f64 = 1e-12;
+/// 3 900 in Panda's first second. It is 1e-12, how far past a bound a
+/// multi-turn joint's angle is read at it too.
+pub const START_SLACK: f64 = crate::limit::AT_BOUND;
 
 /// Refuses `(q0, v0)` as a start of `system` if it is past a stop (by more
 /// than [`START_SLACK`]): [`Problem::StartsPastLimit`], naming the first

@@ -12,6 +12,7 @@
 //! and allocates.
 
 use super::start::{START_SLACK, refuse_passed};
+use super::turns::read_following;
 use super::unilateral::{Change, Event, Report, Unilateral};
 use crate::dynamics::assemble::assemble;
 use crate::dynamics::{Breakdown, Dynamics};
@@ -42,10 +43,12 @@ pub struct StopSimulation<S: Deref<Target: Unilateral>> {
     /// of their own (see [`StopSimulation::split_implied`]); not hit again
     /// until a release changes what is held.
     pub(super) implied: Vec<usize>,
-    /// Each stop's `(g, ġ)` at the start of the step being taken.
+    /// Each stop's `(g, ġ)` at the start of the step being taken: a
+    /// periodic gap as followed from the start ([`read_following`]).
     pub(super) before: Vec<[f64; 2]>,
-    /// Each stop's `(g, ġ)` at the end of the step just taken.
-    after: Vec<[f64; 2]>,
+    /// Each stop's `(g, ġ)` at the end of the step just taken, or a new
+    /// reading on its way to `before`.
+    pub(super) after: Vec<[f64; 2]>,
     /// The stops the step just taken closed.
     hits: Vec<usize>,
     /// Evaluates the multipliers of the held stops' rows.
@@ -78,7 +81,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         self.sim.step()?;
         let (step, t) = (self.sim.steps(), self.sim.t());
         let (q, v) = (self.sim.q(), self.sim.v());
-        self.system.gaps(q, v, &mut self.after)?;
+        read_following(&*self.system, q, v, &self.before, &mut self.after)?;
         let overspeed = &mut self.report.overspeed;
         self.system.overspeed(q, v, &mut |index, ratio| match overspeed.binary_search_by_key(&index, |o| o.0) {
             Ok(k) => overspeed[k].1 = overspeed[k].1.max(ratio),
@@ -93,7 +96,8 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
             let (hits, gaps) = (std::mem::take(&mut self.hits), std::mem::take(&mut self.after));
             let result = self.impact(&hits, &gaps, step, t);
             (self.hits, self.after) = (hits, gaps);
-            return result;
+            let (q, v, held_more) = result?;
+            return self.restart(&q, &v, held_more);
         }
         if !self.held.is_empty() && self.release(step, t)? {
             let (q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
@@ -104,8 +108,9 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     }
 
     /// Hits the stops `hits` (whose gaps closed in the step to `t`):
-    /// Newton's impact, the stops held if plastic, and a new segment.
-    fn impact(&mut self, hits: &[usize], gaps: &[[f64; 2]], step: u64, t: f64) -> Result<()> {
+    /// Newton's impact and the stops held if plastic. Returns the state
+    /// after it and whether more stops are held, for the new segment.
+    fn impact(&mut self, hits: &[usize], gaps: &[[f64; 2]], step: u64, t: f64) -> Result<(Vec<f64>, Vec<f64>, bool)> {
         let h = self.settings.h;
         let (mut q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
         let (rows, implied) = self.split_implied(hits, &q, &v, t)?;
@@ -118,6 +123,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         assemble(&impact, &mut q, &mut plastic, t, ASSEMBLY_TOLERANCE)?;
         let mut free = v;
         assemble(&self.model, &mut q.clone(), &mut free, t, ASSEMBLY_TOLERANCE)?;
+        // Only the rates are read from these: a periodic gap's turn does not matter.
         let mut rates = vec![[0.0; 2]; gaps.len()];
         self.system.gaps(&q, &free, &mut rates)?;
         // A stop whose gap is opening again at the stop crossed and turned
@@ -165,7 +171,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
             self.held = rows;
             self.implied.extend(implied);
         }
-        self.restart(&q, &v, held_more)
+        Ok((q, v, held_more))
     }
 
     /// The stops to hold as rows after hitting `hits` at `(q, v)` — the
@@ -237,7 +243,11 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
             self.dynamics = Dynamics::new(&model);
         }
         self.model = model;
-        self.system.gaps(q, v, &mut self.before)
+        // A restart is up to a step (an impact's projection) from the
+        // step's start: `before` still tells the turns.
+        read_following(&*self.system, q, v, &self.before, &mut self.after)?;
+        std::mem::swap(&mut self.before, &mut self.after);
+        Ok(())
     }
 
     /// Lends the current segment's simulation to `f`: the run's state,

@@ -18,6 +18,14 @@ pub trait Unilateral {
     /// Each stop's gap `g` (`≥ 0` allowed) and its rate `ġ` at `(q, v)`,
     /// into `gaps` (one entry per stop).
     fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()>;
+    /// The period of a stop's gap, if it has one: a joint whose angle is
+    /// read from the state only up to whole turns (a revolute joint's
+    /// range of a turn or more) has gaps a turn apart for the same state.
+    /// A run takes each new reading of such a gap as the one nearest the
+    /// last, so that it follows the joint's turns.
+    fn period(&self, _stop: usize) -> Option<f64> {
+        None
+    }
     /// Newton's coefficient of restitution of a stop.
     fn restitution(&self, stop: usize) -> f64;
     /// How messages name a stop's joint (`"joint 2"`).

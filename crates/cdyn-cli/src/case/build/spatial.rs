@@ -31,8 +31,9 @@ impl Scenario {
             other => anyhow!("{file}: {other}"),
         })?;
         let (mechanism, mut built) = built;
-        if let Some((q0, v0)) = self.initial.joint_state(&mechanism, |k| counts.joint_name(k), file)? {
-            (built.q0, built.v0) = (q0, v0);
+        let mut start = Vec::new();
+        if let Some((coordinates, q0, v0)) = self.initial.joint_state(&mechanism, |k| counts.joint_name(k), file)? {
+            (start, built.q0, built.v0) = (coordinates, q0, v0);
         }
         let rows = built.rows.iter().map(part).collect();
         let forces = built.forces.iter().map(part).collect();
@@ -46,11 +47,15 @@ impl Scenario {
                 .map(|a| mechanism.joints[a.joint].limit.map_or(f64::INFINITY, |l| l.effort))
                 .collect(),
         });
-        let limits = spatial_limits(mechanism, |k| counts.joint_name(k)).map_err(|e| anyhow!("{file}: {e}"))?;
+        let limits = spatial_limits(mechanism, &start, |k| counts.joint_name(k)).map_err(|e| anyhow!("{file}: {e}"))?;
         let notes = counts.notes;
         Ok(Described { example, rows, notes, force_entries: forces, limits, joint_columns })
     }
 }
+
+/// The joints' coordinates given, `(index, value)`, and the positions and
+/// velocities they place the mechanism at.
+type JointStart = (Vec<(usize, f64)>, Vec<f64>, Vec<f64>);
 
 impl InitialSpec {
     /// The state of `mechanism` at `[initial] joints` and `rates`, if given,
@@ -60,7 +65,7 @@ impl InitialSpec {
         mechanism: &cdyn::spatial::Mechanism,
         name: impl Fn(usize) -> String,
         file: &str,
-    ) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
+    ) -> Result<Option<JointStart>> {
         if self.joints.is_none() && self.rates.is_none() {
             return Ok(None);
         }
@@ -80,14 +85,19 @@ impl InitialSpec {
             values.collect::<Result<Vec<_>>>()
         };
         let (coordinates, rates) = (pick("joints", &self.joints)?, pick("rates", &self.rates)?);
-        let state = mechanism.state_at_joints(&coordinates, &rates).map_err(|e| anyhow!("{file}: [initial] {e}"))?;
-        Ok(Some(state))
+        let (q0, v0) = mechanism.state_at_joints(&coordinates, &rates).map_err(|e| anyhow!("{file}: [initial] {e}"))?;
+        Ok(Some((coordinates, q0, v0)))
     }
 }
 
 /// The limits of a spatial mechanism's joints, if any has one (a stop, or
-/// a velocity bound to report), its joints named by `name`.
-fn spatial_limits(mechanism: cdyn::spatial::Mechanism, name: impl Fn(usize) -> String) -> cdyn::Result<Option<Limits>> {
+/// a velocity bound to report), its joints named by `name`; a multi-turn
+/// joint's stops read at the turn of its `[initial] joints` value in `start`.
+fn spatial_limits(
+    mechanism: cdyn::spatial::Mechanism,
+    start: &[(usize, f64)],
+    name: impl Fn(usize) -> String,
+) -> cdyn::Result<Option<Limits>> {
     if mechanism.joints.iter().all(|j| j.limit.is_none()) {
         return Ok(None);
     }
@@ -97,5 +107,6 @@ fn spatial_limits(mechanism: cdyn::spatial::Mechanism, name: impl Fn(usize) -> S
         .map(|stop| StopName { joint: name(stop.joint), upper: stop.upper, bound: mechanism.stop_bound(stop).0 })
         .collect();
     let joints = (0..mechanism.joints.len()).map(name).collect();
-    Ok(Some(Limits { system: Arc::new(MechanismStops::new(mechanism)?), stops, joints }))
+    let system = MechanismStops::new(mechanism)?.starting_at(start)?;
+    Ok(Some(Limits { system: Arc::new(system), stops, joints }))
 }
