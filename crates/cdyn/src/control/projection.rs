@@ -206,7 +206,7 @@ pub(crate) fn invariants(
         d.jac_mul(model, &work.correction, &mut work.rows);
         d.jac_mul(model, v, &mut work.rows_2);
         d.solve_many(&mut [&mut work.rows, &mut work.rows_2]);
-        d.add_weighted_jt_pair(model, [&work.rows, &work.rows_2], [&mut work.correction, &mut work.direction]);
+        d.add_weighted_jt_many(model, [&work.rows, &work.rows_2], [&mut work.correction, &mut work.direction]);
         // The velocities move along P_E P v, leaving the momenta the system
         // keeps as they are (P M⁻¹ Ψ_q is M-orthogonal to them already).
         momenta.project(&mut work.direction);

@@ -32,30 +32,28 @@ impl Dynamics {
         }
     }
 
-    /// `out[k] −= M⁻¹ Φ_qᵀ y[k]` for two pairs in one pass over the Jacobian
-    /// (the coupled control terms' two products), each with the arithmetic of
+    /// `out[k] −= M⁻¹ Φ_qᵀ y[k]` for `K` pairs in one pass over the Jacobian
+    /// (the coupled control terms' products, and `A`'s constraint forces
+    /// with them), each with the arithmetic of
     /// [`add_weighted_jt`](Self::add_weighted_jt) at scale −1.
-    pub fn add_weighted_jt_pair(&self, model: &Model, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
+    pub fn add_weighted_jt_many<const K: usize>(&self, model: &Model, y: [&[f64]; K], out: [&mut [f64]; K]) {
         let jac = &self.constraints.jac;
         match (&self.solver, model.mass()) {
             (Solver::Constant(_), Some(mass)) => {
                 let weight = mass.inverse();
                 assert!(weight.len() == model.n(), "a mass of another model");
                 // SAFETY: as in `add_weighted_jt`.
-                scatter(model, jac, -1.0, [y0, y1], [out0, out1], |s, j, c| unsafe {
+                scatter(model, jac, -1.0, y, out, |s, j, c| unsafe {
                     s * weight.get_unchecked(c) * jac.get_unchecked(j)
                 })
             }
             (Solver::Blocks(b), _) => {
                 let weighted = &b.weighted;
                 // SAFETY: as in `add_weighted_jt`.
-                scatter(model, weighted, -1.0, [y0, y1], [out0, out1], |s, j, _| unsafe {
-                    s * weighted.get_unchecked(j)
-                })
+                scatter(model, weighted, -1.0, y, out, |s, j, _| unsafe { s * weighted.get_unchecked(j) })
             }
             (Solver::General(g), _) => {
-                g.add_weighted_jt(model.n(), y0, -1.0, out0);
-                g.add_weighted_jt(model.n(), y1, -1.0, out1)
+                y.into_iter().zip(out).for_each(|(y, out)| g.add_weighted_jt(model.n(), y, -1.0, out))
             }
             (Solver::Constant(_), None) => unreachable!("a workspace built for another model"),
         }

@@ -151,6 +151,25 @@ impl Dynamics {
     /// Evaluates everything at `(q, v, t)`: constraints, forces, the
     /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
     pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
+        self.evaluate_but_reaction(model, q, v, t)?;
+        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
+        let mut acc = std::mem::take(&mut self.acc);
+        self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
+        self.acc = acc;
+        Ok(())
+    }
+
+    /// [`evaluate`](Self::evaluate) but for the constraint forces in `A`:
+    /// [`acc`](Self::acc) is `M⁻¹G` until the caller subtracts `M⁻¹Φ_qᵀλ`
+    /// (with [`take_acc`](Self::take_acc)) — in the same pass over the
+    /// Jacobian as the control terms' own products, which saves one.
+    pub(crate) fn evaluate_but_reaction(
+        &mut self,
+        model: &Model,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+    ) -> Result<(), Breakdown> {
         self.evaluate_forces(model, q, v, t)?;
         if model.m() == 0 {
             return Ok(());
@@ -180,11 +199,16 @@ impl Dynamics {
             Solver::General(g) => g.factor_and_solve(model, &self.constraints.jac, &mut self.lambda)?,
             Solver::Blocks(b) => b.factor_and_solve(&self.constraints.jac, &mut self.lambda)?,
         }
-        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        let mut acc = std::mem::take(&mut self.acc);
-        self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
-        self.acc = acc;
         Ok(())
+    }
+
+    /// Lends `A` (as [`evaluate_but_reaction`](Self::evaluate_but_reaction)
+    /// left it) to `f`, which finishes it.
+    pub(crate) fn take_acc<R>(&mut self, f: impl FnOnce(&Self, &mut [f64]) -> R) -> R {
+        let mut acc = std::mem::take(&mut self.acc);
+        let out = f(self, &mut acc);
+        self.acc = acc;
+        out
     }
 
     /// The first half of [`evaluate`](Self::evaluate): `V`, `G`, `M(q)`

@@ -7,7 +7,7 @@ use crate::control::evaluation::Evaluation;
 use crate::control::gains::Operators;
 use crate::control::held::Held;
 use crate::control::projection::{self, Failure, Projection};
-use crate::control::{Control, Workspace};
+use crate::control::{Control, Energy, Workspace};
 use crate::dynamics::diagnostics::{Measures, Probe};
 use crate::dynamics::energy;
 use crate::dynamics::momentum::{self, Kind, Momenta, Symmetries};
@@ -17,6 +17,7 @@ use crate::linalg::mass::MassAt;
 use crate::model::Model;
 use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
+use std::cell::RefCell;
 
 /// A model with a control law: the right-hand side an [`Integrator`](crate::integrate::Integrator) steps.
 #[derive(Clone)]
@@ -169,11 +170,19 @@ impl Rhs for ControlledSystem<'_> {
         let n = self.model.n();
         let (q, v, e) = split_state(x, n);
         self.evaluations += 1;
-        self.dynamics.evaluate(self.model, q, v, t).map_err(|b| EvalError::at(b, t))?;
+        // The projected energy law (robust's) takes its products with
+        // M⁻¹Φ_qᵀ in a pass over the Jacobian, which also subtracts A's
+        // constraint forces (one pass fewer); no law of that kind reads A.
+        let fused = u.is_some() && matches!(self.control.energy, Energy::Projected { .. });
+        let evaluated = if fused {
+            self.dynamics.evaluate_but_reaction(self.model, q, v, t)
+        } else {
+            self.dynamics.evaluate(self.model, q, v, t)
+        };
+        evaluated.map_err(|b| EvalError::at(b, t))?;
         self.dependent = self.dependent.max(self.dynamics.dependent_rows());
         let e_dot = self.dynamics.energy_input();
         f[..n].copy_from_slice(v);
-        f[n..2 * n].copy_from_slice(self.dynamics.acc());
         f[2 * n] = e_dot;
         if let Some(u) = u {
             let psi = energy::psi(&self.dynamics.mass(self.model), v, self.dynamics.potential(), e, self.e0);
@@ -191,22 +200,36 @@ impl Rhs for ControlledSystem<'_> {
                 None
             };
             let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work, held };
-            let (model, dynamics, momenta) = (self.model, &self.dynamics, &self.momenta);
-            // The laws are compiled once per kind of mass, so that a constant
-            // diagonal `M` runs its loops without a match per product
-            // (Example 1 took 6.6 % more instructions per step with one).
-            match dynamics.mass(model) {
-                MassAt::Diagonal(mass) => {
-                    self.control.terms(&Evaluated { model, dynamics, mass, momenta }, v, psi, e_dot, u_q, u_v, work)
+            let (model, control, momenta) = (self.model, &self.control, &self.momenta);
+            let run = |dynamics: &Dynamics, reaction: Option<&mut [f64]>| {
+                let reaction = RefCell::new(reaction);
+                // The laws are compiled once per kind of mass, so that a constant
+                // diagonal `M` runs its loops without a match per product
+                // (Example 1 took 6.6 % more instructions per step with one).
+                macro_rules! terms {
+                    ($mass:expr) => {{
+                        let e = Evaluated { model, dynamics, mass: $mass, momenta, reaction };
+                        control.terms(&e, v, psi, e_dot, u_q, u_v, work);
+                        e.reaction.into_inner()
+                    }};
                 }
-                MassAt::Dense(mass) => {
-                    self.control.terms(&Evaluated { model, dynamics, mass, momenta }, v, psi, e_dot, u_q, u_v, work)
+                let left = match dynamics.mass(model) {
+                    MassAt::Diagonal(mass) => terms!(mass),
+                    MassAt::Dense(mass) => terms!(mass),
+                    MassAt::Blocks(mass) => terms!(mass),
+                };
+                // No pair of products took them (no law called for one).
+                if let Some(acc) = left {
+                    dynamics.add_weighted_jt(model, dynamics.lambda(), -1.0, acc);
                 }
-                MassAt::Blocks(mass) => {
-                    self.control.terms(&Evaluated { model, dynamics, mass, momenta }, v, psi, e_dot, u_q, u_v, work)
-                }
+            };
+            if fused {
+                self.dynamics.take_acc(|dynamics, acc| run(dynamics, Some(acc)));
+            } else {
+                run(&self.dynamics, None);
             }
         }
+        f[n..2 * n].copy_from_slice(self.dynamics.acc());
         Ok(())
     }
 }
@@ -239,7 +262,8 @@ impl System for ControlledSystem<'_> {
         let (q, v, _) = split_state(x, self.model.n());
         let (model, n) = (self.model, self.model.n());
         self.dynamics.evaluate(model, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let d = Evaluated { model, dynamics: &self.dynamics, mass: &self.dynamics.mass(model), momenta: &self.momenta };
+        let mass = self.dynamics.mass(model);
+        let d = Evaluated::new(model, &self.dynamics, &mass, &self.momenta);
         let rows = (0..model.m()).map(|r| d.row(r).0.iter().map(|j| j * j).sum::<f64>());
         let damping = |w: &[f64], out: &mut [f64]| {
             out.fill(0.0);
