@@ -210,16 +210,7 @@ fn bad_limits_get_one_line_naming_the_joint() {
 /// its revolute joint's coordinate is its angle.
 fn planar_rod(limit: &str, more: &str) -> String {
     format!(
-        r#"
-[model]
-kind = "mechanism"
-gravity = [0.0, -{G}]
-
-[integrator]
-scheme = "rk4"
-h = {H}
-t_end = 1.0
-
+        r#"{header}
 [[bodies]]
 name = "rod"
 mass = {M}
@@ -234,8 +225,17 @@ b = "rod"
 point_b = [0.0, {L}]
 limit = {limit}
 {more}"#,
+        header = planar_header(1.0),
         x = L * PHI0.sin(),
         y = -L * PHI0.cos(),
+    )
+}
+
+/// The `[model]` and `[integrator]` of the planar cases: under gravity,
+/// RK-4 at `H` for `t_end`.
+fn planar_header(t_end: f64) -> String {
+    format!(
+        "\n[model]\nkind = \"mechanism\"\ngravity = [0.0, -{G}]\n\n[integrator]\nscheme = \"rk4\"\nh = {H}\nt_end = {t_end:?}\n"
     )
 }
 
@@ -268,16 +268,7 @@ fn a_planar_slider_is_stopped_at_its_limit_down_an_incline_and_its_velocity_boun
     // A point mass from rest down a line at α below the horizontal: s = ½ g sin α t².
     let (alpha, d) = (0.5_f64, 0.4);
     let text = format!(
-        r#"
-[model]
-kind = "mechanism"
-gravity = [0.0, -{G}]
-
-[integrator]
-scheme = "rk4"
-h = {H}
-t_end = 0.6
-
+        r#"{header}
 [[bodies]]
 name = "block"
 mass = 3.0
@@ -290,6 +281,7 @@ b = "block"
 axis = [{c}, {s}]
 limit = {{ upper = {d}, velocity = 1.0 }}
 "#,
+        header = planar_header(0.6),
         c = alpha.cos(),
         s = -alpha.sin(),
     );
