@@ -152,10 +152,7 @@ impl Dynamics {
     /// factorization of `Φ_q M⁻¹ Φ_qᵀ`, `λ` and `A`.
     pub fn evaluate(&mut self, model: &Model, q: &[f64], v: &[f64], t: f64) -> Result<(), Breakdown> {
         self.evaluate_but_reaction(model, q, v, t)?;
-        // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        let mut acc = std::mem::take(&mut self.acc);
-        self.add_weighted_jt(model, &self.lambda, -1.0, &mut acc);
-        self.acc = acc;
+        self.take_acc(|d, acc| d.subtract_reaction(model, acc));
         Ok(())
     }
 
@@ -204,11 +201,15 @@ impl Dynamics {
 
     /// Lends `A` (as [`evaluate_but_reaction`](Self::evaluate_but_reaction)
     /// left it) to `f`, which finishes it.
-    pub(crate) fn take_acc<R>(&mut self, f: impl FnOnce(&Self, &mut [f64]) -> R) -> R {
+    pub(crate) fn take_acc(&mut self, f: impl FnOnce(&Self, &mut [f64])) {
         let mut acc = std::mem::take(&mut self.acc);
-        let out = f(self, &mut acc);
+        f(self, &mut acc);
         self.acc = acc;
-        out
+    }
+
+    /// `acc −= M⁻¹ Φ_qᵀ λ`: `A`'s constraint forces (Eq. 8, `A = M⁻¹ (G − Φ_qᵀ λ)`).
+    pub(crate) fn subtract_reaction(&self, model: &Model, acc: &mut [f64]) {
+        self.add_weighted_jt(model, &self.lambda, -1.0, acc);
     }
 
     /// The first half of [`evaluate`](Self::evaluate): `V`, `G`, `M(q)`

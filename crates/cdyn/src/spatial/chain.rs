@@ -27,13 +27,5 @@ pub fn chain(n: usize, theta0: f64, g: f64) -> Mechanism {
         })
         .collect();
     let joints = (0..n).map(|i| Joint::new(JointKind::Spherical, i, i.checked_sub(1), end(i))).collect();
-    Mechanism {
-        bodies,
-        joints,
-        gravity: [0.0, 0.0, -g],
-        loads: vec![],
-        couplings: vec![],
-        actuators: vec![],
-        ground: vec![],
-    }
+    Mechanism::new([0.0, 0.0, -g]).with_bodies(bodies).with_joints(joints)
 }

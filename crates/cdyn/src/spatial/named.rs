@@ -144,6 +144,6 @@ impl Mechanism {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { bodies, joints, gravity, loads, couplings: Vec::new(), actuators: Vec::new(), ground: Vec::new() })
+        Ok(Self { bodies, joints, loads, ..Self::new(gravity) })
     }
 }

@@ -220,7 +220,7 @@ impl Rhs for ControlledSystem<'_> {
                 };
                 // No pair of products took them (no law called for one).
                 if let Some(acc) = left {
-                    dynamics.add_weighted_jt(model, dynamics.lambda(), -1.0, acc);
+                    dynamics.subtract_reaction(model, acc);
                 }
             };
             if fused {
