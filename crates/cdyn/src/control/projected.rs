@@ -45,27 +45,30 @@ impl Control {
             Velocity::None => 0.0,
         };
         let mass = d.mass();
-        let (phi_dot, phi_t) = (d.phi_dot(), d.phi_t());
+        // Every row vector cut to the same length, so that the row loops
+        // below index them without bounds checks.
+        let m = z_dot.len();
+        let (phi, phi_dot, phi_t) = (&d.phi()[..m], &d.phi_dot()[..m], &d.phi_t()[..m]);
+        let (z_q, y_v, y_w, phi_q_w) = (&mut z_q[..m], &mut y_v[..m], &mut y_w[..m], &mut phi_q_w[..m]);
         let energy = alpha_e > 0.0;
-        let scleronomic = phi_t.iter().all(|&x| x == 0.0);
-        // The right-hand sides in use: α_g Φ, Φ̇, and Φ_q v = Φ̇ − Φ_t where it differs from Φ̇.
-        if let Some(a) = alpha_g {
-            z_q.iter_mut().zip(d.phi()).for_each(|(b, p)| *b = a * p);
-        }
-        z_dot.copy_from_slice(phi_dot);
-        let separate_y_v = energy && !scleronomic;
-        if separate_y_v {
-            y_v.iter_mut().zip(phi_dot).zip(phi_t).for_each(|((b, pd), pt)| *b = pd - pt);
-        }
         let c = if energy { position_weight / (alpha_e * alpha_e) } else { 0.0 };
         let positions = c > 0.0;
         if positions || (energy && alpha_g.is_some()) {
             mass.solve(d.grad_potential(), w);
             d.potential_rate(w, phi_q_w);
         }
-        if positions {
-            y_w.copy_from_slice(phi_q_w);
+        // The right-hand sides, in one pass over the rows (each pass has a
+        // fixed cost that is most of a small model's): α_g Φ, Φ̇, Φ_q w, and
+        // Φ_q v = Φ̇ − Φ_t, solved apart from Φ̇ only where they differ.
+        let mut scleronomic = true;
+        for r in 0..m {
+            z_q[r] = alpha_g.map_or(0.0, |a| a * phi[r]);
+            z_dot[r] = phi_dot[r];
+            y_v[r] = phi_dot[r] - phi_t[r];
+            scleronomic &= phi_t[r] == 0.0;
+            y_w[r] = phi_q_w[r];
         }
+        let separate_y_v = energy && !scleronomic;
         {
             let mut rhs: [&mut [f64]; 4] = Default::default();
             let mut k = 0;
@@ -82,15 +85,26 @@ impl Control {
         // The unit vectors' velocities carried along by U_q (whose energy
         // part moves no unit vector's length), before the energy term
         // reads U_v.
-        if let Some(a) = alpha_g {
-            carry_rate(d.unit_vectors(), d.phi(), z_q, a, v, u_v);
+        if let Some(a) = alpha_g
+            && !d.unit_vectors().is_empty()
+        {
+            carry_rate(d.unit_vectors(), phi, z_q, a, v, u_v);
         }
         let (mut kappa, mut kappa_c) = (0.0, 0.0);
         let momenta = d.momenta();
         let (along, kept) = momenta.split(v);
         if energy {
             let y_v: &[f64] = if separate_y_v { y_v } else { z_dot };
-            let phi_q_v = |r: usize| phi_dot[r] - phi_t[r];
+            // The sums over the rows, in one pass: (Φ_q w)·z_Φ, (Φ_q v)·z_Φ̇,
+            // (Φ_q v)·y_v and (Φ_q w)·y_w.
+            let (mut w_z_q, mut v_z_dot, mut v_y_v, mut w_y_w) = (0.0, 0.0, 0.0, 0.0);
+            for r in 0..m {
+                let phi_q_v = phi_dot[r] - phi_t[r];
+                w_z_q += phi_q_w[r] * z_q[r];
+                v_z_dot += phi_q_v * z_dot[r];
+                v_y_v += phi_q_v * y_v[r];
+                w_y_w += phi_q_w[r] * y_w[r];
+            }
             let grad = d.grad_potential();
             // The rate at which the other terms change Ψ (moving q through V,
             // v through T) is cancelled too: the whole control gives Ψ̇ = −α_e Ψ.
@@ -106,20 +120,17 @@ impl Control {
             }
             if alpha_g.is_some() {
                 // ∇V·(−M⁻¹Φ_qᵀ z_Φ) = −(Φ_q w)·z_Φ
-                others -= dot(phi_q_w, z_q);
+                others -= w_z_q;
             }
             // vᵀM(−α_v M⁻¹Φ_qᵀ z_Φ̇) = −α_v (Φ_q v)·z_Φ̇
-            let phi_q_v_z_dot = (0..z_dot.len()).map(|r| phi_q_v(r) * z_dot[r]).sum::<f64>();
-            others -= alpha_v * phi_q_v_z_dot;
+            others -= alpha_v * v_z_dot;
             let target = alpha_e * psi + others;
             // N = c|P M⁻¹∇V|²_M + |P_E P v|²_M, |P_E P v|²_M = vᵀMv − (Φ_q v)·y_v − pᵀ(EᵀME)⁻¹p
             // (P_E and P commute, since Φ_q E = 0).
             let whole = 2.0 * mass.kinetic(v);
-            let phi_q_v_y_v =
-                if separate_y_v { (0..y_v.len()).map(|r| phi_q_v(r) * y_v[r]).sum::<f64>() } else { phi_q_v_z_dot };
-            let mut norm = whole - phi_q_v_y_v - kept;
+            let mut norm = whole - v_y_v - kept;
             if positions {
-                norm += c * (dot(grad, w) - dot(phi_q_w, y_w));
+                norm += c * (dot(grad, w) - w_y_w);
             }
             // A correction is a first-order step along the gradient; where the
             // gradient is too short to reach the target without the quadratic
@@ -132,20 +143,16 @@ impl Control {
                 (kappa, kappa_c) = (scale, scale * c);
             }
         }
-        // U_q = −M⁻¹Φ_qᵀ(α_g z_Φ − κc y_w) − κc w
-        if alpha_g.is_none() {
-            z_q.fill(0.0);
+        // U_q = −M⁻¹Φ_qᵀ(α_g z_Φ − κc y_w) − κc w and U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v:
+        // their weights on the rows in one pass (y_v is z_Φ̇ itself where not solved apart).
+        for r in 0..m {
+            if kappa_c != 0.0 {
+                z_q[r] -= kappa_c * y_w[r];
+            }
+            z_dot[r] = if separate_y_v { alpha_v * z_dot[r] - kappa * y_v[r] } else { z_dot[r] * (alpha_v - kappa) };
         }
         if kappa_c != 0.0 {
-            z_q.iter_mut().zip(y_w.iter()).for_each(|(z, y)| *z -= kappa_c * y);
             u_q.iter_mut().zip(w.iter()).for_each(|(u, w)| *u -= kappa_c * w);
-        }
-        // U_v = −M⁻¹Φ_qᵀ(α_v z_Φ̇ − κ y_v) − κ v
-        if separate_y_v {
-            z_dot.iter_mut().zip(y_v.iter()).for_each(|(z, y)| *z = alpha_v * *z - kappa * y);
-        } else {
-            // y_v is z_Φ̇ itself.
-            z_dot.iter_mut().for_each(|z| *z *= alpha_v - kappa);
         }
         if kappa != 0.0 {
             mass.add_inverse_psi_v(v, -kappa, u_v);

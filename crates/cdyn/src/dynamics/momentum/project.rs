@@ -20,13 +20,22 @@ pub(crate) struct Momenta {
     constant: bool,
     /// `M E` has been formed.
     ready: bool,
+    /// Number of directions, `k`.
+    k: usize,
     n: usize,
 }
 
 impl Momenta {
     /// No directions: every operation is a no-op.
-    pub(crate) const NONE: Momenta =
-        Momenta { e: Vec::new(), mass_e: Vec::new(), gram_inverse: Vec::new(), constant: true, ready: true, n: 0 };
+    pub(crate) const NONE: Momenta = Momenta {
+        e: Vec::new(),
+        mass_e: Vec::new(),
+        gram_inverse: Vec::new(),
+        constant: true,
+        ready: true,
+        k: 0,
+        n: 0,
+    };
 
     /// The constant directions of `kept` (not the rotations), for a model of `n` coordinates; `M e` is
     /// set by [`update`](Self::update).
@@ -39,6 +48,7 @@ impl Momenta {
             gram_inverse: vec![0.0; k * k],
             constant,
             ready: k == 0,
+            k,
             n,
         }
     }
@@ -46,13 +56,13 @@ impl Momenta {
     /// Number of directions.
     #[inline(always)]
     pub(crate) fn len(&self) -> usize {
-        self.gram_inverse.len().isqrt()
+        self.k
     }
 
     /// Whether there are none.
     #[inline(always)]
     pub(crate) fn is_empty(&self) -> bool {
-        self.gram_inverse.is_empty()
+        self.k == 0
     }
 
     /// Whether `M E` must be formed (again) at the current state.
@@ -94,8 +104,11 @@ impl Momenta {
     }
 
     /// `out += scale · E a`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn add_directions(&self, a: &[f64; MAX_MOMENTA], scale: f64, out: &mut [f64]) {
+        if self.is_empty() {
+            return;
+        }
         let n = self.n;
         for (j, &aj) in a.iter().enumerate().take(self.len()) {
             let s = scale * aj;
@@ -116,7 +129,7 @@ impl Momenta {
 
     /// `x`'s coefficients `a` along the momentum directions and the part
     /// of `|x|²_M` along them, `(EᵀMx)ᵀ (EᵀME)⁻¹ (EᵀMx) = aᵀ EᵀMx`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn split(&self, x: &[f64]) -> ([f64; MAX_MOMENTA], f64) {
         if self.is_empty() {
             return ([0.0; MAX_MOMENTA], 0.0);
