@@ -130,7 +130,7 @@ impl Dynamics {
 
     /// Whether `Φ_q M⁻¹ Φ_qᵀ` is factored along a sparse pattern (fewer
     /// entries of `L` than the full triangle), as [`LinearSolver::Auto`]
-    /// chooses for chains and trees.
+    /// finds for chains and trees.
     pub fn sparse_factor(&self) -> bool {
         match &self.solver {
             Solver::Constant(schur) => schur.is_sparse(),

@@ -67,6 +67,33 @@ impl Structure {
     }
 }
 
+/// The pattern of `L` for the `m × m` symmetric pattern with entries
+/// `(a, b)` in the natural order: no fill-reducing permutation, so that
+/// the rows are eliminated, and dependent ones dropped, in their own order.
+/// Its entries are a subset of the full triangle's, and the elimination
+/// along it does the same arithmetic less the products of structural zeros.
+pub(crate) fn natural(m: usize, entries: impl Iterator<Item = (usize, usize)>) -> Structure {
+    let mut below: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); m];
+    for (a, b) in entries {
+        if a != b {
+            below[a.min(b)].insert(a.max(b));
+        }
+    }
+    let (mut col_ptr, mut row_idx) = (vec![0], Vec::new());
+    for j in 0..m {
+        let column = std::mem::take(&mut below[j]);
+        // Eliminating row j couples its rows below it with each other; the
+        // first of them (its parent in the elimination tree) takes the rest.
+        let mut rows = column.iter().copied();
+        if let Some(parent) = rows.next() {
+            below[parent].extend(rows);
+        }
+        row_idx.extend(column);
+        col_ptr.push(row_idx.len());
+    }
+    Structure { perm: None, col_ptr, row_idx }
+}
+
 /// Analyses the `m × m` symmetric pattern with entries `(a, b)`, `a ≥ b`
 /// (repeats allowed).
 pub(crate) fn analyse(m: usize, entries: impl Iterator<Item = (usize, usize)>) -> Structure {
