@@ -17,7 +17,7 @@ use crate::linalg::mass::MassAt;
 use crate::model::Model;
 use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
-use std::cell::RefCell;
+use std::cell::Cell;
 
 /// A model with a control law: the right-hand side an [`Integrator`](crate::integrate::Integrator) steps.
 #[derive(Clone)]
@@ -202,7 +202,7 @@ impl Rhs for ControlledSystem<'_> {
             let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.work, held };
             let (model, control, momenta) = (self.model, &self.control, &self.momenta);
             let run = |dynamics: &Dynamics, reaction: Option<&mut [f64]>| {
-                let reaction = RefCell::new(reaction);
+                let reaction = Cell::new(reaction);
                 // The laws are compiled once per kind of mass, so that a constant
                 // diagonal `M` runs its loops without a match per product
                 // (Example 1 took 6.6 % more instructions per step with one).

@@ -6,7 +6,7 @@ use crate::dynamics::Dynamics;
 use crate::dynamics::momentum::Momenta;
 use crate::linalg::mass::MassMatrix;
 use crate::model::Model;
-use std::cell::RefCell;
+use std::cell::Cell;
 
 /// One evaluation of a general model, as the control laws read it, with
 /// its mass matrix `M` (a kind, or [`MassAt`] where either will do).
@@ -19,12 +19,12 @@ pub(super) struct Evaluated<'a, M> {
     /// ([`Dynamics::evaluate_but_reaction`]): the first pair of products
     /// the laws take subtracts `M⁻¹Φ_qᵀλ` from it in the same pass over the
     /// Jacobian, and takes it.
-    pub(super) reaction: RefCell<Option<&'a mut [f64]>>,
+    pub(super) reaction: Cell<Option<&'a mut [f64]>>,
 }
 
 impl<'a, M> Evaluated<'a, M> {
     pub(super) fn new(model: &'a Model, dynamics: &'a Dynamics, mass: &'a M, momenta: &'a Momenta) -> Self {
-        Self { model, dynamics, mass, momenta, reaction: RefCell::new(None) }
+        Self { model, dynamics, mass, momenta, reaction: Cell::new(None) }
     }
 }
 
@@ -61,13 +61,15 @@ impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
     fn jac_mul(&self, x: &[f64], out: &mut [f64]) {
         self.dynamics.jac_mul(self.model, x, out);
     }
+    #[inline]
     fn add_weighted_jt_pair(&self, [y0, y1]: [&[f64]; 2], [out0, out1]: [&mut [f64]; 2]) {
         let (model, dynamics) = (self.model, self.dynamics);
-        match self.reaction.borrow_mut().take() {
+        match self.reaction.take() {
             Some(acc) => dynamics.add_weighted_jt_many(model, [dynamics.lambda(), y0, y1], [acc, out0, out1]),
             None => dynamics.add_weighted_jt_many(model, [y0, y1], [out0, out1]),
         }
     }
+    #[inline]
     fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
         match self.dynamics.potential_rate() {
             Some(rate) => out.copy_from_slice(rate),
