@@ -58,10 +58,18 @@ pub(crate) trait Evaluation {
         &NO_MOMENTA
     }
 
-    /// `out = Φ_q w` for `w = M⁻¹Ψ_q`, from the evaluation itself where it
-    /// has it.
+    /// `Φ_q w` for `w = M⁻¹Ψ_q`, where the evaluation has it from its own
+    /// right-hand side (otherwise the laws form it with [`jac_mul`](Self::jac_mul)).
+    fn kept_potential_rate(&self) -> Option<&[f64]> {
+        None
+    }
+
+    /// `out = Φ_q w` for `w = M⁻¹Ψ_q`: the evaluation's own where it has it.
     fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
-        self.jac_mul(w, out);
+        match self.kept_potential_rate() {
+            Some(rate) => out.copy_from_slice(rate),
+            None => self.jac_mul(w, out),
+        }
     }
 
     /// `out = Φ_q x`.

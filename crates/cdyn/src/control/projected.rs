@@ -49,14 +49,24 @@ impl Control {
         // below index them without bounds checks.
         let m = z_dot.len();
         let (phi, phi_dot, phi_t) = (&d.phi()[..m], &d.phi_dot()[..m], &d.phi_t()[..m]);
-        let (z_q, y_v, y_w, phi_q_w) = (&mut z_q[..m], &mut y_v[..m], &mut y_w[..m], &mut phi_q_w[..m]);
+        let (z_q, y_v, y_w) = (&mut z_q[..m], &mut y_v[..m], &mut y_w[..m]);
         let energy = alpha_e > 0.0;
         let c = if energy { position_weight / (alpha_e * alpha_e) } else { 0.0 };
         let positions = c > 0.0;
-        if positions || (energy && alpha_g.is_some()) {
+        let reads_w = positions || (energy && alpha_g.is_some());
+        if reads_w {
             mass.solve(d.grad_potential(), w);
-            d.potential_rate(w, phi_q_w);
         }
+        // Φ_q w, read off the evaluation where it kept it (stale, and unread, without `w`).
+        let phi_q_w: &[f64] = match d.kept_potential_rate() {
+            Some(rate) if reads_w => &rate[..m],
+            _ => {
+                if reads_w {
+                    d.jac_mul(w, phi_q_w);
+                }
+                &phi_q_w[..m]
+            }
+        };
         // The right-hand sides, in one pass over the rows (each pass has a
         // fixed cost that is most of a small model's): α_g Φ, Φ̇, Φ_q w, and
         // Φ_q v = Φ̇ − Φ_t, solved apart from Φ̇ only where they differ.
@@ -92,7 +102,8 @@ impl Control {
         }
         let (mut kappa, mut kappa_c) = (0.0, 0.0);
         let momenta = d.momenta();
-        let (along, kept) = momenta.split(v);
+        let split = (!momenta.is_empty()).then(|| momenta.split(v));
+        let kept = split.map_or(0.0, |(_, kept)| kept);
         if energy {
             let y_v: &[f64] = if separate_y_v { y_v } else { z_dot };
             // The sums over the rows, in one pass: (Φ_q w)·z_Φ, (Φ_q v)·z_Φ̇,
@@ -156,7 +167,9 @@ impl Control {
         }
         if kappa != 0.0 {
             mass.add_inverse_psi_v(v, -kappa, u_v);
-            momenta.add_directions(&along, kappa, u_v);
+            if let Some((along, _)) = &split {
+                momenta.add_directions(along, kappa, u_v);
+            }
         }
         // Both products in one pass over the Jacobian.
         d.add_weighted_jt_pair([z_q, z_dot], [u_q, u_v]);

@@ -70,11 +70,8 @@ impl<M: MassMatrix> Evaluation for Evaluated<'_, M> {
         }
     }
     #[inline]
-    fn potential_rate(&self, w: &[f64], out: &mut [f64]) {
-        match self.dynamics.potential_rate() {
-            Some(rate) => out.copy_from_slice(rate),
-            None => self.dynamics.jac_mul(self.model, w, out),
-        }
+    fn kept_potential_rate(&self) -> Option<&[f64]> {
+        self.dynamics.potential_rate()
     }
     fn unit_vectors(&self) -> &[crate::model::unit_vector::UnitVector] {
         self.model.unit_vectors()
