@@ -28,7 +28,7 @@ impl Control {
         &self,
         d: &E,
         v: &[f64],
-        psi: f64,
+        [psi, kinetic]: [f64; 2],
         alpha_e: f64,
         position_weight: f64,
         u_q: &mut [f64],
@@ -138,7 +138,7 @@ impl Control {
             let target = alpha_e * psi + others;
             // N = c|P M⁻¹∇V|²_M + |P_E P v|²_M, |P_E P v|²_M = vᵀMv − (Φ_q v)·y_v − pᵀ(EᵀME)⁻¹p
             // (P_E and P commute, since Φ_q E = 0).
-            let whole = 2.0 * mass.kinetic(v);
+            let whole = 2.0 * kinetic;
             let mut norm = whole - v_y_v - kept;
             if positions {
                 norm += c * (dot(grad, w) - w_y_w);

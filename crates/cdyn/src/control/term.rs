@@ -166,15 +166,14 @@ impl Control {
     }
 
     /// Writes the control term `U = (U_q, U_v)` at a state whose dynamics
-    /// `d` were just evaluated. `psi` and `e_dot` are `Ψ` and `Ė` there.
-    #[allow(clippy::too_many_arguments)]
+    /// `d` were just evaluated, where `Ψ`, `T = ½vᵀMv` and `Ė` are
+    /// `[psi, kinetic, e_dot]` (`T` as `Ψ` took it, not formed again).
     #[inline(always)]
     pub(crate) fn terms<E: Evaluation>(
         &self,
         d: &E,
         v: &[f64],
-        psi: f64,
-        e_dot: f64,
+        [psi, kinetic, e_dot]: [f64; 3],
         u_q: &mut [f64],
         u_v: &mut [f64],
         work: Workspace<'_>,
@@ -284,7 +283,7 @@ impl Control {
                 // A_geo = A + U_v so far and Ψ_v M⁻¹ Ψ_vᵀ = vᵀ M v = 2T (Eqs. 17–19).
                 // With momenta kept, μ acts along P_E v, and Ψ_v P_E v = |P_E v|²_M.
                 let (along, kept) = momenta.split(v);
-                let whole = 2.0 * mass.kinetic(v);
+                let whole = 2.0 * kinetic;
                 let two_t = whole - kept;
                 if two_t > REST && (momenta.is_empty() || two_t > RELATIVE_REST * whole) {
                     let (acc, grad) = (d.acc(), d.grad_potential());
@@ -305,13 +304,13 @@ impl Control {
                         // angular momenta held together.
                         let [a, b, r2, r3, r4] = rows;
                         let others = [&mut *a, &mut *b, r2, r3, r4];
-                        self.coupled_terms(d, v, psi, 0.0, position_weight, u_q, u_v, others, work.w);
+                        self.coupled_terms(d, v, [psi, kinetic], 0.0, position_weight, u_q, u_v, others, work.w);
                         let c = position_weight / (alpha_e * alpha_e);
                         let free =
                             |norm: f64, whole: f64| norm > REST && (momenta.is_empty() || norm > RELATIVE_REST * whole);
                         held.hold(d, v, psi, alpha_e, c, Some(free), u_q, u_v, [a, b], work.w);
                     }
-                    None => self.coupled_terms(d, v, psi, alpha_e, position_weight, u_q, u_v, rows, work.w),
+                    None => self.coupled_terms(d, v, [psi, kinetic], alpha_e, position_weight, u_q, u_v, rows, work.w),
                 }
             }
         }

@@ -15,7 +15,13 @@ use crate::linalg::mass::MassMatrix;
 /// `Ψ(q, v, e) = T(v) + V(q) − E₀ − e`, with `V` evaluated elsewhere.
 #[inline(always)]
 pub fn psi(mass: &impl MassMatrix, v: &[f64], potential: f64, e: f64, e0: f64) -> f64 {
-    mass.kinetic(v) + potential - e0 - e
+    psi_from(mass.kinetic(v), potential, e, e0)
+}
+
+/// `Ψ` from the kinetic energy `T` already formed (the control laws read `T` too).
+#[inline(always)]
+pub fn psi_from(kinetic: f64, potential: f64, e: f64, e0: f64) -> f64 {
+    kinetic + potential - e0 - e
 }
 
 /// `Ė = F·v + λᵀ Φ_t` from its parts.

@@ -114,13 +114,14 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
         f[N..2 * N].copy_from_slice(&d.acc);
         f[2 * N] = e_dot;
         if let Some(u) = u {
-            let psi = energy::psi(&d.mass, &v, d.potential, e, self.e0);
+            let kinetic = d.mass.kinetic(&v);
+            let psi = energy::psi_from(kinetic, d.potential, e, self.e0);
             let (u_q, rest) = u.split_at_mut(N);
             let (u_v, u_e) = rest.split_at_mut(N);
             u_e[0] = 0.0;
             let [r0, r1, r2, r3, r4] = &mut self.rows;
             let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.w, held: None };
-            self.control.terms(&*d, &v, psi, e_dot, u_q, u_v, work);
+            self.control.terms(&*d, &v, [psi, kinetic, e_dot], u_q, u_v, work);
         }
         Ok(())
     }

@@ -13,7 +13,7 @@ use crate::dynamics::energy;
 use crate::dynamics::momentum::{self, Kind, Momenta, Symmetries};
 use crate::dynamics::{DependentRows, Dynamics, LinearSolver};
 use crate::integrate::Rhs;
-use crate::linalg::mass::MassAt;
+use crate::linalg::mass::{MassAt, MassMatrix};
 use crate::model::Model;
 use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
@@ -185,7 +185,8 @@ impl Rhs for ControlledSystem<'_> {
         f[..n].copy_from_slice(v);
         f[2 * n] = e_dot;
         if let Some(u) = u {
-            let psi = energy::psi(&self.dynamics.mass(self.model), v, self.dynamics.potential(), e, self.e0);
+            let kinetic = self.dynamics.mass(self.model).kinetic(v);
+            let psi = energy::psi_from(kinetic, self.dynamics.potential(), e, self.e0);
             let (u_q, u_v, u_e) = split_state_mut(u, n);
             *u_e = 0.0;
             let [r0, r1, r2, r3, r4] = &mut self.rows;
@@ -209,7 +210,7 @@ impl Rhs for ControlledSystem<'_> {
                 macro_rules! terms {
                     ($mass:expr) => {{
                         let e = Evaluated { model, dynamics, mass: $mass, momenta, reaction };
-                        control.terms(&e, v, psi, e_dot, u_q, u_v, work);
+                        control.terms(&e, v, [psi, kinetic, e_dot], u_q, u_v, work);
                         e.reaction.into_inner()
                     }};
                 }
