@@ -57,7 +57,8 @@ impl Control {
         if reads_w {
             mass.solve(d.grad_potential(), w);
         }
-        // Φ_q w, read off the evaluation where it kept it (stale, and unread, without `w`).
+        // Φ_q w, read off the evaluation where it kept it. Where `w` is not
+        // needed, the buffer's old values are copied below and never read.
         let phi_q_w: &[f64] = match d.kept_potential_rate() {
             Some(rate) if reads_w => &rate[..m],
             _ => {
@@ -147,8 +148,11 @@ impl Control {
             // gradient is too short to reach the target without the quadratic
             // terms dominating (N < |target|/α_e: a static equilibrium, or at
             // rest at an extremum of V on the constraint surface) the gain is
-            // capped so that |U| stays bounded (docs/methods.md).
-            let scale = target / norm.max(target.abs() / alpha_e);
+            // capped so that |U| stays bounded (docs/methods.md). The test
+            // multiplies instead of dividing: the common case then waits on
+            // one division, not two in a row (Example 1's step is short
+            // enough for that to show).
+            let scale = if norm * alpha_e >= target.abs() { target / norm } else { target / (target.abs() / alpha_e) };
             let relative = momenta.is_empty() || norm > RELATIVE_REST * whole;
             if norm > REST && relative && scale.is_finite() {
                 (kappa, kappa_c) = (scale, scale * c);

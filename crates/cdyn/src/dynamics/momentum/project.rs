@@ -106,9 +106,6 @@ impl Momenta {
     /// `out += scale · E a`.
     #[inline(always)]
     pub(crate) fn add_directions(&self, a: &[f64; MAX_MOMENTA], scale: f64, out: &mut [f64]) {
-        if self.is_empty() {
-            return;
-        }
         let n = self.n;
         for (j, &aj) in a.iter().enumerate().take(self.len()) {
             let s = scale * aj;
