@@ -9,9 +9,8 @@
 //! `t* = (F(π/2 | m) − F(ψ* | m)) / √k`, `m = sin²(φ₀/2)`, `sin ψ* =
 //! sin(φ*/2) / sin(φ₀/2)`, and the rate there `√(2k (cos φ* − cos φ₀))`.
 
+use crate::common::rod::{FINGER_UPPER, G, H, JYY, L, M, rod_at, turning_finger};
 use crate::common::{Table, cdyn, one_error_line, path_str, scenario, summary_case, table};
-
-const G: f64 = 9.81;
 
 /// `t*` of the module's head ([`cdyn::reference::time_to_swing`]).
 fn stop_time(k: f64, phi0: f64, phi_stop: f64) -> f64 {
@@ -37,49 +36,13 @@ fn run(text: &str, files: &[(&str, &str)]) -> (String, Table, serde_json::Value)
 
 // The rod of the library's test (crates/cdyn/tests/limits.rs), released at
 // φ₀ = 1.2 rad onto a stop at φ = 0.3 rad: its joint's θ = φ − φ₀ ≥ −0.9.
-const M: f64 = 2.0;
-const L: f64 = 0.5;
-const JYY: f64 = 0.02;
 const PHI0: f64 = 1.2;
 const PHI_STOP: f64 = 0.3;
-const H: f64 = 1e-3;
 
 fn rod(limit: &str) -> String {
     let (s, c) = (PHI0.sin(), PHI0.cos());
     let orientation = [(PHI0 / 2.0).cos(), 0.0, (PHI0 / 2.0).sin(), 0.0];
     rod_at(limit, [-L * s, 0.0, -L * c], orientation, "")
-}
-
-/// The rod of [`rod`] built at `position` and `orientation`, with `more`
-/// sections (an `[initial]`) before its body.
-fn rod_at(limit: &str, [x, y, z]: [f64; 3], [q0, q1, q2, q3]: [f64; 4], more: &str) -> String {
-    format!(
-        r#"
-[model]
-kind = "spatial"
-gravity = [0.0, 0.0, -{G}]
-
-[integrator]
-scheme = "rk4"
-h = {H}
-t_end = 1.0
-{more}
-[[bodies]]
-name = "rod"
-mass = {M}
-inertia = [0.02, {JYY}, 0.005]
-position = [{x}, {y}, {z}]
-orientation = [{q0}, {q1}, {q2}, {q3}]
-
-[[joints]]
-kind = "revolute"
-a = "rod"
-b = "ground"
-point = [0.0, 0.0, 0.0]
-axis = [0.0, 1.0, 0.0]
-limit = {limit}
-"#
-    )
 }
 
 fn column(header: &[String], name: &str) -> usize {
@@ -350,21 +313,6 @@ fn a_rods_angle_in_a_range_across_pi_is_reported_in_that_range_without_a_jump() 
     let reported = case["joint_space"]["joints"].as_array().unwrap();
     let stats = reported.iter().find(|c| c["column"] == "joints[0].q").unwrap();
     assert_eq!((stats["min"].as_f64(), stats["max"].as_f64()), (Some(low), Some(high)), "{stats}");
-}
-
-/// TIAGo's fingers' upper bound, its URDF's.
-#[allow(clippy::approx_constant)] // 6.28, not 2π
-const FINGER_UPPER: f64 = 6.28;
-
-/// The rod of [`rod_at`] hanging, without gravity, limited to TIAGo's
-/// fingers' −2.62 … 6.28 rad (more than a turn), started at the joint
-/// angle `theta0` turning up at 2 rad/s, run to `t_end`.
-fn turning_finger(theta0: f64, t_end: f64) -> String {
-    let initial = format!("\n[initial]\njoints = {{ \"joints[0]\" = {theta0} }}\nrates = {{ \"joints[0]\" = 2.0 }}\n");
-    let limit = format!("{{ lower = -2.62, upper = {FINGER_UPPER} }}");
-    rod_at(&limit, [0.0, 0.0, -L], [1.0, 0.0, 0.0, 0.0], &initial)
-        .replace(&format!("gravity = [0.0, 0.0, -{G}]"), "gravity = [0.0, 0.0, 0.0]")
-        .replace("t_end = 1.0", &format!("t_end = {t_end}"))
 }
 
 #[test]

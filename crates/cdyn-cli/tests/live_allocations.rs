@@ -16,6 +16,9 @@ use cdyn_cli::case::scenario;
 use cdyn_cli::io::alloc_count::{Counting, thread_allocations};
 use std::path::Path;
 
+#[path = "common/rod.rs"]
+mod rod;
+
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
@@ -163,36 +166,11 @@ limit = { lower = 0.3, velocity = 2.0 }
 fn a_multi_turn_joints_steps_through_pi_allocate_nothing_but_at_its_impact() {
     // A rod turning freely at 2 rad/s from 0 through π (its stops' gaps
     // followed across the seam of (−π, π] at every step) to its upper
-    // limit 6.2 of a range −2.62 … 6.2, more than a turn, at 3.1 s.
-    let text = r#"
-[model]
-kind = "spatial"
-
-[integrator]
-scheme = "rk4"
-h = 1e-3
-t_end = 3.5
-
-[initial]
-rates = { "joints[0]" = 2.0 }
-
-[[bodies]]
-name = "rod"
-mass = 2.0
-inertia = [0.02, 0.02, 0.005]
-position = [0.0, 0.0, -0.5]
-
-[[joints]]
-kind = "revolute"
-a = "rod"
-b = "ground"
-point = [0.0, 0.0, 0.0]
-axis = [0.0, 1.0, 0.0]
-limit = { lower = -2.62, upper = 6.2 }
-"#;
-    let mut live = live_of(text, Path::new("turning_finger.toml"));
+    // limit 6.28 of a range −2.62 … 6.28, more than a turn, at 3.14 s.
+    let mut live = live_of(&rod::turning_finger(0.0, 3.5), Path::new("turning_finger.toml"));
     assert!(steps_and_outputs_allocate_nothing(&mut live, 350) >= 1);
     let first = &live.limits().unwrap().events[0];
     assert_eq!((first.event, first.side), ("impact", "upper"));
-    assert!((first.t.0 - 3.1).abs() < 1e-9, "{}", first.t.0);
+    let t_star = rod::FINGER_UPPER / 2.0;
+    assert!((first.t.0 - t_star).abs() < 1e-9, "{} against {t_star} by hand", first.t.0);
 }

@@ -2,6 +2,8 @@
 //! written on the fly.
 #![allow(dead_code)] // each test file uses some of the helpers
 
+pub mod rod;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
