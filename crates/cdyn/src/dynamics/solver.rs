@@ -1,7 +1,7 @@
 //! How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied, by the kind of mass
 //! matrix: constant diagonal, dense `M(q)`, or block-diagonal `M(q)`.
 
-use crate::linalg::mass::{BlockMass, DenseMass, DiagonalMass, MassMatrix, WidthFn};
+use crate::linalg::mass::{BlockMass, DenseMass, MassMatrix, WidthFn};
 use crate::linalg::{Breakdown, DenseLdl, LinearSolver, Schur};
 use crate::model::Model;
 
@@ -27,11 +27,13 @@ pub const BLOCKS_FROM: usize = 16;
 /// The workspace of a block-diagonal `M(q)` ([`BlockMass`]), allocated once.
 ///
 /// With `M_b = L_b L_bᵀ` on each block, `S = Φ_q M⁻¹ Φ_qᵀ = J̃ W J̃ᵀ`, where
-/// `J̃` is `Φ_q` with each row's entries on a block multiplied by `L_b⁻ᵀ`
+/// `J̃` is `Φ_q` with each row's entries on a block multiplied by `L_b⁻¹`
 /// and `W` is `M⁻¹` outside the blocks and 1 on them. Since a row that
-/// reads a block reads all of it (the model checks), `J̃` and `M⁻¹ Φ_qᵀ`
-/// keep the pattern of `Φ_q`, and `S` is assembled and factored by the
-/// same sparse [`Schur`] as for a constant `M`.
+/// reads a block reads all of it (the model checks), a row's `J̃` on a
+/// block is a dense segment, and `S`'s entries from that block are the dot
+/// products of the segments on it, taken block by block at the block's
+/// width; the entries outside the blocks are summed product by product.
+/// `S` is then factored by the sparse [`Schur`], along its pattern.
 #[derive(Clone)]
 pub(super) struct Blocks {
     pub(super) mass: BlockMass,
@@ -39,16 +41,27 @@ pub(super) struct Blocks {
     pub(super) psi_q: Vec<f64>,
     /// `Ṁ q̇`
     pub(super) mdot_v: Vec<f64>,
-    /// `J̃`, in the pattern's order.
-    pub(super) scaled: Vec<f64>,
     /// `M⁻¹ Φ_qᵀ`, entry by entry in the pattern's order.
     pub(super) weighted: Vec<f64>,
     /// The Jacobian entries outside every block, with their coordinate.
     pub(super) plain: Vec<(u32, u32)>,
-    /// Each row's run of entries on one block: the block, and where its
-    /// entries (in the block's coordinate order) start in `entries`.
-    pub(super) segments: Vec<(u32, u32)>,
-    pub(super) entries: Vec<u32>,
+    /// The products `J_a J_b (M⁻¹)_cc` on coordinates outside the blocks,
+    /// with the slot of `S` each adds to.
+    plain_products: Vec<(u32, u32, f64, u32)>,
+    /// Each block's segments (`segment_start` by block): where a row's
+    /// entries on it start in `entries`, which holds their places in the
+    /// Jacobian in the block's coordinate order, and in `tilde`, which
+    /// holds `J̃` on them.
+    segment_start: Vec<u32>,
+    segments: Vec<u32>,
+    entries: Vec<u32>,
+    tilde: Vec<f64>,
+    /// Each block's pairs of segments (`pair_start` by block) and the slot
+    /// of `S` their dot product adds to.
+    pair_start: Vec<u32>,
+    pairs: Vec<(u32, u32, u32)>,
+    /// `S`'s entries by slot, assembled each step.
+    s: Vec<f64>,
     pub(super) schur: Schur,
 }
 
@@ -62,9 +75,12 @@ impl Blocks {
             }
         }
         let diagonal = model.diagonal_mass();
-        let (mut plain, mut segments, mut entries) = (Vec::new(), Vec::new(), Vec::new());
+        let schur = Schur::assembled_by_caller(pattern, n, solver);
+        let slot = schur.slot_finder();
+        // Every row's segment on every block it reads: (block, row, start).
+        let (mut plain, mut found, mut entries) = (Vec::new(), Vec::new(), Vec::new());
         for r in 0..model.m() {
-            let first_segment = segments.len();
+            let first_segment = found.len();
             for j in pattern.row(r) {
                 let c = pattern.cols[j];
                 let (b, i) = owner[c as usize];
@@ -72,11 +88,11 @@ impl Blocks {
                     plain.push((j as u32, c));
                     continue;
                 }
-                let at = match segments[first_segment..].iter().find(|&&(sb, _)| sb == b) {
-                    Some(&(_, at)) => at,
+                let at = match found[first_segment..].iter().find(|&&(sb, _, _)| sb == b) {
+                    Some(&(_, _, at)) => at,
                     None => {
                         let at = entries.len() as u32;
-                        segments.push((b, at));
+                        found.push((b, r, at));
                         entries.resize(entries.len() + blocks[b as usize].len(), 0);
                         at
                     }
@@ -84,59 +100,130 @@ impl Blocks {
                 entries[(at + i) as usize] = j as u32;
             }
         }
-        // `S`'s weights: `M⁻¹` outside the blocks, 1 on them (in `J̃`).
-        let weights: Vec<f64> =
-            owner.iter().zip(diagonal).map(|(&(b, _), &m)| if b == u32::MAX { m } else { 1.0 }).collect();
-        let weights = DiagonalMass::new(weights).expect("positive masses outside the blocks (checked by the model)");
-        let nnz = pattern.nnz();
-        Self {
+        found.sort_by_key(|&(b, r, _)| (b, r));
+        let (mut segment_start, mut segments, mut pair_start, mut pairs) = (vec![0], Vec::new(), vec![0], Vec::new());
+        for b in 0..blocks.len() as u32 {
+            let on_block: Vec<_> = found.iter().filter(|&&(sb, ..)| sb == b).collect();
+            for (k, &&(_, ra, at_a)) in on_block.iter().enumerate() {
+                segments.push(at_a);
+                for &&(_, rb, at_b) in &on_block[..=k] {
+                    pairs.push((at_a, at_b, slot(ra, rb) as u32));
+                }
+            }
+            segment_start.push(segments.len() as u32);
+            pair_start.push(pairs.len() as u32);
+        }
+        let plain_products = crate::linalg::products(pattern, n)
+            .into_iter()
+            .filter(|&(.., col)| owner[col].0 == u32::MAX)
+            .map(|(a, b, ja, jb, col)| (ja as u32, jb as u32, 1.0 / diagonal[col], slot(a, b) as u32))
+            .collect();
+        let slots = schur.slots();
+        drop(slot);
+        let blocks = Self {
             mass: BlockMass::new(diagonal, blocks),
             psi_q: vec![0.0; n],
             mdot_v: vec![0.0; n],
-            scaled: vec![0.0; nnz],
-            weighted: vec![0.0; nnz],
+            weighted: vec![0.0; pattern.nnz()],
             plain,
+            plain_products,
+            segment_start,
             segments,
+            tilde: vec![0.0; entries.len()],
             entries,
-            schur: Schur::new_for_blocks(pattern, &weights, solver),
-        }
+            pair_start,
+            pairs,
+            s: vec![0.0; slots],
+            schur,
+        };
+        blocks.check(pattern.nnz());
+        blocks
     }
 
-    /// `J̃` and `M⁻¹ Φ_qᵀ` from `Φ_q`, then `S` factored and `b` solved in place.
+    /// Checks the bounds the unchecked assembly relies on: every segment's
+    /// places lie in `entries` and `tilde` and index a Jacobian of `nnz`
+    /// entries, and every pair adds to a slot of `S`.
+    fn check(&self, nnz: usize) {
+        let mass = &self.mass;
+        let ok = (0..mass.blocks()).all(|b| {
+            let k = mass.coordinates(b).len();
+            let span = |start: &[u32]| start[b] as usize..start[b + 1] as usize;
+            let inside = |at: u32| at as usize + k <= self.entries.len();
+            self.segments[span(&self.segment_start)].iter().all(|&at| inside(at))
+                && self.pairs[span(&self.pair_start)]
+                    .iter()
+                    .all(|&(a, c, slot)| inside(a) && inside(c) && (slot as usize) < self.s.len())
+        });
+        let ok = ok
+            && self.tilde.len() == self.entries.len()
+            && self.weighted.len() == nnz
+            && self.entries.iter().all(|&j| (j as usize) < nnz);
+        assert!(ok, "inconsistent structure of the block assembly");
+    }
+
+    /// `J̃`, `M⁻¹ Φ_qᵀ` and `S` from `Φ_q`, then `S` factored and `b` solved in place.
     pub(super) fn factor_and_solve(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        assert!(jac.len() == self.weighted.len(), "a Jacobian of the pattern's length");
         let inverse = self.mass.inverse();
         for &(j, c) in &self.plain {
             let (j, c) = (j as usize, c as usize);
-            self.scaled[j] = jac[j];
             self.weighted[j] = jac[j] * inverse[c];
         }
-        // One row's entries on one block: `J̃` is `L⁻¹` times them, `M⁻¹ Φ_qᵀ` `L⁻ᵀ L⁻¹`.
-        struct Segment<'a> {
+        self.s.fill(0.0);
+        for &(ja, jb, w, slot) in &self.plain_products {
+            self.s[slot as usize] += jac[ja as usize] * jac[jb as usize] * w;
+        }
+        // One block's segments: `J̃` is `L⁻¹` times them, `M⁻¹ Φ_qᵀ` `L⁻ᵀ L⁻¹`;
+        // then the dot products of every pair of them.
+        struct Block<'a> {
+            segments: &'a [u32],
+            pairs: &'a [(u32, u32, u32)],
             entries: &'a [u32],
             jac: &'a [f64],
-            scaled: &'a mut [f64],
+            tilde: &'a mut [f64],
             weighted: &'a mut [f64],
+            s: &'a mut [f64],
         }
-        impl WidthFn for Segment<'_> {
+        impl WidthFn for Block<'_> {
             #[inline(always)]
             fn call<const K: usize>(self, mass: &BlockMass, b: usize) {
-                let idx: &[u32; K] = self.entries[..K].try_into().expect("a block's K entries");
-                let x = mass.forward(b, idx.map(|j| self.jac[j as usize]));
-                idx.iter().zip(x).for_each(|(&j, x)| self.scaled[j as usize] = x);
-                let y = mass.backward(b, x);
-                idx.iter().zip(y).for_each(|(&j, y)| self.weighted[j as usize] = y);
+                // SAFETY: `new` checked (`check`) that every segment's `K`
+                // places lie in `entries` and `tilde`, that `entries` holds
+                // places < nnz = `jac.len()` = `weighted.len()`, and every
+                // pair's slot < `s.len()`. Unchecked: the pairs' loop is
+                // most of the assembly, and its bounds checks a third of it.
+                unsafe {
+                    let segment = |values: &[f64], at: u32| -> [f64; K] {
+                        *(values.as_ptr().add(at as usize) as *const [f64; K])
+                    };
+                    for &at in self.segments {
+                        let idx = &*(self.entries.as_ptr().add(at as usize) as *const [u32; K]);
+                        let x = mass.forward(b, idx.map(|j| *self.jac.get_unchecked(j as usize)));
+                        *(self.tilde.as_mut_ptr().add(at as usize) as *mut [f64; K]) = x;
+                        let y = mass.backward(b, x);
+                        idx.iter().zip(y).for_each(|(&j, y)| *self.weighted.get_unchecked_mut(j as usize) = y);
+                    }
+                    for &(at_a, at_b, slot) in self.pairs {
+                        let (x, y) = (segment(self.tilde, at_a), segment(self.tilde, at_b));
+                        *self.s.get_unchecked_mut(slot as usize) += x.iter().zip(y).map(|(x, y)| x * y).sum::<f64>();
+                    }
+                }
             }
         }
-        for &(block, at) in &self.segments {
-            let segment = Segment {
-                entries: &self.entries[at as usize..],
+        for block in 0..self.mass.blocks() {
+            let span = |start: &[u32]| start[block] as usize..start[block + 1] as usize;
+            let pass = Block {
+                segments: &self.segments[span(&self.segment_start)],
+                pairs: &self.pairs[span(&self.pair_start)],
+                entries: &self.entries,
                 jac,
-                scaled: &mut self.scaled,
+                tilde: &mut self.tilde,
                 weighted: &mut self.weighted,
+                s: &mut self.s,
             };
-            self.mass.at_width(block as usize, segment);
+            self.mass.at_width(block, pass);
         }
-        self.schur.factor_and_solve(&self.scaled, b)
+        self.schur.factor_and_solve_assembled(&self.s, b)
     }
 }
 

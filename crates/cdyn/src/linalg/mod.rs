@@ -16,4 +16,4 @@ pub(crate) mod sparse_lu;
 pub use ldl::{Breakdown, DependentRows};
 pub(crate) use ldl::{DenseLdl, inverse_pivot};
 pub use schur::{LinearSolver, SPARSE_FROM};
-pub(crate) use schur::{Schur, dot, norm};
+pub(crate) use schur::{Schur, dot, norm, products};

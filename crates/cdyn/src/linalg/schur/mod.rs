@@ -118,6 +118,9 @@ pub(crate) struct Schur {
     work: Vec<f64>,
     /// Length of the Jacobian the terms index.
     nnz: usize,
+    /// Whether `terms` sum `S`'s entries; if not, the caller passes them
+    /// assembled (`factor_and_solve_assembled`).
+    summed: bool,
     /// Whether a dependent row is an error or dropped.
     dependent: DependentRows,
     /// Rows dropped by the last factorization.
@@ -145,13 +148,16 @@ impl Schur {
     /// The structure of `S = Φ_q M⁻¹ Φ_qᵀ` for this Jacobian pattern, with
     /// the weights of its products taken from the (constant) mass matrix.
     pub fn new(pattern: &Pattern, mass: &DiagonalMass, solver: LinearSolver) -> Self {
-        Self::with_rule(pattern, mass, solver, false)
+        Self::with_rule(pattern, Some(mass), mass.inverse().len(), solver)
     }
 
-    /// As [`new`](Self::new), but below [`SPARSE_FROM`] rows `Auto` takes
-    /// the reordered sparse pattern where it has fewer entries than the full
-    /// triangle: for the `S` of block masses (spatial bodies), where a
-    /// robot arm's tree of 43 rows (UR5) stepped in 18.3 µs with the full
+    /// The structure of `S` for `n` coordinates, whose entries the caller
+    /// assembles and passes by slot ([`slot_finder`](Self::slot_finder),
+    /// [`factor_and_solve_assembled`](Self::factor_and_solve_assembled)):
+    /// for block masses (spatial bodies), whose products on a block are
+    /// dense. Below [`SPARSE_FROM`] rows `Auto` takes the reordered sparse
+    /// pattern where it has fewer entries than the full triangle: a robot
+    /// arm's tree of 43 rows (UR5) stepped in 18.3 µs with the full
     /// triangle and 10.7 µs with its own pattern (the kernel is the same
     /// for both, so fewer entries cost less). A constant mass (planar
     /// models) keeps the rows' own order below `SPARSE_FROM`, which fixes
@@ -159,14 +165,17 @@ impl Schur {
     /// and eliminates along the pattern that order fills: the full
     /// triangle's arithmetic less the products of structural zeros (a
     /// planar chain of 10: 45 entries of `L` → 9).
-    pub fn new_for_blocks(pattern: &Pattern, weights: &DiagonalMass, solver: LinearSolver) -> Self {
-        Self::with_rule(pattern, weights, solver, true)
+    pub fn assembled_by_caller(pattern: &Pattern, n: usize, solver: LinearSolver) -> Self {
+        Self::with_rule(pattern, None, n, solver)
     }
 
-    fn with_rule(pattern: &Pattern, mass: &DiagonalMass, solver: LinearSolver, fewest_below: bool) -> Self {
+    /// `mass` weighs the products that sum `S`'s entries; without it the
+    /// caller (a block mass) assembles them, and `Auto` takes the fewest
+    /// entries below `SPARSE_FROM`.
+    fn with_rule(pattern: &Pattern, mass: Option<&DiagonalMass>, n: usize, solver: LinearSolver) -> Self {
         let m = pattern.start.len() - 1;
-        let inv_mass = mass.inverse();
-        let products = products(pattern, inv_mass.len());
+        let fewest_below = mass.is_none();
+        let products = products(pattern, n);
         let pairs = || products.iter().map(|&(a, b, ..)| (a, b));
         let analyse = || crate::linalg::sparse::analyse(m, pairs());
         let natural = || crate::linalg::sparse::natural(m, pairs());
@@ -185,9 +194,11 @@ impl Schur {
         let order = perm.unwrap_or_else(|| (0..m).collect());
         let mut position = vec![0; m];
         order.iter().enumerate().for_each(|(new, &old)| position[old] = new);
-        let mut by_slot: Vec<(usize, (u32, u32, f64))> = products
-            .iter()
-            .map(|&(a, b, ja, jb, col)| {
+        let summed = mass.map(|mass| (&products, mass.inverse()));
+        let mut by_slot: Vec<(usize, (u32, u32, f64))> = summed
+            .into_iter()
+            .flat_map(|(products, inv_mass)| products.iter().map(move |p| (p, inv_mass)))
+            .map(|(&(a, b, ja, jb, col), inv_mass)| {
                 let (i, j) = (position[a].max(position[b]), position[a].min(position[b]));
                 let slot = if i == j {
                     j
@@ -238,6 +249,7 @@ impl Schur {
             inv_d: vec![0.0; m],
             work: vec![0.0; m],
             nnz: pattern.nnz(),
+            summed: mass.is_some(),
             dependent: DependentRows::Error,
             dropped: 0,
             tolerance: DependentRows::Error.tolerance(),
@@ -269,6 +281,31 @@ impl Schur {
         // A row reads each coordinate once, so its diagonal products are squares.
         let squares = self.terms[..self.sum_ptr[m] as usize].iter().all(|&(a, b, _)| a == b);
         assert!(squares, "a constraint row reads a coordinate twice");
+    }
+
+    /// Entries of `S` the factorization reads: `m` diagonal ones, then one
+    /// per entry of `L` (zero for fill).
+    pub fn slots(&self) -> usize {
+        self.m + self.lower.len()
+    }
+
+    /// The slot of `S`'s entry `(a, b)` (original rows), for
+    /// [`factor_and_solve_assembled`](Self::factor_and_solve_assembled):
+    /// diagonal entries at their elimination position, the others at their
+    /// entry of `L`. Panics if the entry is not in `L`'s pattern.
+    pub fn slot_finder(&self) -> impl Fn(usize, usize) -> usize + '_ {
+        let mut position = vec![0; self.m];
+        self.order.iter().enumerate().for_each(|(new, &old)| position[old as usize] = new);
+        move |a, b| {
+            let (i, j) = (position[a].max(position[b]), position[a].min(position[b]));
+            if i == j {
+                return j;
+            }
+            // A column's rows are in elimination order.
+            let column = &self.row_idx[self.col_ptr[j] as usize..self.col_ptr[j + 1] as usize];
+            let at = column.binary_search_by_key(&i, |&r| position[r as usize]).expect("S's pattern lies inside L's");
+            self.m + self.col_ptr[j] as usize + at
+        }
     }
 
     /// Sets what a dependent row does in the next factorizations.
@@ -468,6 +505,48 @@ mod tests {
                     assert_eq!(y_auto, y_dense, "{name} {rows:?}");
                     let bits = |x: &[f64]| x.iter().filter(|v| **v != 0.0).map(|v| v.to_bits()).collect::<Vec<_>>();
                     assert_eq!(bits(&x_auto), bits(&x_dense), "{name} {rows:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn entries_assembled_by_the_caller_by_slot_factor_as_the_summed_ones() {
+        let (with_dependent, n_dependent, jac_dependent) = repeated_row(1.0);
+        let cases = [
+            ("chain", chain(20), None),
+            ("star", star(5, 12), None),
+            ("net", net(8, 17), None),
+            ("dependent", (with_dependent, n_dependent), Some(jac_dependent)),
+        ];
+        for (name, (pattern, n), jac) in cases {
+            let m = pattern.start.len() - 1;
+            let jac = jac.unwrap_or_else(|| values(pattern.nnz(), 0.3));
+            let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+            for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
+                let mut summed = Schur::new(&pattern, &mass, solver);
+                let mut assembled = Schur::assembled_by_caller(&pattern, n, solver);
+                assert_eq!(assembled.order, summed.order, "{name} {solver:?}");
+                // Each entry summed in the order of the summed structure's terms.
+                let mut entries = vec![0.0; assembled.slots()];
+                let slot = assembled.slot_finder();
+                for (a, b, ja, jb, col) in products(&pattern, n) {
+                    entries[slot(a, b)] += jac[ja] * jac[jb] * mass.inverse()[col];
+                }
+                drop(slot);
+                for rows in [DependentRows::Error, DependentRows::Tolerate] {
+                    summed.set_dependent_rows(rows);
+                    assembled.set_dependent_rows(rows);
+                    let b = values(m, 2.0);
+                    let (mut x_summed, mut x_assembled) = (b.clone(), b.clone());
+                    let outcome = summed.factor_and_solve(&jac, &mut x_summed);
+                    let assembled_outcome = assembled.factor_and_solve_assembled(&entries, &mut x_assembled);
+                    assert_eq!(outcome, assembled_outcome, "{name} {solver:?} {rows:?}");
+                    if outcome.is_ok() {
+                        // The same sums in the same order: equal as numbers.
+                        assert_eq!(x_summed, x_assembled, "{name} {solver:?} {rows:?}");
+                        assert_eq!(summed.dependent_rows(), assembled.dependent_rows(), "{name}");
+                    }
                 }
             }
         }
