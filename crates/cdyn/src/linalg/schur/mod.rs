@@ -194,11 +194,14 @@ impl Schur {
         let order = perm.unwrap_or_else(|| (0..m).collect());
         let mut position = vec![0; m];
         order.iter().enumerate().for_each(|(new, &old)| position[old] = new);
-        let summed = mass.map(|mass| (&products, mass.inverse()));
+        // The products that sum S's entries: none where the caller assembles them.
+        let (summed, inv_mass): (&[_], &[f64]) = match mass {
+            Some(mass) => (&products, mass.inverse()),
+            None => (&[], &[]),
+        };
         let mut by_slot: Vec<(usize, (u32, u32, f64))> = summed
-            .into_iter()
-            .flat_map(|(products, inv_mass)| products.iter().map(move |p| (p, inv_mass)))
-            .map(|(&(a, b, ja, jb, col), inv_mass)| {
+            .iter()
+            .map(|&(a, b, ja, jb, col)| {
                 let (i, j) = (position[a].max(position[b]), position[a].min(position[b]));
                 let slot = if i == j {
                     j
