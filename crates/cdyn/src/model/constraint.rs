@@ -28,6 +28,20 @@ pub trait Constraint<const K: usize, const R: usize>: Send + Sync + 'static {
         jacobian_of(self, x, t)
     }
 
+    /// Along the path `(x + s v, t + s)`: each row's `[Φ, Φ̇, Φ̈]` at
+    /// `s = 0` (`Φ̈` at zero acceleration, which is `−γ`), and the Jacobian
+    /// at `(x, t)`. The default differentiates [`eval`](Self::eval) on
+    /// second-order dual numbers ([`second_order_of`]) and takes
+    /// [`jacobian`](Self::jacobian); an element whose parts both need (a
+    /// spatial joint's rotated points and axes) may form them once.
+    #[inline(always)]
+    fn second_order(&self, x: [f64; K], v: [f64; K], t: f64) -> ([[f64; 3]; R], [[f64; K]; R])
+    where
+        Self: Sized,
+    {
+        (second_order_of(self, x, v, t), self.jacobian(x, t))
+    }
+
     /// Which coordinates each row can depend on: an entry `false` here must
     /// be zero at every state, and its products are left out when
     /// `Φ_q M⁻¹ Φ_qᵀ` is assembled (a spherical joint's row reads one
@@ -265,22 +279,32 @@ pub(crate) fn local<C: Constraint<K, R>, const K: usize, const R: usize>(
     a: [f64; K],
     t: f64,
 ) -> Local<K, R> {
-    // Second directional derivative of s ↦ Φ(q + s v, t + s): Φ̈ at zero
-    // acceleration, which is −γ.
-    let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], v[j], 0.0));
-    let along = c.eval(path, Dual2_64::new(t, 1.0, 0.0));
-    let jac = c.jacobian(x, t);
+    let (along, jac) = c.second_order(x, v, t);
     let dot = |row: &[f64; K], y: &[f64; K]| row.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let jv: [f64; R] = std::array::from_fn(|r| dot(&jac[r], &v));
     let ja: [f64; R] = std::array::from_fn(|r| dot(&jac[r], &a));
     Local {
-        phi: along.map(|d| d.re),
-        phi_dot: along.map(|d| d.v1),
-        phi_t: std::array::from_fn(|r| along[r].v1 - jv[r]),
-        gamma: along.map(|d| -d.v2),
-        rhs: std::array::from_fn(|r| ja[r] + along[r].v2),
+        phi: along.map(|[phi, ..]| phi),
+        phi_dot: along.map(|[_, rate, _]| rate),
+        phi_t: std::array::from_fn(|r| along[r][1] - jv[r]),
+        gamma: along.map(|[.., curvature]| -curvature),
+        rhs: std::array::from_fn(|r| ja[r] + along[r][2]),
         jac,
     }
+}
+
+/// Each row's `[Φ, Φ̇, Φ̈]` along `(x + s v, t + s)` at `s = 0`, `Φ̈` at zero
+/// acceleration: the second directional derivative, by one pass of
+/// [`eval`](Constraint::eval) on second-order dual numbers.
+#[inline(always)]
+pub fn second_order_of<C: Constraint<K, R>, const K: usize, const R: usize>(
+    c: &C,
+    x: [f64; K],
+    v: [f64; K],
+    t: f64,
+) -> [[f64; 3]; R] {
+    let path: [Dual2_64; K] = std::array::from_fn(|j| Dual2_64::new(x[j], v[j], 0.0));
+    c.eval(path, Dual2_64::new(t, 1.0, 0.0)).map(|d| [d.re, d.v1, d.v2])
 }
 
 /// `Φ_x` by dual passes of `c.eval`. For an element of a few coordinates,

@@ -21,9 +21,7 @@
 
 use super::joint::JointKind;
 use super::rotation::rotate_fixed;
-use crate::ad::jet::{Eps, JetN};
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::Constraint;
 use crate::model::timefn::TimeFn;
 
 /// A joint's frame on one side: point `s` and axes `(f, g, h)`, in the
@@ -66,49 +64,6 @@ impl<D: Scalar> Place<D> for Side<'_, D> {
     }
 }
 
-/// A body side of a joint's Jacobian pass: its seven coordinates are
-/// `offset..offset + 7` of the pass's jet, and a point or axis depends on
-/// them through `p` alone (and `r`, with unit slope). So it is rotated by a
-/// 4-wide jet over `p` and then placed among the jet's derivatives: a
-/// spatial joint's Jacobian costs two 4-wide rotations, where one pass of
-/// a 14-wide jet carried the other body's zeros through every product.
-struct Seeded<'a> {
-    r: [f64; 3],
-    p: [JetN<4>; 4],
-    offset: usize,
-    frame: &'a Frame,
-}
-
-impl<'a> Seeded<'a> {
-    fn new(r: [f64; 3], p: [f64; 4], offset: usize, frame: &'a Frame) -> Self {
-        Self { r, p: std::array::from_fn(|j| JetN::seeded(p[j], j)), offset, frame }
-    }
-
-    /// `x` rotated by the body, moved by `r` when `moved`, as an `N`-wide jet.
-    #[inline(always)]
-    fn place<const N: usize>(&self, x: [f64; 3], moved: bool) -> [JetN<N>; 3] {
-        let x = rotate_fixed(self.p, x);
-        let at = |i: usize| {
-            let mut d = [0.0; N];
-            d[self.offset + 3..self.offset + 7].copy_from_slice(x[i].eps.0.as_slice());
-            if moved {
-                d[self.offset + i] = 1.0;
-            }
-            JetN::new(x[i].re + if moved { self.r[i] } else { 0.0 }, Eps(d.into()))
-        };
-        [at(0), at(1), at(2)]
-    }
-}
-
-impl<const N: usize> Place<JetN<N>> for Seeded<'_> {
-    fn point(&self) -> [JetN<N>; 3] {
-        self.place(self.frame.s, true)
-    }
-    fn axis(&self, k: usize) -> [JetN<N>; 3] {
-        self.place(self.frame.axes[k], false)
-    }
-}
-
 pub(super) fn dot<D: Scalar>(a: [D; 3], b: [D; 3]) -> D {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -131,7 +86,7 @@ pub(crate) struct JointRows<const R: usize> {
 }
 
 impl<const R: usize> JointRows<R> {
-    fn rows<D: Scalar>(&self, a: impl Place<D>, b: impl Place<D>, t: D) -> [D; R] {
+    pub(super) fn rows<D: Scalar>(&self, a: impl Place<D>, b: impl Place<D>, t: D) -> [D; R] {
         let mut out = self.kinematic_rows(&a, &b);
         let mut next = self.kind.rows();
         // At the initial pose both sides' frames coincide, so a's f axis
@@ -180,7 +135,7 @@ impl<const R: usize> JointRows<R> {
     }
 
     /// [`Constraint::reads`] for a joint whose bodies' poses start at the offsets `sides`.
-    fn reads<const K: usize>(&self, sides: &[usize]) -> [[bool; K]; R] {
+    pub(super) fn reads<const K: usize>(&self, sides: &[usize]) -> [[bool; K]; R] {
         self.reads_position().map(|reach| {
             let mut row = [false; K];
             for &at in sides {
@@ -248,108 +203,6 @@ impl Reach {
     }
 }
 
-/// A joint between two bodies: reads `(r_a, p_a, r_b, p_b)`.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct BodyToBody<const R: usize>(pub JointRows<R>);
-
-/// A joint between a body and the ground: reads `(r_a, p_a)`.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct BodyToGround<const R: usize>(pub JointRows<R>);
-
 pub(super) fn pose<D: Copy, const K: usize>(x: &[D; K], at: usize) -> ([D; 3], [D; 4]) {
     (std::array::from_fn(|i| x[at + i]), std::array::from_fn(|i| x[at + 3 + i]))
-}
-
-impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
-    fn eval<D: Scalar>(&self, x: [D; 14], t: D) -> [D; R] {
-        let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
-        self.0.rows(Side::Body { r: ra, p: pa, frame: &self.0.a }, Side::Body { r: rb, p: pb, frame: &self.0.b }, t)
-    }
-
-    fn jacobian(&self, x: [f64; 14], t: f64) -> [[f64; 14]; R] {
-        let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
-        let (a, b) = (Seeded::new(ra, pa, 0, &self.0.a), Seeded::new(rb, pb, 7, &self.0.b));
-        self.0.rows::<JetN<14>>(a, b, JetN::from_re(t)).map(|row| row.eps.0.into())
-    }
-
-    fn reads(&self) -> [[bool; 14]; R] {
-        self.0.reads(&[0, 7])
-    }
-}
-
-impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
-    fn eval<D: Scalar>(&self, x: [D; 7], t: D) -> [D; R] {
-        let (r, p) = pose(&x, 0);
-        self.0.rows(Side::Body { r, p, frame: &self.0.a }, Side::Ground(&self.0.b), t)
-    }
-
-    fn jacobian(&self, x: [f64; 7], t: f64) -> [[f64; 7]; R] {
-        let (r, p) = pose(&x, 0);
-        let a = Seeded::new(r, p, 0, &self.0.a);
-        self.0.rows::<JetN<7>>(a, Side::Ground(&self.0.b), JetN::from_re(t)).map(|row| row.eps.0.into())
-    }
-
-    fn reads(&self) -> [[bool; 7]; R] {
-        self.0.reads(&[0])
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::constraint::jacobian_of;
-
-    /// A reproducible stream of numbers in (−1, 1).
-    fn numbers(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
-    }
-
-    /// The joints' composed Jacobians against one jet pass of their rows,
-    /// at poses off the constraints with quaternions off unit length; and
-    /// the entries `reads` leaves out are zero in that pass.
-    fn composed_is_the_plain_pass<const R: usize>(kind: JointKind, angle: bool, displacement: bool) {
-        let mut x = numbers(R as u64 + 7 * kind.rows() as u64);
-        let mut frame =
-            || Frame { s: std::array::from_fn(|_| x()), axes: std::array::from_fn(|_| std::array::from_fn(|_| x())) };
-        let rows = JointRows::<R> {
-            kind,
-            a: frame(),
-            b: frame(),
-            length2: 0.7,
-            angle: angle.then(|| TimeFn::constant(0.4)),
-            displacement: displacement.then(|| TimeFn::constant(-0.2)),
-        };
-        let mut x = numbers(99);
-        for _ in 0..20 {
-            let (q, t): ([f64; 14], f64) = (std::array::from_fn(|_| x()), x());
-            let (two, one) = (BodyToBody(rows.clone()), BodyToGround(rows.clone()));
-            let q7: [f64; 7] = std::array::from_fn(|i| q[i]);
-            let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * (1.0 + b.abs());
-            let (c, p) = (two.jacobian(q, t), jacobian_of(&two, q, t));
-            assert!(c.iter().flatten().zip(p.iter().flatten()).all(|(a, b)| close(*a, *b)), "{kind:?}: {c:?} vs {p:?}");
-            let unread_are_zero = |p: &[f64], reads: &[bool]| p.iter().zip(reads).all(|(p, &r)| r || *p == 0.0);
-            assert!(unread_are_zero(p.as_flattened(), two.reads().as_flattened()), "{kind:?} reads");
-            let (c, p) = (one.jacobian(q7, t), jacobian_of(&one, q7, t));
-            assert!(c.iter().flatten().zip(p.iter().flatten()).all(|(a, b)| close(*a, *b)), "{kind:?} grounded");
-            assert!(unread_are_zero(p.as_flattened(), one.reads().as_flattened()), "{kind:?} grounded reads");
-        }
-    }
-
-    #[test]
-    fn composed_jacobians_equal_the_plain_jet_pass_and_unread_entries_are_zero_for_every_joint() {
-        composed_is_the_plain_pass::<3>(JointKind::Spherical, false, false);
-        composed_is_the_plain_pass::<5>(JointKind::Revolute, false, false);
-        composed_is_the_plain_pass::<6>(JointKind::Revolute, true, false);
-        composed_is_the_plain_pass::<4>(JointKind::Universal, false, false);
-        composed_is_the_plain_pass::<4>(JointKind::Cylindrical, false, false);
-        composed_is_the_plain_pass::<6>(JointKind::Cylindrical, true, true);
-        composed_is_the_plain_pass::<5>(JointKind::Prismatic, false, false);
-        composed_is_the_plain_pass::<6>(JointKind::Prismatic, false, true);
-        composed_is_the_plain_pass::<6>(JointKind::Fixed, false, false);
-        composed_is_the_plain_pass::<1>(JointKind::Distance, false, false);
-    }
 }

@@ -4,7 +4,8 @@
 
 use super::body::{Body, SpatialBody};
 use super::joint::{Joint, JointKind};
-use super::joint_rows::{BodyToBody, BodyToGround, Frame, JointRows};
+use super::joint_element::{BodyToBody, BodyToGround};
+use super::joint_rows::{Frame, JointRows};
 use super::load::{
     BodyRotaryDamper, BodyTorque, GroundRotaryDamper, Law, LineDamper, Load, PointForce, Slide, SpringEnergy,
 };
