@@ -141,8 +141,9 @@ impl Blocks {
     }
 
     /// Checks the bounds the unchecked assembly relies on: every segment's
-    /// places lie in `entries` and `tilde` and index a Jacobian of `nnz`
-    /// entries, and every pair adds to a slot of `S`.
+    /// places lie in `entries` and `tilde`, every place indexes a Jacobian of
+    /// `nnz` entries and every coordinate the mass, and every pair and
+    /// product adds to a slot of `S`.
     fn check(&self, nnz: usize) {
         let mass = &self.mass;
         let ok = (0..mass.blocks()).all(|b| {
@@ -154,10 +155,16 @@ impl Blocks {
                     .iter()
                     .all(|&(a, c, slot)| inside(a) && inside(c) && (slot as usize) < self.s.len())
         });
+        let n = mass.inverse().len();
         let ok = ok
             && self.tilde.len() == self.entries.len()
             && self.weighted.len() == nnz
-            && self.entries.iter().all(|&j| (j as usize) < nnz);
+            && self.entries.iter().all(|&j| (j as usize) < nnz)
+            && self.plain.iter().all(|&(j, c)| (j as usize) < nnz && (c as usize) < n)
+            && self
+                .plain_products
+                .iter()
+                .all(|&(a, b, _, slot)| (a as usize) < nnz && (b as usize) < nnz && (slot as usize) < self.s.len());
         assert!(ok, "inconsistent structure of the block assembly");
     }
 
@@ -165,13 +172,19 @@ impl Blocks {
     pub(super) fn factor_and_solve(&mut self, jac: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
         assert!(jac.len() == self.weighted.len(), "a Jacobian of the pattern's length");
         let inverse = self.mass.inverse();
-        for &(j, c) in &self.plain {
-            let (j, c) = (j as usize, c as usize);
-            self.weighted[j] = jac[j] * inverse[c];
-        }
         self.s.fill(0.0);
-        for &(ja, jb, w, slot) in &self.plain_products {
-            self.s[slot as usize] += jac[ja as usize] * jac[jb as usize] * w;
+        // SAFETY: `check` bounded the places by the Jacobian's length (its
+        // length is asserted above), the coordinates by `inverse`'s and the
+        // slots by `s`'s.
+        unsafe {
+            for &(j, c) in &self.plain {
+                let (j, c) = (j as usize, c as usize);
+                *self.weighted.get_unchecked_mut(j) = jac.get_unchecked(j) * inverse.get_unchecked(c);
+            }
+            for &(ja, jb, w, slot) in &self.plain_products {
+                *self.s.get_unchecked_mut(slot as usize) +=
+                    jac.get_unchecked(ja as usize) * jac.get_unchecked(jb as usize) * w;
+            }
         }
         // One block's segments: `J̃` is `L⁻¹` times them, `M⁻¹ Φ_qᵀ` `L⁻ᵀ L⁻¹`;
         // then the dot products of every pair of them.

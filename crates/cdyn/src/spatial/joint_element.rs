@@ -307,8 +307,8 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::timefn::TimeFn;
     use crate::model::constraint::jacobian_of;
+    use crate::model::timefn::TimeFn;
 
     /// A reproducible stream of numbers in (−1, 1).
     fn numbers(seed: u64) -> impl FnMut() -> f64 {
