@@ -183,52 +183,55 @@ impl<const R: usize> JointRows<R> {
     /// [`kinematic_rows`](Self::kinematic_rows)' `[Φ, Φ̇, Φ̈]` along the
     /// sides' motion and their Jacobian, by sides; only for a joint without
     /// drives (`has_drives`), whose rows are these.
-    fn kinematic_derivatives(&self, a: &impl SidedPlace, b: &impl SidedPlace) -> [([f64; 3], Halves); R] {
-        let mut out = [([0.0; 3], [[0.0; 7]; 2]); R];
+    fn kinematic_derivatives<const K: usize>(
+        &self,
+        a: &impl SidedPlace,
+        b: &impl SidedPlace,
+        place: impl Fn(Halves) -> [f64; K],
+    ) -> ([[f64; 3]; R], [[f64; K]; R]) {
+        let (mut rows, mut jac) = ([[0.0; 3]; R], [[0.0; K]; R]);
+        let mut put = |k: usize, (row, halves): ([f64; 3], Halves)| {
+            rows[k] = row;
+            jac[k] = place(halves);
+        };
         let (pa, pb) = (a.point(), b.point());
         let gap: Motion = std::array::from_fn(|k| std::array::from_fn(|i| pb.motion[k][i] - pa.motion[k][i]));
-        let spherical = |out: &mut [([f64; 3], Halves); R]| {
-            for (i, row) in out.iter_mut().enumerate().take(3) {
-                *row = (gap.map(|x| x[i]), [pa.d[i].map(|x| -x), pb.d[i]]);
-            }
-        };
+        let spherical = |i: usize| (gap.map(|x| x[i]), [pa.d[i].map(|x| -x), pb.d[i]]);
         let across = |u: &Sided, w: &Sided| (dot_motion(&u.motion, &w.motion), dot_across(u, w));
         let along_gap = |u: &Sided| (dot_motion(&u.motion, &gap), dot_gap(u, &pa, &pb));
+        if matches!(self.kind, JointKind::Spherical | JointKind::Revolute | JointKind::Universal | JointKind::Fixed) {
+            (0..3).for_each(|i| put(i, spherical(i)));
+        }
         match self.kind {
-            JointKind::Spherical => spherical(&mut out),
+            JointKind::Spherical => {}
             JointKind::Revolute => {
-                spherical(&mut out);
                 let hb = b.axis(H);
-                out[3] = across(&a.axis(F), &hb);
-                out[4] = across(&a.axis(G), &hb);
+                put(3, across(&a.axis(F), &hb));
+                put(4, across(&a.axis(G), &hb));
             }
-            JointKind::Universal => {
-                spherical(&mut out);
-                out[3] = across(&a.axis(H), &b.axis(H));
-            }
+            JointKind::Universal => put(3, across(&a.axis(H), &b.axis(H))),
             JointKind::Cylindrical | JointKind::Prismatic => {
                 let (fa, ga, hb) = (a.axis(F), a.axis(G), b.axis(H));
-                out[0] = across(&fa, &hb);
-                out[1] = across(&ga, &hb);
-                out[2] = along_gap(&fa);
-                out[3] = along_gap(&ga);
+                put(0, across(&fa, &hb));
+                put(1, across(&ga, &hb));
+                put(2, along_gap(&fa));
+                put(3, along_gap(&ga));
                 if self.kind == JointKind::Prismatic {
-                    out[4] = across(&fa, &b.axis(G));
+                    put(4, across(&fa, &b.axis(G)));
                 }
             }
             JointKind::Fixed => {
-                spherical(&mut out);
-                out[3] = across(&a.axis(F), &b.axis(G));
-                out[4] = across(&a.axis(G), &b.axis(H));
-                out[5] = across(&a.axis(H), &b.axis(F));
+                put(3, across(&a.axis(F), &b.axis(G)));
+                put(4, across(&a.axis(G), &b.axis(H)));
+                put(5, across(&a.axis(H), &b.axis(F)));
             }
             JointKind::Distance => {
                 let [x, rate, curvature] = dot_motion(&gap, &gap);
                 let (by_a, by_b) = (through(&pa, gap[0]), through(&pb, gap[0]));
-                out[0] = ([x - self.length2, rate, curvature], [by_a.map(|x| -2.0 * x), by_b.map(|x| 2.0 * x)]);
+                put(0, ([x - self.length2, rate, curvature], [by_a.map(|x| -2.0 * x), by_b.map(|x| 2.0 * x)]));
             }
         }
-        out
+        (rows, jac)
     }
 
     /// Whether the joint drives an angle or a displacement (rows beyond the
@@ -255,7 +258,7 @@ impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
         if self.0.has_drives() {
             return self.0.rows::<JetN<14>>(a, b, JetN::from_re(t)).map(|row| row.eps.0.into());
         }
-        self.0.kinematic_derivatives(&a, &b).map(|(_, jac)| both(jac))
+        self.0.kinematic_derivatives(&a, &b, both).1
     }
 
     fn second_order(&self, x: [f64; 14], v: [f64; 14], t: f64) -> ([[f64; 3]; R], [[f64; 14]; R]) {
@@ -265,8 +268,7 @@ impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
         let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
         let a = Seeded::new(ra, pa, 0, &self.0.a).moving(pose(&v, 0));
         let b = Seeded::new(rb, pb, 7, &self.0.b).moving(pose(&v, 7));
-        let rows = self.0.kinematic_derivatives(&a, &b);
-        (rows.map(|(rows, _)| rows), rows.map(|(_, jac)| both(jac)))
+        self.0.kinematic_derivatives(&a, &b, both)
     }
 
     fn reads(&self) -> [[bool; 14]; R] {
@@ -286,7 +288,7 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
         if self.0.has_drives() {
             return self.0.rows::<JetN<7>>(a, Side::Ground(&self.0.b), JetN::from_re(t)).map(|row| row.eps.0.into());
         }
-        self.0.kinematic_derivatives(&a, &Fixed(&self.0.b)).map(|(_, [jac, _])| jac)
+        self.0.kinematic_derivatives(&a, &Fixed(&self.0.b), |[jac, _]| jac).1
     }
 
     fn second_order(&self, x: [f64; 7], v: [f64; 7], t: f64) -> ([[f64; 3]; R], [[f64; 7]; R]) {
@@ -295,8 +297,7 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
         }
         let (r, p) = pose(&x, 0);
         let a = Seeded::new(r, p, 0, &self.0.a).moving(pose(&v, 0));
-        let rows = self.0.kinematic_derivatives(&a, &Fixed(&self.0.b));
-        (rows.map(|(rows, _)| rows), rows.map(|(_, [jac, _])| jac))
+        self.0.kinematic_derivatives(&a, &Fixed(&self.0.b), |[jac, _]| jac)
     }
 
     fn reads(&self) -> [[bool; 7]; R] {
