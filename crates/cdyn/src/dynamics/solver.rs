@@ -100,28 +100,32 @@ impl Blocks {
                 entries[(at + i) as usize] = j as u32;
             }
         }
+        // By block, then row: each block's segments are one run.
         found.sort_by_key(|&(b, r, _)| (b, r));
         let (mut segment_start, mut segments, mut pair_start, mut pairs) = (vec![0], Vec::new(), vec![0], Vec::new());
+        let mut rest = found.as_slice();
         for b in 0..blocks.len() as u32 {
-            let on_block: Vec<_> = found.iter().filter(|&&(sb, ..)| sb == b).collect();
-            for (k, &&(_, ra, at_a)) in on_block.iter().enumerate() {
+            let (on_block, after) = rest.split_at(rest.iter().take_while(|&&(sb, ..)| sb == b).count());
+            rest = after;
+            for (k, &(_, ra, at_a)) in on_block.iter().enumerate() {
                 segments.push(at_a);
-                for &&(_, rb, at_b) in &on_block[..=k] {
+                for &(_, rb, at_b) in &on_block[..=k] {
                     pairs.push((at_a, at_b, slot(ra, rb) as u32));
                 }
             }
             segment_start.push(segments.len() as u32);
             pair_start.push(pairs.len() as u32);
         }
+        let mass = BlockMass::new(diagonal, blocks);
         let plain_products = crate::linalg::products(pattern, n)
             .into_iter()
             .filter(|&(.., col)| owner[col].0 == u32::MAX)
-            .map(|(a, b, ja, jb, col)| (ja as u32, jb as u32, 1.0 / diagonal[col], slot(a, b) as u32))
+            .map(|(a, b, ja, jb, col)| (ja as u32, jb as u32, mass.inverse()[col], slot(a, b) as u32))
             .collect();
         let slots = schur.slots();
         drop(slot);
         let blocks = Self {
-            mass: BlockMass::new(diagonal, blocks),
+            mass,
             psi_q: vec![0.0; n],
             mdot_v: vec![0.0; n],
             weighted: vec![0.0; pattern.nnz()],

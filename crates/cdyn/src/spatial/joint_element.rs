@@ -47,18 +47,17 @@ impl<'a> Seeded<'a> {
         Self { rates: (rd, pd), ..self }
     }
 
-    /// `x` rotated by the body, moved by `r` when `moved`, as an `N`-wide jet.
+    /// `x` rotated by the body, moved by `r` when `moved`, as an `N`-wide
+    /// jet: its [`sided`](Self::sided) derivatives placed at the body's offset.
     #[inline(always)]
     fn place<const N: usize>(&self, x: [f64; 3], moved: bool) -> [JetN<N>; 3] {
-        let x = rotate_fixed(self.p, x);
+        let sided = self.sided(x, moved);
         let at = |i: usize| {
             let mut d = [0.0; N];
-            d[self.offset + 3..self.offset + 7].copy_from_slice(x[i].eps.0.as_slice());
-            if moved {
-                d[self.offset + i] = 1.0;
-            }
-            JetN::new(x[i].re + if moved { self.r[i] } else { 0.0 }, Eps(d.into()))
+            d[self.offset..self.offset + 7].copy_from_slice(&sided.d[i]);
+            JetN::new(sided.x[i], Eps(d.into()))
         };
+        // Written out: `array::from_fn` of jets was an outlined call through memory.
         [at(0), at(1), at(2)]
     }
 }

@@ -470,20 +470,34 @@ mod tests {
         (pattern, 2 * m + 2)
     }
 
-    #[test]
-    fn below_sparse_from_auto_takes_the_natural_pattern_and_gives_the_full_triangles_answers_to_the_bit() {
+    /// A chain, the star and net given, and a pattern with a dependent
+    /// row: each with its Jacobian values and a diagonal mass.
+    fn cases(
+        star: (Pattern, usize),
+        net: (Pattern, usize),
+    ) -> Vec<(&'static str, Pattern, usize, Vec<f64>, DiagonalMass)> {
         let (with_dependent, n_dependent, jac_dependent) = repeated_row(1.0);
-        let cases = [
+        let shapes = [
             ("chain", chain(20), None),
-            ("star", star(3, 4), None),
-            ("net", net(4, 3), None),
+            ("star", star, None),
+            ("net", net, None),
             ("dependent", (with_dependent, n_dependent), Some(jac_dependent)),
         ];
-        for (name, (pattern, n), jac) in cases {
+        shapes
+            .into_iter()
+            .map(|(name, (pattern, n), jac)| {
+                let jac = jac.unwrap_or_else(|| values(pattern.nnz(), 0.3));
+                let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
+                (name, pattern, n, jac, mass)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn below_sparse_from_auto_takes_the_natural_pattern_and_gives_the_full_triangles_answers_to_the_bit() {
+        for (name, pattern, _, jac, mass) in cases(star(3, 4), net(4, 3)) {
             let m = pattern.start.len() - 1;
             assert!(m < SPARSE_FROM, "{name}");
-            let jac = jac.unwrap_or_else(|| values(pattern.nnz(), 0.3));
-            let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
             let (mut auto, mut dense) =
                 (Schur::new(&pattern, &mass, LinearSolver::Auto), Schur::new(&pattern, &mass, LinearSolver::Dense));
             // The rows' own order, so that the same dependent rows are dropped.
@@ -515,17 +529,8 @@ mod tests {
 
     #[test]
     fn entries_assembled_by_the_caller_by_slot_factor_as_the_summed_ones() {
-        let (with_dependent, n_dependent, jac_dependent) = repeated_row(1.0);
-        let cases = [
-            ("chain", chain(20), None),
-            ("star", star(5, 12), None),
-            ("net", net(8, 17), None),
-            ("dependent", (with_dependent, n_dependent), Some(jac_dependent)),
-        ];
-        for (name, (pattern, n), jac) in cases {
+        for (name, pattern, n, jac, mass) in cases(star(5, 12), net(8, 17)) {
             let m = pattern.start.len() - 1;
-            let jac = jac.unwrap_or_else(|| values(pattern.nnz(), 0.3));
-            let mass = DiagonalMass::new(values(n, 1.1).iter().map(|x| 1.5 + x).collect()).unwrap();
             for solver in [LinearSolver::Dense, LinearSolver::Sparse] {
                 let mut summed = Schur::new(&pattern, &mass, solver);
                 let mut assembled = Schur::assembled_by_caller(&pattern, n, solver);
