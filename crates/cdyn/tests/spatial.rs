@@ -717,10 +717,10 @@ fn springs_dampers_forces_torques_and_drives_against_closed_forms() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// A body's rotational energy differentiated as a velocity map (what
-    /// spatial bodies use) and as a plain kinetic energy by hyper-dual
-    /// numbers give the same `M`, `Ṁ ẋ`, `∂T/∂x` and `T`, also off the
-    /// normalization.
+    /// A body's rotational energy differentiated as a velocity map, as a
+    /// plain kinetic energy by hyper-dual numbers, and in the closed forms
+    /// spatial bodies use give the same `M`, `Ṁ ẋ`, `∂T/∂x` and `T`, also
+    /// off the normalization.
     #[test]
     fn the_velocity_map_and_the_kinetic_energy_agree(
         p in prop::array::uniform4(-1.2..1.2f64),
@@ -731,7 +731,9 @@ proptest! {
         let inertia = [[j[0] + j[1], off, 0.1], [off, j[1] + j[2], -0.2], [0.1, -0.2, j[0] + j[2]]];
         let body = cdyn::spatial::Rotation::new(inertia);
         let (a, b) = (cdyn::model::kinetic::local(&body, p, pd), cdyn::model::kinetic::local_map(&body, p, pd));
+        let closed = cdyn::model::kinetic::VelocityMap::derivatives(&body, p, pd);
         let scale = 1.0 + a.energy.abs();
+        for b in [b, closed] {
         prop_assert!((a.energy - b.energy).abs() < 1e-13 * scale);
         for r in 0..4 {
             prop_assert!((a.grad_q[r] - b.grad_q[r]).abs() < 1e-12 * scale, "∂T/∂x {:?} vs {:?}", a.grad_q, b.grad_q);
@@ -739,6 +741,7 @@ proptest! {
             for c in 0..4 {
                 prop_assert!((a.mass[r][c] - b.mass[r][c]).abs() < 1e-13 * scale, "M {:?} vs {:?}", a.mass, b.mass);
             }
+        }
         }
     }
 }

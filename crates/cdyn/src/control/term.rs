@@ -263,10 +263,13 @@ impl Control {
                 u_v.iter_mut().zip(w.iter()).for_each(|(u, w)| *u += scale * w);
             }
             Energy::Gradient(gain) => {
+                // Ψ_v = M v once: the gain and the term both read it.
+                let w = work.w;
+                mass.mul(v, w);
                 let (rho_q, rho_v) = match gain {
                     EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
                     EnergyGain::Rate { alpha_e } => {
-                        let g2 = mass.psi_v_norm2(v);
+                        let g2 = w.iter().map(|w| w * w).sum::<f64>();
                         (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
                     }
                 };
@@ -276,7 +279,8 @@ impl Control {
                         *u -= 2.0 * rho_q * psi * g;
                     }
                 }
-                mass.add_psi_v(v, -(2.0 * rho_v * psi), u_v);
+                let scale = -(2.0 * rho_v * psi);
+                u_v.iter_mut().zip(w.iter()).for_each(|(u, w)| *u += scale * w);
             }
             Energy::Baumgarte { eta } => {
                 // μ = [Ψ_v A_geo + Ψ_q v − Ė + η Ψ] / (Ψ_v M⁻¹ Ψ_vᵀ), with

@@ -19,6 +19,9 @@ pub struct Dynamics {
     force: Vec<f64>,
     grad_potential: Vec<f64>,
     potential: f64,
+    /// `T` of the last evaluation where `M` depends on `q` (its pass sums
+    /// it with `M`); unused with a constant `M`.
+    kinetic: f64,
     force_power: f64,
     lambda: Vec<f64>,
     acc: Vec<f64>,
@@ -84,6 +87,7 @@ impl Dynamics {
             force: vec![0.0; n],
             grad_potential: vec![0.0; n],
             potential: 0.0,
+            kinetic: 0.0,
             force_power: 0.0,
             lambda: vec![0.0; m],
             acc: vec![0.0; n],
@@ -231,14 +235,16 @@ impl Dynamics {
             (Solver::General(g), _) => {
                 g.psi_q.fill(0.0);
                 g.mdot_v.fill(0.0);
-                model.mass_at(q, v, &mut g.mass, &mut g.psi_q, &mut g.mdot_v).map_err(Breakdown::Mass)?;
+                self.kinetic =
+                    model.mass_at(q, v, &mut g.mass, &mut g.psi_q, &mut g.mdot_v).map_err(Breakdown::Mass)?;
                 lagrange_terms(&mut self.force, &mut g.psi_q, &g.mdot_v, &self.grad_potential);
                 g.mass.solve(&self.force, &mut self.acc);
             }
             (Solver::Blocks(b), _) => {
                 b.psi_q.fill(0.0);
                 b.mdot_v.fill(0.0);
-                model.block_mass_at(q, v, &mut b.mass, &mut b.psi_q, &mut b.mdot_v).map_err(Breakdown::Mass)?;
+                self.kinetic =
+                    model.block_mass_at(q, v, &mut b.mass, &mut b.psi_q, &mut b.mdot_v).map_err(Breakdown::Mass)?;
                 lagrange_terms(&mut self.force, &mut b.psi_q, &b.mdot_v, &self.grad_potential);
                 b.mass.solve(&self.force, &mut self.acc);
             }
@@ -319,6 +325,14 @@ impl Dynamics {
     /// `V(q)`
     pub fn potential(&self) -> f64 {
         self.potential
+    }
+    /// Kinetic energy at the last evaluation, whose velocities `v` are:
+    /// summed by the mass pass where `M` depends on `q`, `½ vᵀMv` otherwise.
+    pub fn kinetic(&self, model: &Model, v: &[f64]) -> f64 {
+        match (&self.solver, model.mass()) {
+            (Solver::Constant(_), Some(mass)) => mass.kinetic(v),
+            _ => self.kinetic,
+        }
     }
     /// Power of the non-conservative forces, `F·v`.
     pub fn force_power(&self) -> f64 {

@@ -79,6 +79,18 @@ pub trait VelocityMap<const K: usize, const V: usize>: Send + Sync + 'static {
     fn velocities<D: Scalar>(&self, x: [D; K], xd: [D; K]) -> [D; V];
     /// `J`, symmetric.
     fn inertia(&self) -> [[f64; V]; V];
+
+    /// What the equations of motion need of the element at `(x, ẋ)`. The
+    /// default takes it by dual passes of the map ([`local_map`]); an
+    /// element that knows closed forms may return them instead (and test
+    /// them against `local_map`).
+    #[inline(always)]
+    fn derivatives(&self, x: [f64; K], xd: [f64; K]) -> Local<K>
+    where
+        Self: Sized,
+    {
+        local_map(self, x, xd)
+    }
 }
 
 /// Differentiates a [`VelocityMap`] element at `(x, ẋ)`:
@@ -145,10 +157,10 @@ pub(crate) struct ByMap<T, const V: usize>(pub T);
 impl<T: VelocityMap<K, V>, const K: usize, const V: usize> KineticElement<K> for ByMap<T, V> {
     #[inline(always)]
     fn local(&self, x: [f64; K], xd: [f64; K]) -> Local<K> {
-        local_map(&self.0, x, xd)
+        self.0.derivatives(x, xd)
     }
     fn energy(&self, x: [f64; K], xd: [f64; K], grad: Option<&mut [f64; K]>) -> f64 {
-        let l = local_map(&self.0, x, xd);
+        let l = self.0.derivatives(x, xd);
         if let Some(g) = grad {
             *g = l.grad_q;
         }

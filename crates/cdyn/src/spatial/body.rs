@@ -2,10 +2,10 @@
 //! coordinates are in a mechanism's state, and its rotational kinetic
 //! energy as a kinetic element of its Euler parameters.
 
-use super::rotation::body_rate;
+use super::rotation::{body_rate, g_matrix};
 use crate::ad::scalar::Scalar;
 use crate::error::{Problem, Result, positive};
-use crate::model::kinetic::{Kinetic, VelocityMap};
+use crate::model::kinetic::{Kinetic, Local, VelocityMap};
 
 /// A rigid body as the user describes it, at the initial instant; in a
 /// scenario file a `[[bodies]]` entry with these keys (`orientation`,
@@ -223,6 +223,39 @@ impl VelocityMap<4, 4> for Rotation {
                 }
             })
         })
+    }
+
+    /// In closed form, with `G = G(p)`, `ω′ = 2Gṗ`, `s = pᵀṗ` (`G(a)b =
+    /// −G(b)a`, so `G(a)a = 0`):
+    /// * `M = 4GᵀJ′G + k ppᵀ`;
+    /// * `∂T/∂p = −2G(ṗ)ᵀJ′ω′ + k s ṗ`, since `ω′ = −2G(ṗ)p`;
+    /// * `Ṁṗ = 2G(ṗ)ᵀJ′ω′ + k|ṗ|²p + k s ṗ`, the rate of `∂T/∂ṗ = 2GᵀJ′ω′ + k s p`
+    ///   along `p + εṗ` (where `ω′` stays: `G(ṗ)ṗ = 0`).
+    ///
+    /// A tenth of the dual passes' cost; `tests/spatial.rs` checks it against them.
+    #[inline(always)]
+    fn derivatives(&self, p: [f64; 4], pd: [f64; 4]) -> Local<4> {
+        let (g, g_rate, j, k) = (g_matrix(p), g_matrix(pd), &self.inertia, self.k);
+        let w = body_rate(p, pd);
+        let jw: [f64; 3] = std::array::from_fn(|i| j[i][0] * w[0] + j[i][1] * w[1] + j[i][2] * w[2]);
+        let (s, speed2) = ((0..4).map(|c| p[c] * pd[c]).sum::<f64>(), (0..4).map(|c| pd[c] * pd[c]).sum::<f64>());
+        let turn: [f64; 4] =
+            std::array::from_fn(|c| 2.0 * (g_rate[0][c] * jw[0] + g_rate[1][c] * jw[1] + g_rate[2][c] * jw[2]));
+        let jg: [[f64; 4]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|c| j[i][0] * g[0][c] + j[i][1] * g[1][c] + j[i][2] * g[2][c]));
+        let mut mass = [[0.0; 4]; 4];
+        for a in 0..4 {
+            for b in a..4 {
+                let m = 4.0 * (g[0][a] * jg[0][b] + g[1][a] * jg[1][b] + g[2][a] * jg[2][b]) + k * p[a] * p[b];
+                (mass[a][b], mass[b][a]) = (m, m);
+            }
+        }
+        Local {
+            energy: 0.5 * (w[0] * jw[0] + w[1] * jw[1] + w[2] * jw[2] + k * s * s),
+            mass,
+            grad_q: std::array::from_fn(|c| -turn[c] + k * s * pd[c]),
+            mdot_v: std::array::from_fn(|c| turn[c] + k * (speed2 * p[c] + s * pd[c])),
+        }
     }
 }
 

@@ -45,16 +45,8 @@ impl MassMatrix for MassAt<'_> {
         either!(self, m => m.kinetic(v))
     }
     #[inline(always)]
-    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
-        either!(self, m => m.psi_v_norm2(v))
-    }
-    #[inline(always)]
     fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
         either!(self, m => m.psi_v_dot(v, x, extra, init))
-    }
-    #[inline(always)]
-    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
-        either!(self, m => m.add_psi_v(v, scale, out))
     }
     #[inline(always)]
     fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {

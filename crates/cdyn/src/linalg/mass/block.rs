@@ -245,20 +245,10 @@ impl MassMatrix for BlockMass {
         0.5 * sum
     }
 
-    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
-        let mut sum = 0.0;
-        self.each_product(v, |_, y| sum += y * y);
-        sum
-    }
-
     fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
         let mut sum = init;
         self.each_product(v, |c, y| sum += y * x(c) + extra(c));
         sum
-    }
-
-    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
-        self.each_product(v, |c, y| out[c] += scale * y);
     }
 
     fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {

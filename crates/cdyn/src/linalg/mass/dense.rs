@@ -91,22 +91,12 @@ impl MassMatrix for DenseMass {
         0.5 * (0..self.n).map(|i| v[i] * self.row_dot(i, v)).sum::<f64>()
     }
 
-    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
-        (0..self.n).map(|i| self.row_dot(i, v).powi(2)).sum()
-    }
-
     fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
         let mut sum = init;
         for i in 0..self.n {
             sum += self.row_dot(i, v) * x(i) + extra(i);
         }
         sum
-    }
-
-    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o += scale * self.row_dot(i, v);
-        }
     }
 
     fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {

@@ -69,24 +69,12 @@ impl<S: AsRef<[f64]>> MassMatrix for DiagonalMass<S> {
     }
 
     #[inline(always)]
-    fn psi_v_norm2(&self, v: &[f64]) -> f64 {
-        self.diagonal.as_ref().iter().zip(v).map(|(m, v)| (m * v) * (m * v)).sum()
-    }
-
-    #[inline(always)]
     fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
         let mut sum = init;
         for (i, (m, v)) in self.diagonal.as_ref().iter().zip(v).enumerate() {
             sum += m * v * x(i) + extra(i);
         }
         sum
-    }
-
-    #[inline(always)]
-    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]) {
-        for ((o, m), v) in out.iter_mut().zip(self.diagonal.as_ref()).zip(v) {
-            *o += scale * m * v;
-        }
     }
 
     #[inline(always)]

@@ -41,14 +41,10 @@ pub trait MassMatrix {
     fn solve(&self, x: &[f64], out: &mut [f64]);
     /// The kinetic energy `½ vᵀ M v`.
     fn kinetic(&self, v: &[f64]) -> f64;
-    /// `|Ψ_v|² = |M v|²`, which sets the gain of the gradient energy control (Eq. 27).
-    fn psi_v_norm2(&self, v: &[f64]) -> f64;
     /// `Ψ_v x = (M v) · x`, summed in coordinate order after `init`, with
     /// `extra(i)` added to the `i`-th term before it joins the sum (the
     /// Baumgarte-type energy control sums `Ψ_v A + Ψ_q v` in one pass).
     fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64;
-    /// `out += scale · Ψ_vᵀ = scale · M v`.
-    fn add_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]);
     /// `out += scale · M⁻¹ Ψ_vᵀ`. Since `Ψ_vᵀ = M v`, this is `scale · v`
     /// for every kind of `M`, formed without the round trip through `M`.
     fn add_inverse_psi_v(&self, v: &[f64], scale: f64, out: &mut [f64]);
@@ -69,11 +65,7 @@ mod tests {
         mass.solve(&mv, &mut back);
         assert_eq!(back, v);
         assert_eq!(mass.kinetic(&v), 0.5 * (2.0 + 2.0 + 0.25));
-        assert_eq!(mass.psi_v_norm2(&v), 4.0 + 1.0 + 1.0);
         assert_eq!(mass.psi_v_dot(&v, |_| 1.0, |_| 0.0, 0.5), 0.5 + 2.0);
-        let mut out = [1.0; 3];
-        mass.add_psi_v(&v, -1.0, &mut out);
-        assert_eq!(out, [-1.0, 2.0, 0.0]);
         // M⁻¹ Ψ_vᵀ = v.
         let mut out = [0.0; 3];
         mass.add_inverse_psi_v(&v, 2.0, &mut out);
@@ -100,10 +92,6 @@ mod tests {
         }
         let vmv: f64 = mv.iter().zip(&v).map(|(a, b)| a * b).sum();
         assert_eq!(mass.kinetic(&v), 0.5 * vmv);
-        assert_eq!(mass.psi_v_norm2(&v), mv.iter().map(|x| x * x).sum::<f64>());
-        let mut out = [0.0; 3];
-        mass.add_psi_v(&v, 2.0, &mut out);
-        assert_eq!(out, mv.map(|x| 2.0 * x));
         // Not positive definite: the pivot of coordinate 1 is 1 − 4 < 0.
         mass.matrix_mut().copy_from_slice(&[1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
         assert_eq!(mass.factor(), Err(1));

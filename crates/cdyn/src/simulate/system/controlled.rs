@@ -13,7 +13,7 @@ use crate::dynamics::energy;
 use crate::dynamics::momentum::{self, Kind, Momenta, Symmetries};
 use crate::dynamics::{DependentRows, Dynamics, LinearSolver};
 use crate::integrate::Rhs;
-use crate::linalg::mass::{MassAt, MassMatrix};
+use crate::linalg::mass::MassAt;
 use crate::model::Model;
 use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
@@ -185,7 +185,7 @@ impl Rhs for ControlledSystem<'_> {
         f[..n].copy_from_slice(v);
         f[2 * n] = e_dot;
         if let Some(u) = u {
-            let kinetic = self.dynamics.mass(self.model).kinetic(v);
+            let kinetic = self.dynamics.kinetic(self.model, v);
             let psi = energy::psi_from(kinetic, self.dynamics.potential(), e, self.e0);
             let (u_q, u_v, u_e) = split_state_mut(u, n);
             *u_e = 0.0;
