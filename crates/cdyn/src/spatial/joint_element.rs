@@ -1,7 +1,8 @@
 //! A joint's rows as a model element ([`BodyToBody`], [`BodyToGround`]) and
 //! their derivatives. A joint without drives forms its Jacobian and its
 //! rows' rates in one pass, side by side: each body's points and axes are
-//! rotated once with their derivatives in its seven coordinates and
+//! rotated once with their derivatives in its seven coordinates (in closed
+//! form: `∂(A(p)s)/∂p` is linear in `p`) and
 //! combined by the product rule, where a jet over both bodies' 14
 //! coordinates multiplied the other body's zeros in every product, and a
 //! second pass on second-order duals rotated them again. A joint with
@@ -9,7 +10,7 @@
 
 use super::joint::JointKind;
 use super::joint_rows::{F, Frame, G, H, JointRows, Place, Side, pose};
-use super::rotation::rotate_fixed;
+use super::rotation::{rotate_fixed, rotate_jacobian};
 use crate::ad::jet::{Eps, JetN};
 use crate::ad::scalar::Scalar;
 use crate::model::constraint::{Constraint, second_order_of};
@@ -24,13 +25,13 @@ pub(crate) struct BodyToGround<const R: usize>(pub JointRows<R>);
 
 /// A body side of a joint's Jacobian pass: its seven coordinates are
 /// `offset..offset + 7` of the pass's jet, and a point or axis depends on
-/// them through `p` alone (and `r`, with unit slope). So it is rotated by a
-/// 4-wide jet over `p` and then placed among the jet's derivatives: a
-/// spatial joint's Jacobian costs two 4-wide rotations, where one pass of
-/// a 14-wide jet carried the other body's zeros through every product.
+/// them through `p` alone (and `r`, with unit slope). So it is rotated with
+/// its 3 × 4 derivative in `p` (`rotate_jacobian`) and then placed among the
+/// jet's derivatives, where one pass of a 14-wide jet carried the other
+/// body's zeros through every product.
 struct Seeded<'a> {
     r: [f64; 3],
-    p: [JetN<4>; 4],
+    p: [f64; 4],
     offset: usize,
     frame: &'a Frame,
     /// `ṙ` and `ṗ`, for the rows' rates (zero for the Jacobian alone).
@@ -39,7 +40,7 @@ struct Seeded<'a> {
 
 impl<'a> Seeded<'a> {
     fn new(r: [f64; 3], p: [f64; 4], offset: usize, frame: &'a Frame) -> Self {
-        Self { r, p: std::array::from_fn(|j| JetN::seeded(p[j], j)), offset, frame, rates: ([0.0; 3], [0.0; 4]) }
+        Self { r, p, offset, frame, rates: ([0.0; 3], [0.0; 4]) }
     }
 
     /// Moving at `(ṙ, ṗ)`.
@@ -102,15 +103,15 @@ impl Seeded<'_> {
     /// `p + s ṗ` its second rate is `2 A(ṗ) x`.
     #[inline(always)]
     fn sided(&self, s: [f64; 3], moved: bool) -> Sided {
-        let y = rotate_fixed(self.p, s);
+        let (y, jacobian) = (rotate_fixed(self.p, s), rotate_jacobian(self.p, s));
         let mut d = [[0.0; 7]; 3];
         for i in 0..3 {
-            d[i][3..7].copy_from_slice(y[i].eps.0.as_slice());
+            d[i][3..7].copy_from_slice(&jacobian[i]);
             if moved {
                 d[i][i] = 1.0;
             }
         }
-        let x = [0, 1, 2].map(|i| y[i].re + if moved { self.r[i] } else { 0.0 });
+        let x = [0, 1, 2].map(|i| y[i] + if moved { self.r[i] } else { 0.0 });
         let (rd, pd) = self.rates;
         let rate = [0, 1, 2].map(|i| {
             let turn: f64 = (0..4).map(|k| d[i][3 + k] * pd[k]).sum();

@@ -43,6 +43,27 @@ pub fn rotate_fixed<D: Scalar>(p: [D; 4], s: [f64; 3]) -> [D; 3] {
     [at(0), at(1), at(2)]
 }
 
+/// `∂(A(p) s)/∂p`, a 3 × 4 matrix linear in `p`: column `e₀` is
+/// `2(e₀s + e × s)`, the block of `e` is `2((eᵀs) I + e sᵀ − s eᵀ − e₀[s]×)`.
+/// `A(p)s` being a quadratic form in `p`, its rate along `ṗ` is `J(p) ṗ`
+/// and its second rate `2A(ṗ)s = J(ṗ) ṗ`.
+#[inline(always)]
+pub fn rotate_jacobian(p: [f64; 4], s: [f64; 3]) -> [[f64; 4]; 3] {
+    let [e0, e1, e2, e3] = p;
+    let e = [e1, e2, e3];
+    let es = e1 * s[0] + e2 * s[1] + e3 * s[2];
+    let cross = [e2 * s[2] - e3 * s[1], e3 * s[0] - e1 * s[2], e1 * s[1] - e2 * s[0]];
+    // [s]× x = s × x: row i of [s]×.
+    let skew = [[0.0, -s[2], s[1]], [s[2], 0.0, -s[0]], [-s[1], s[0], 0.0]];
+    std::array::from_fn(|i| {
+        let block = |j: usize| {
+            let diagonal = if i == j { es } else { 0.0 };
+            2.0 * (diagonal + e[i] * s[j] - s[i] * e[j] - e0 * skew[i][j])
+        };
+        [2.0 * (e0 * s[i] + cross[i]), block(0), block(1), block(2)]
+    })
+}
+
 /// `A(p)ᵀ x`: a space vector in body axes (`|p| = 1`).
 pub fn unrotate(p: [f64; 4], x: [f64; 3]) -> [f64; 3] {
     rotate([p[0], -p[1], -p[2], -p[3]], x)
@@ -120,6 +141,28 @@ mod tests {
         let wr = rotate(q, w);
         for i in 0..3 {
             assert!((wb[i] - w[i]).abs() < 1e-14 && (ws[i] - wr[i]).abs() < 1e-14);
+        }
+    }
+
+    /// `∂(A(p)s)/∂p` against central differences, off the unit sphere, and
+    /// `A(p)s = ½ J(p) p` (a quadratic form).
+    #[test]
+    fn the_jacobian_of_a_rotated_vector_is_its_derivative() {
+        let (p, s) = ([0.9, -0.3, 0.5, 0.2], [0.3, -1.2, 2.0]);
+        let j = rotate_jacobian(p, s);
+        let h = 1e-6;
+        for k in 0..4 {
+            let moved = |d: f64| rotate(std::array::from_fn(|m| p[m] + if m == k { d } else { 0.0 }), s);
+            let (up, down) = (moved(h), moved(-h));
+            for i in 0..3 {
+                let fd = (up[i] - down[i]) / (2.0 * h);
+                assert!((j[i][k] - fd).abs() < 1e-9, "∂/∂p{k} row {i}: {} against {fd}", j[i][k]);
+            }
+        }
+        let value = rotate(p, s);
+        for i in 0..3 {
+            let half: f64 = 0.5 * (0..4).map(|k| j[i][k] * p[k]).sum::<f64>();
+            assert!((half - value[i]).abs() < 1e-14, "{half} against {}", value[i]);
         }
     }
 }
