@@ -265,13 +265,10 @@ impl Control {
             Energy::Gradient(gain) => {
                 // Ψ_v = M v once: the gain and the term both read it.
                 let w = work.w;
-                mass.mul(v, w);
+                let g2 = mass.psi_v(v, w);
                 let (rho_q, rho_v) = match gain {
                     EnergyGain::Fixed { rho_q, rho_v } => (rho_q, rho_v),
-                    EnergyGain::Rate { alpha_e } => {
-                        let g2 = w.iter().map(|w| w * w).sum::<f64>();
-                        (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 })
-                    }
+                    EnergyGain::Rate { alpha_e } => (0.0, if g2 > REST { alpha_e / (2.0 * g2) } else { 0.0 }),
                 };
                 // U_q −= 2ρ_q Ψ Ψ_q,  U_v −= 2ρ_v Ψ Ψ_v,  Ψ_q = ∇V + ∂T/∂q, Ψ_v = M v
                 if rho_q != 0.0 {

@@ -45,6 +45,10 @@ impl MassMatrix for MassAt<'_> {
         either!(self, m => m.kinetic(v))
     }
     #[inline(always)]
+    fn psi_v(&self, v: &[f64], out: &mut [f64]) -> f64 {
+        either!(self, m => m.psi_v(v, out))
+    }
+    #[inline(always)]
     fn psi_v_dot(&self, v: &[f64], x: impl Fn(usize) -> f64, extra: impl Fn(usize) -> f64, init: f64) -> f64 {
         either!(self, m => m.psi_v_dot(v, x, extra, init))
     }

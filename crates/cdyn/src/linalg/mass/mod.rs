@@ -41,6 +41,12 @@ pub trait MassMatrix {
     fn solve(&self, x: &[f64], out: &mut [f64]);
     /// The kinetic energy `½ vᵀ M v`.
     fn kinetic(&self, v: &[f64]) -> f64;
+    /// `out = Ψ_vᵀ = M v`; returns `|Ψ_v|²`, which sets the gain of the
+    /// gradient energy control (Eq. 27).
+    fn psi_v(&self, v: &[f64], out: &mut [f64]) -> f64 {
+        self.mul(v, out);
+        out.iter().map(|w| w * w).sum()
+    }
     /// `Ψ_v x = (M v) · x`, summed in coordinate order after `init`, with
     /// `extra(i)` added to the `i`-th term before it joins the sum (the
     /// Baumgarte-type energy control sums `Ψ_v A + Ψ_q v` in one pass).
@@ -65,6 +71,8 @@ mod tests {
         mass.solve(&mv, &mut back);
         assert_eq!(back, v);
         assert_eq!(mass.kinetic(&v), 0.5 * (2.0 + 2.0 + 0.25));
+        assert_eq!(mass.psi_v(&v, &mut mv), 4.0 + 1.0 + 1.0);
+        assert_eq!(mv, [2.0, -1.0, 1.0]);
         assert_eq!(mass.psi_v_dot(&v, |_| 1.0, |_| 0.0, 0.5), 0.5 + 2.0);
         // M⁻¹ Ψ_vᵀ = v.
         let mut out = [0.0; 3];
@@ -92,6 +100,9 @@ mod tests {
         }
         let vmv: f64 = mv.iter().zip(&v).map(|(a, b)| a * b).sum();
         assert_eq!(mass.kinetic(&v), 0.5 * vmv);
+        let mut again = [0.0; 3];
+        assert_eq!(mass.psi_v(&v, &mut again), mv.iter().map(|x| x * x).sum::<f64>());
+        assert_eq!(again, mv);
         // Not positive definite: the pivot of coordinate 1 is 1 − 4 < 0.
         mass.matrix_mut().copy_from_slice(&[1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
         assert_eq!(mass.factor(), Err(1));
