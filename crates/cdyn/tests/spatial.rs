@@ -733,15 +733,15 @@ proptest! {
         let (a, b) = (cdyn::model::kinetic::local(&body, p, pd), cdyn::model::kinetic::local_map(&body, p, pd));
         let closed = cdyn::model::kinetic::VelocityMap::derivatives(&body, p, pd);
         let scale = 1.0 + a.energy.abs();
-        for b in [b, closed] {
-        prop_assert!((a.energy - b.energy).abs() < 1e-13 * scale);
-        for r in 0..4 {
-            prop_assert!((a.grad_q[r] - b.grad_q[r]).abs() < 1e-12 * scale, "∂T/∂x {:?} vs {:?}", a.grad_q, b.grad_q);
-            prop_assert!((a.mdot_v[r] - b.mdot_v[r]).abs() < 1e-12 * scale, "Ṁẋ {:?} vs {:?}", a.mdot_v, b.mdot_v);
-            for c in 0..4 {
-                prop_assert!((a.mass[r][c] - b.mass[r][c]).abs() < 1e-13 * scale, "M {:?} vs {:?}", a.mass, b.mass);
+        for other in [b, closed] {
+            prop_assert!((a.energy - other.energy).abs() < 1e-13 * scale);
+            for r in 0..4 {
+                prop_assert!((a.grad_q[r] - other.grad_q[r]).abs() < 1e-12 * scale, "∂T/∂x {:?} vs {:?}", a.grad_q, other.grad_q);
+                prop_assert!((a.mdot_v[r] - other.mdot_v[r]).abs() < 1e-12 * scale, "Ṁẋ {:?} vs {:?}", a.mdot_v, other.mdot_v);
+                for c in 0..4 {
+                    prop_assert!((a.mass[r][c] - other.mass[r][c]).abs() < 1e-13 * scale, "M {:?} vs {:?}", a.mass, other.mass);
+                }
             }
-        }
         }
     }
 }

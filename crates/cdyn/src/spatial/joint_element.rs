@@ -1,12 +1,10 @@
 //! A joint's rows as a model element ([`BodyToBody`], [`BodyToGround`]) and
 //! their derivatives. A joint without drives forms its Jacobian and its
 //! rows' rates in one pass, side by side: each body's points and axes are
-//! rotated once with their derivatives in its seven coordinates (in closed
-//! form: `∂(A(p)s)/∂p` is linear in `p`) and
-//! combined by the product rule, where a jet over both bodies' 14
-//! coordinates multiplied the other body's zeros in every product, and a
-//! second pass on second-order duals rotated them again. A joint with
-//! drives differentiates its rows ([`JointRows`]) as written.
+//! rotated once, with their derivatives in its seven coordinates in closed
+//! form (`∂(A(p)s)/∂p` is linear in `p`), and combined by the product rule
+//! at each side's width. A joint with drives differentiates its rows
+//! ([`JointRows`]) as written.
 
 use super::joint::JointKind;
 use super::joint_rows::{F, Frame, G, H, JointRows, Place, Side, pose};

@@ -1,24 +1,5 @@
-//! The 4 × 4 algebra of one body: the rotation's Jacobian, and the
-//! Cholesky factor of a block with its two triangular solves.
-
-/// `∂(A(p) s)/∂p`, row by row: `A(p) s = (e₀² − eᵀe) s + 2e(eᵀs) + 2e₀(e × s)`
-/// gives `2(e₀ s + e × s)` for `e₀` and `2((eᵀs) I + e sᵀ − s eᵀ − e₀ [s]×)` for `e`.
-#[inline(always)]
-pub(super) fn d_rotate([e0, e1, e2, e3]: [f64; 4], s: [f64; 3]) -> [[f64; 4]; 3] {
-    let e = [e1, e2, e3];
-    let es = dot(&e, &s);
-    let cross = [e2 * s[2] - e3 * s[1], e3 * s[0] - e1 * s[2], e1 * s[1] - e2 * s[0]];
-    // [s]× e = s × e, so row i of [s]× is ∂(s × e)_i/∂e.
-    let skew = [[0.0, -s[2], s[1]], [s[2], 0.0, -s[0]], [-s[1], s[0], 0.0]];
-    std::array::from_fn(|i| {
-        let mut row = [2.0 * (e0 * s[i] + cross[i]), 0.0, 0.0, 0.0];
-        for j in 0..3 {
-            let identity = if i == j { es } else { 0.0 };
-            row[j + 1] = 2.0 * (identity + e[i] * s[j] - s[i] * e[j] - e0 * skew[i][j]);
-        }
-        row
-    })
-}
+//! The 4 × 4 algebra of one body: the Cholesky factor of a block with its
+//! two triangular solves.
 
 #[inline(always)]
 pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -2,8 +2,8 @@
 //! tridiagonal factorization of `S` and its solves, the multipliers, the
 //! accelerations and the control term.
 
-use super::blocks::{backward, cholesky, d_rotate, dot, forward, quaternion};
-use crate::spatial::rotation::{body_rate, g_matrix, rotate_fixed};
+use super::blocks::{backward, cholesky, dot, forward, quaternion};
+use crate::spatial::rotation::{body_rate, g_matrix, rotate_fixed, rotate_jacobian};
 
 /// What one body contributes to an evaluation.
 #[derive(Debug, Clone, Copy, Default)]
@@ -125,8 +125,8 @@ impl Chain {
             let momentum_p = self.momentum(p, pd, &j_omega);
             energy += self.body_energy(r[2], rd, pd, &momentum_p);
             momentum2 += self.mass * self.mass * dot(rd, rd) + dot(&momentum_p, &momentum_p);
-            let top = d_rotate(p, self.top);
-            let bottom = d_rotate(p, self.bottom).map(|row| row.map(|x| -x));
+            let top = rotate_jacobian(p, self.top);
+            let bottom = rotate_jacobian(p, self.bottom).map(|row| row.map(|x| -x));
             let terms = BodyTerms {
                 top,
                 bottom,

@@ -148,25 +148,9 @@ impl HandWrittenChain {
 
 #[cfg(test)]
 mod tests {
-    use super::blocks::{d_rotate, quaternion};
+    use super::blocks::quaternion;
     use super::*;
     use crate::Simulation;
-    use crate::spatial::rotation::rotate;
-
-    #[test]
-    fn the_rotation_jacobian_is_the_derivative_of_the_rotation() {
-        let (p, s) = ([0.9, -0.3, 0.25, 0.4], [0.3, -1.1, 0.7]);
-        let jac = d_rotate(p, s);
-        for j in 0..4 {
-            let h = 1e-6;
-            let at = |d: f64| rotate(std::array::from_fn(|i| p[i] + if i == j { d } else { 0.0 }), s);
-            let (plus, minus) = (at(h), at(-h));
-            for i in 0..3 {
-                let fd = (plus[i] - minus[i]) / (2.0 * h);
-                assert!((jac[i][j] - fd).abs() < 1e-9, "∂(As)_{i}/∂p_{j}: {} against {fd}", jac[i][j]);
-            }
-        }
-    }
 
     /// The hand-written chain and cdyn's, with the benchmark's control,
     /// through the RK-4 start-up and 2 s of AB-3, from rest (a plane swing)
