@@ -1,8 +1,9 @@
 //! How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied, by the kind of mass
 //! matrix: constant diagonal, dense `M(q)`, or block-diagonal `M(q)`.
 
+use crate::linalg::band::MAX_WIDTH;
 use crate::linalg::mass::{BlockMass, DenseMass, MassMatrix, WidthFn};
-use crate::linalg::{Breakdown, DenseLdl, LinearSolver, Schur};
+use crate::linalg::{Band, Breakdown, DenseLdl, DependentRows, LinearSolver, Schur, products};
 use crate::model::Model;
 
 /// How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied: decided by the model's mass.
@@ -33,7 +34,8 @@ pub const BLOCKS_FROM: usize = 16;
 /// block is a dense segment, and `S`'s entries from that block are the dot
 /// products of the segments on it, taken block by block at the block's
 /// width; the entries outside the blocks are summed product by product.
-/// `S` is then factored by the sparse [`Schur`], along its pattern.
+/// `S` is then factored by the sparse [`Schur`], along its pattern, or
+/// inside its envelope ([`BlockSchur`]).
 #[derive(Clone)]
 pub(super) struct Blocks {
     pub(super) mass: BlockMass,
@@ -62,7 +64,7 @@ pub(super) struct Blocks {
     pairs: Vec<(u32, u32, u32)>,
     /// `S`'s entries by slot, assembled each step.
     s: Vec<f64>,
-    pub(super) schur: Schur,
+    pub(super) schur: BlockSchur,
 }
 
 impl Blocks {
@@ -75,7 +77,7 @@ impl Blocks {
             }
         }
         let diagonal = model.diagonal_mass();
-        let schur = Schur::assembled_by_caller(pattern, n, solver);
+        let schur = BlockSchur::new(pattern, n, solver);
         let slot = schur.slot_finder();
         // Every row's segment on every block it reads: (block, row, start).
         let (mut plain, mut found, mut entries) = (Vec::new(), Vec::new(), Vec::new());
@@ -117,7 +119,7 @@ impl Blocks {
             pair_start.push(pairs.len() as u32);
         }
         let mass = BlockMass::new(diagonal, blocks);
-        let plain_products = crate::linalg::products(pattern, n)
+        let plain_products = products(pattern, n)
             .into_iter()
             .filter(|&(.., col)| owner[col].0 == u32::MAX)
             .map(|(a, b, ja, jb, col)| (ja as u32, jb as u32, mass.inverse()[col], slot(a, b) as u32))
@@ -241,6 +243,95 @@ impl Blocks {
             self.mass.at_width(block, pass);
         }
         self.schur.factor_and_solve_assembled(&self.s, b)
+    }
+}
+
+/// How `S` of a block mass is factored: in a [`Band`] where `Auto` finds
+/// one at most [`MAX_WIDTH`] wide and with at most [`BAND_WIDER`] times
+/// the entries of the sparse factor (chains, arms: every entry costs less
+/// there), else by the column kernel of [`Schur`].
+#[derive(Clone)]
+pub(super) enum BlockSchur {
+    Columns(Schur),
+    Band(Band),
+}
+
+/// How many times the sparse factor's entries a band may hold and still be chosen.
+pub const BAND_WIDER: usize = 2;
+
+impl BlockSchur {
+    fn new(pattern: &crate::linalg::sparse::Pattern, n: usize, solver: LinearSolver) -> Self {
+        let columns = Schur::assembled_by_caller(pattern, n, solver);
+        let m = pattern.start.len() - 1;
+        if solver != LinearSolver::Auto || m == 0 {
+            return Self::Columns(columns);
+        }
+        let band = Band::new(m, products(pattern, n).into_iter().map(|(a, b, ..)| (a, b)));
+        if band.width() <= MAX_WIDTH && band.entries() <= BAND_WIDER * (columns.slots() - m) {
+            Self::Band(band)
+        } else {
+            Self::Columns(columns)
+        }
+    }
+
+    fn slot_finder(&self) -> Box<dyn Fn(usize, usize) -> usize + '_> {
+        match self {
+            Self::Columns(s) => Box::new(s.slot_finder()),
+            Self::Band(e) => Box::new(e.slot_finder()),
+        }
+    }
+
+    fn slots(&self) -> usize {
+        match self {
+            Self::Columns(s) => s.slots(),
+            Self::Band(e) => e.slots(),
+        }
+    }
+
+    fn factor_and_solve_assembled(&mut self, entries: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        match self {
+            Self::Columns(s) => s.factor_and_solve_assembled(entries, b),
+            Self::Band(e) => e.factor_and_solve_assembled(entries, b),
+        }
+    }
+
+    pub(super) fn solve(&self, b: &mut [f64]) {
+        match self {
+            Self::Columns(s) => s.solve(b),
+            Self::Band(e) => e.solve(b),
+        }
+    }
+
+    pub(super) fn solve_many(&self, bs: &mut [&mut [f64]]) {
+        match self {
+            Self::Columns(s) => s.solve_many(bs),
+            Self::Band(e) => e.solve_many(bs),
+        }
+    }
+
+    pub(super) fn set_dependent_rows(&mut self, dependent: DependentRows) {
+        match self {
+            Self::Columns(s) => s.set_dependent_rows(dependent),
+            Self::Band(e) => e.set_dependent_rows(dependent),
+        }
+    }
+
+    pub(super) fn dependent_rows(&self) -> usize {
+        match self {
+            Self::Columns(s) => s.dependent_rows(),
+            Self::Band(e) => e.dependent_rows(),
+        }
+    }
+
+    /// Whether `L` has fewer entries than the full triangle.
+    pub(super) fn is_sparse(&self) -> bool {
+        match self {
+            Self::Columns(s) => s.is_sparse(),
+            Self::Band(e) => {
+                let m = e.slots() - e.entries();
+                e.entries() < m * m.saturating_sub(1) / 2
+            }
+        }
     }
 }
 
