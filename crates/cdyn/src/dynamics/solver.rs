@@ -1,9 +1,8 @@
 //! How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied, by the kind of mass
 //! matrix: constant diagonal, dense `M(q)`, or block-diagonal `M(q)`.
 
-use crate::linalg::band::MAX_WIDTH;
 use crate::linalg::mass::{BlockMass, DenseMass, MassMatrix, WidthFn};
-use crate::linalg::{Band, Breakdown, DenseLdl, DependentRows, LinearSolver, Schur, products};
+use crate::linalg::{AssembledSchur, Breakdown, DenseLdl, LinearSolver, Schur, products};
 use crate::model::Model;
 
 /// How `M⁻¹` and `(Φ_q M⁻¹ Φ_qᵀ)⁻¹` are applied: decided by the model's mass.
@@ -34,8 +33,7 @@ pub const BLOCKS_FROM: usize = 16;
 /// block is a dense segment, and `S`'s entries from that block are the dot
 /// products of the segments on it, taken block by block at the block's
 /// width; the entries outside the blocks are summed product by product.
-/// `S` is then factored by the sparse [`Schur`], along its pattern, or
-/// inside its envelope ([`BlockSchur`]).
+/// `S` is then factored in a band or along its sparse pattern ([`AssembledSchur`]).
 #[derive(Clone)]
 pub(super) struct Blocks {
     pub(super) mass: BlockMass,
@@ -64,7 +62,7 @@ pub(super) struct Blocks {
     pairs: Vec<(u32, u32, u32)>,
     /// `S`'s entries by slot, assembled each step.
     s: Vec<f64>,
-    pub(super) schur: BlockSchur,
+    pub(super) schur: AssembledSchur,
 }
 
 impl Blocks {
@@ -77,7 +75,7 @@ impl Blocks {
             }
         }
         let diagonal = model.diagonal_mass();
-        let schur = BlockSchur::new(pattern, n, solver);
+        let schur = AssembledSchur::new(pattern, n, solver);
         let slot = schur.slot_finder();
         // Every row's segment on every block it reads: (block, row, start).
         let (mut plain, mut found, mut entries) = (Vec::new(), Vec::new(), Vec::new());
@@ -246,95 +244,6 @@ impl Blocks {
     }
 }
 
-/// How `S` of a block mass is factored: in a [`Band`] where `Auto` finds
-/// one at most [`MAX_WIDTH`] wide and with at most [`BAND_WIDER`] times
-/// the entries of the sparse factor (chains, arms: every entry costs less
-/// there), else by the column kernel of [`Schur`].
-#[derive(Clone)]
-pub(super) enum BlockSchur {
-    Columns(Schur),
-    Band(Band),
-}
-
-/// How many times the sparse factor's entries a band may hold and still be chosen.
-pub const BAND_WIDER: usize = 2;
-
-impl BlockSchur {
-    fn new(pattern: &crate::linalg::sparse::Pattern, n: usize, solver: LinearSolver) -> Self {
-        let columns = Schur::assembled_by_caller(pattern, n, solver);
-        let m = pattern.start.len() - 1;
-        if solver != LinearSolver::Auto || m == 0 {
-            return Self::Columns(columns);
-        }
-        let band = Band::new(m, products(pattern, n).into_iter().map(|(a, b, ..)| (a, b)));
-        if band.width() <= MAX_WIDTH && band.entries() <= BAND_WIDER * (columns.slots() - m) {
-            Self::Band(band)
-        } else {
-            Self::Columns(columns)
-        }
-    }
-
-    fn slot_finder(&self) -> Box<dyn Fn(usize, usize) -> usize + '_> {
-        match self {
-            Self::Columns(s) => Box::new(s.slot_finder()),
-            Self::Band(e) => Box::new(e.slot_finder()),
-        }
-    }
-
-    fn slots(&self) -> usize {
-        match self {
-            Self::Columns(s) => s.slots(),
-            Self::Band(e) => e.slots(),
-        }
-    }
-
-    fn factor_and_solve_assembled(&mut self, entries: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
-        match self {
-            Self::Columns(s) => s.factor_and_solve_assembled(entries, b),
-            Self::Band(e) => e.factor_and_solve_assembled(entries, b),
-        }
-    }
-
-    pub(super) fn solve(&self, b: &mut [f64]) {
-        match self {
-            Self::Columns(s) => s.solve(b),
-            Self::Band(e) => e.solve(b),
-        }
-    }
-
-    pub(super) fn solve_many(&self, bs: &mut [&mut [f64]]) {
-        match self {
-            Self::Columns(s) => s.solve_many(bs),
-            Self::Band(e) => e.solve_many(bs),
-        }
-    }
-
-    pub(super) fn set_dependent_rows(&mut self, dependent: DependentRows) {
-        match self {
-            Self::Columns(s) => s.set_dependent_rows(dependent),
-            Self::Band(e) => e.set_dependent_rows(dependent),
-        }
-    }
-
-    pub(super) fn dependent_rows(&self) -> usize {
-        match self {
-            Self::Columns(s) => s.dependent_rows(),
-            Self::Band(e) => e.dependent_rows(),
-        }
-    }
-
-    /// Whether `L` has fewer entries than the full triangle.
-    pub(super) fn is_sparse(&self) -> bool {
-        match self {
-            Self::Columns(s) => s.is_sparse(),
-            Self::Band(e) => {
-                let m = e.slots() - e.entries();
-                e.entries() < m * m.saturating_sub(1) / 2
-            }
-        }
-    }
-}
-
 /// The workspace of a configuration-dependent `M(q)`, allocated once.
 #[derive(Clone)]
 pub(super) struct General {
@@ -382,5 +291,44 @@ impl General {
                 *o += s * w;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::Dynamics;
+    use crate::linalg::DependentRows;
+
+    /// The band of `Auto` and the column kernel of `Sparse` on a moving
+    /// spatial chain: the same `λ`, `A` and solves, and the column kernel
+    /// again once dependent rows are tolerated.
+    #[test]
+    fn a_spatial_chain_is_factored_in_a_band_with_the_column_kernels_answers() {
+        let built = crate::spatial::chain(12, 0.3, 9.81).build().unwrap();
+        let (model, q) = (&built.model, &built.q0);
+        let v: Vec<f64> = (0..model.n()).map(|i| 0.4 * (0.7 * i as f64).sin()).collect();
+        let banded = |d: &Dynamics| matches!(&d.solver, Solver::Blocks(b) if b.schur.banded());
+        let (mut band, mut columns) =
+            (Dynamics::with_solver(model, LinearSolver::Auto), Dynamics::with_solver(model, LinearSolver::Sparse));
+        assert!(banded(&band) && !banded(&columns));
+        band.evaluate(model, q, &v, 0.0).unwrap();
+        columns.evaluate(model, q, &v, 0.0).unwrap();
+        let close = |a: &[f64], b: &[f64], what: &str| {
+            let scale = a.iter().fold(1.0_f64, |s, x| s.max(x.abs()));
+            let error = a.iter().zip(b).fold(0.0_f64, |e, (a, b)| e.max((a - b).abs()));
+            assert!(error <= 1e-12 * scale, "{what}: {error:e} of {scale:e}");
+        };
+        close(band.lambda(), columns.lambda(), "λ");
+        close(band.acc(), columns.acc(), "A");
+        let rhs: Vec<f64> = (0..model.m()).map(|i| (1.0 + i as f64).cos()).collect();
+        let (mut x, mut y) = (rhs.clone(), rhs.clone());
+        band.solve_many(&mut [&mut x]);
+        columns.solve_many(&mut [&mut y]);
+        close(&x, &y, "S⁻¹b");
+        band.set_dependent_rows(DependentRows::Tolerate);
+        assert!(!banded(&band));
+        band.set_dependent_rows(DependentRows::Error);
+        assert!(banded(&band));
     }
 }

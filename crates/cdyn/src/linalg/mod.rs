@@ -1,20 +1,22 @@
 //! Linear algebra: the mass matrix `M` and every product with it
 //! ([`mass`]), the `m × m` system `S = Φ_q M⁻¹ Φ_qᵀ` with its `L D Lᵀ`
 //! factorization (`schur`; its pivot test and the dense factorization in
-//! `ldl`; in a band, `band`), and the symbolic analysis of a sparse `S`
+//! `ldl`; in a band, `band`; the choice between them for an `S` its caller
+//! assembles, `assembled`), and the symbolic analysis of a sparse `S`
 //! (`sparse`, done once per model); the sparse LU of an implicit step's
 //! Newton matrix (`sparse_lu`).
 //!
 //! May import: `error`.
 
-pub(crate) mod band;
+mod assembled;
+mod band;
 mod ldl;
 pub mod mass;
 mod schur;
 pub(crate) mod sparse;
 pub(crate) mod sparse_lu;
 
-pub(crate) use band::Band;
+pub(crate) use assembled::AssembledSchur;
 pub use ldl::{Breakdown, DependentRows};
 pub(crate) use ldl::{DenseLdl, inverse_pivot};
 pub use schur::{LinearSolver, SPARSE_FROM};
