@@ -139,6 +139,21 @@ fn bricards_redundant_mechanism_moves_and_keeps_its_energy_without_control() {
 }
 
 #[test]
+fn bricards_projection_holds_the_energy_though_it_has_as_many_rows_as_coordinates() {
+    // 35 rows on 35 coordinates, one of them dependent: one degree of
+    // freedom, so the projection holds Ψ, to its tolerance 1e-10 of
+    // T + |V| (some tens of J). At h = 2e-2: 3.8e-9; 1.8e-7 when rows
+    // were counted with the dependent one (as a fully driven mechanism).
+    let text = example("bricard.toml").replace("h = 1e-3", "h = 2e-2").replace("t_end = 10.0", "t_end = 5.0");
+    let out = run("coarse", &text);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let case = &summary["cases"][0];
+    assert_eq!(case["dependent_rows"]["max"].as_u64(), Some(1), "{case}");
+    assert!(case["max_abs_psi"].as_f64().unwrap() < 1e-8, "{case}");
+}
+
+#[test]
 fn bricard_with_generalized_alpha_drops_its_redundant_row_and_converges_at_order_2() {
     // RK-4 at h = 1e-3 with projection is the reference (4e-12 from RK-4 at
     // 1e-4); the benchmark's high precision is 1e-3 on positions.

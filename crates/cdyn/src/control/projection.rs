@@ -180,10 +180,13 @@ pub(crate) fn invariants(
         let psi = kinetic + potential - e0_plus_e;
         // Ψ is a difference of energies: its round-off grows with them.
         let psi_tol = tol * (kinetic + potential.abs()).max(1.0);
-        // With as many constraint rows as coordinates no motion is free (a
-        // fully driven mechanism): T and V are fixed by the constraints, and
-        // Ψ measures only the quadrature of Ė, which no projection can change.
-        if !settings.energy || psi.abs() <= psi_tol || model.m() == model.n() {
+        // With as many independent constraint rows as coordinates no motion
+        // is free (a fully driven mechanism): T and V are fixed by the
+        // constraints, and Ψ measures only the quadrature of Ė, which no
+        // projection can change. Rows dropped as dependent do not count: the
+        // Bricard mechanism has as many rows as coordinates and one degree
+        // of freedom.
+        if !settings.energy || psi.abs() <= psi_tol || model.m() - d.dependent_rows() >= model.n() {
             return Ok(iterations);
         }
         if energy_steps == settings.max_iterations {
