@@ -128,7 +128,7 @@ impl Dynamics {
         match &mut self.solver {
             Solver::Constant(schur) => schur.set_dependent_rows(dependent),
             Solver::General(g) => g.schur.set_dependent_rows(dependent),
-            Solver::Blocks(b) => b.schur.set_dependent_rows(dependent),
+            Solver::Blocks(b) => b.set_dependent_rows(dependent),
         }
     }
 

@@ -13,15 +13,17 @@ use super::sparse::Pattern;
 /// How `S` of a block mass is factored: in a [`Band`] where `Auto` finds
 /// one at most [`MAX_WIDTH`] wide and with at most [`BAND_WIDER`] times
 /// the entries of the sparse factor (chains, arms: every entry costs less
-/// there), else by the column kernel of [`Schur`]. Both are kept: `S` is
-/// assembled in the column kernel's slots (and one zero after them), which
-/// the band reads through `map`, and with dependent rows tolerated the
-/// column kernel factors, so that the same rows are dropped as without a
-/// band (its order is another: the Bricard mechanism then dropped a row
-/// whose loss made the projection's position step move `Ψ` by 5e-6).
+/// there), else by the column kernel of [`Schur`]. With dependent rows
+/// tolerated the column kernel factors, so that the same rows are dropped
+/// as without a band (the band's order is another: the Bricard mechanism
+/// then dropped a row whose loss made the projection's position step move
+/// `Ψ` by 5e-6). Both are kept; `S` is assembled in the slots of the one
+/// that factors, and [`set_dependent_rows`](Self::set_dependent_rows)
+/// says how to move the assembly's slots when that changes.
 #[derive(Clone)]
 pub(crate) struct AssembledSchur {
     columns: Schur,
+    /// The band, and the band's slot of each of the column kernel's.
     band: Option<(Band, Vec<u32>)>,
     /// Whether the band factors (it exists and no dependent row is tolerated).
     banded: bool,
@@ -39,19 +41,15 @@ impl AssembledSchur {
             .then(|| Band::new(m, pairs()))
             .filter(|band| band.width() <= MAX_WIDTH && band.entries() <= BAND_WIDER * (columns.slots() - m));
         let band = band.map(|band| {
-            // Every band slot reads the column kernel's slot of its entry,
-            // or the zero after them.
-            let zero = columns.slots() as u32;
-            let mut map = vec![zero; band.slots()];
+            // Every entry of `S` the caller assembles, in both layouts; the
+            // column kernel's fill is never assembled.
+            let mut to_band = vec![0; columns.slots()];
             let (to, from) = (band.slot_finder(), columns.slot_finder());
-            for r in 0..m {
-                map[to(r, r)] = from(r, r) as u32;
-            }
-            for (a, b) in pairs().filter(|(a, b)| a != b) {
-                map[to(a, b)] = from(a, b) as u32;
+            for (a, b) in (0..m).map(|r| (r, r)).chain(pairs()) {
+                to_band[from(a, b)] = to(a, b) as u32;
             }
             drop((to, from));
-            (band, map)
+            (band, to_band)
         });
         Self { banded: band.is_some(), columns, band }
     }
@@ -62,19 +60,26 @@ impl AssembledSchur {
         self.banded
     }
 
-    /// `S`'s entries by slot, and one zero after them.
+    /// Entries of `S` the factorization reads, by slot.
     pub(crate) fn slots(&self) -> usize {
-        self.columns.slots() + 1
+        match &self.band {
+            Some((band, _)) if self.banded => band.slots(),
+            _ => self.columns.slots(),
+        }
     }
 
-    pub(crate) fn slot_finder(&self) -> impl Fn(usize, usize) -> usize + '_ {
-        self.columns.slot_finder()
+    /// The slot of `S`'s entry `(a, b)` (original rows).
+    pub(crate) fn slot_finder(&self) -> Box<dyn Fn(usize, usize) -> usize + '_> {
+        match &self.band {
+            Some((band, _)) if self.banded => Box::new(band.slot_finder()),
+            _ => Box::new(self.columns.slot_finder()),
+        }
     }
 
     pub(crate) fn factor_and_solve_assembled(&mut self, entries: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
         match &mut self.band {
-            Some((band, map)) if self.banded => band.factor_and_solve_mapped(entries, map, b),
-            _ => self.columns.factor_and_solve_assembled(&entries[..self.columns.slots()], b),
+            Some((band, _)) if self.banded => band.factor_and_solve_assembled(entries, b),
+            _ => self.columns.factor_and_solve_assembled(entries, b),
         }
     }
 
@@ -89,12 +94,27 @@ impl AssembledSchur {
         }
     }
 
-    pub(crate) fn set_dependent_rows(&mut self, dependent: DependentRows) {
+    /// Sets what a dependent row does in the next factorizations. Where
+    /// that changes which kernel factors, returns the new slot of each old
+    /// one the caller assembles (others map to 0), to be applied before the
+    /// next factorization, with [`slots`](Self::slots) entries from then on.
+    #[must_use]
+    pub(crate) fn set_dependent_rows(&mut self, dependent: DependentRows) -> Option<Vec<u32>> {
         self.columns.set_dependent_rows(dependent);
-        if let Some((band, _)) = &mut self.band {
-            band.set_dependent_rows(dependent);
+        let Some((band, to_band)) = &mut self.band else { return None };
+        band.set_dependent_rows(dependent);
+        let banded = dependent == DependentRows::Error;
+        if banded == self.banded {
+            return None;
         }
-        self.banded = self.band.is_some() && dependent == DependentRows::Error;
+        self.banded = banded;
+        Some(if banded {
+            to_band.clone()
+        } else {
+            let mut to_columns = vec![0; band.slots()];
+            to_band.iter().enumerate().for_each(|(column, &slot)| to_columns[slot as usize] = column as u32);
+            to_columns
+        })
     }
 
     pub(crate) fn dependent_rows(&self) -> usize {

@@ -114,26 +114,19 @@ impl Band {
         self.dropped
     }
 
-    /// Factors `S` and solves `S x = b` in place, `S` laid out by another
-    /// factorization's slots: the entry of the band's `slot`
-    /// ([`slot_finder`](Self::slot_finder)) is `s[map[slot]]`.
-    pub fn factor_and_solve_mapped(&mut self, s: &[f64], map: &[u32], b: &mut [f64]) -> Result<(), Breakdown> {
-        assert!(map.len() == self.slots() && b.len() == self.m, "map or right-hand side of the wrong length");
+    /// Factors `S`, given by slot ([`slot_finder`](Self::slot_finder)), and
+    /// solves `S x = b` in place.
+    pub fn factor_and_solve_assembled(&mut self, s: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
+        assert!(s.len() == self.slots() && b.len() == self.m, "entries or right-hand side of the wrong length");
         crate::with_const!(self.width, W, [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16], {
-            self.factor::<W>(|slot| s[map[slot] as usize], s, b)
+            self.factor::<W>(s, b)
         })
     }
 
     /// Row by row (up-looking): row `i`'s `L D` entries are `S`'s less
     /// their dot products with the finished rows; the forward substitution
     /// joins it.
-    #[inline(always)]
-    fn factor<const W: usize>(
-        &mut self,
-        entry: impl Fn(usize) -> f64,
-        s: &[f64],
-        b: &mut [f64],
-    ) -> Result<(), Breakdown> {
+    fn factor<const W: usize>(&mut self, s: &[f64], b: &mut [f64]) -> Result<(), Breakdown> {
         let m = self.m;
         let (dependent, tolerance) = (self.dependent, self.tolerance);
         let mut count = 0;
@@ -142,7 +135,8 @@ impl Band {
         // solve may have reached them.
         self.work[..W].fill(0.0);
         let rows = self.lower.as_chunks_mut::<W>().0;
-        for i in 0..m {
+        let (s_diagonal, s_rows) = s.split_at(m);
+        for (i, s_row) in s_rows.as_chunks::<W>().0.iter().enumerate() {
             // Row `i` is `rows[i + W]`; column `i − W + t`'s row is `rows[i + t]`.
             let (before, row) = rows[i..].split_at_mut(W);
             let mut u = [0.0; W];
@@ -151,11 +145,11 @@ impl Band {
                 for k in 0..t {
                     sum += u[k] * before[t][k + W - t];
                 }
-                u[t] = entry(m + i * W + t) - sum;
+                u[t] = s_row[t] - sum;
             }
             // `u` holds `(L D)_ij`; `L_ij` and the pivot from it.
             let inv_before: &[f64; W] = self.inv_d[i..i + W].try_into().expect("W entries");
-            let s_ii = entry(i);
+            let s_ii = s_diagonal[i];
             let mut d = s_ii;
             for t in 0..W {
                 let l = u[t] * inv_before[t];
@@ -322,11 +316,6 @@ mod tests {
         Case { j, s, band, slots }
     }
 
-    /// Each slot read from its own place.
-    fn identity(band: &Band) -> Vec<u32> {
-        (0..band.slots() as u32).collect()
-    }
-
     /// A chain of bodies of 7 coordinates (a position and Euler
     /// parameters): a joint's three rows on a body and the next, and each
     /// body's normalization row on its last four, numbered joints first.
@@ -385,12 +374,11 @@ mod tests {
             [("spatial chain", spatial_chain(12)), ("scrambled chain", scrambled_chain(30)), ("star", star(4, 5))]
         {
             let Case { s, mut band, slots, .. } = case(&rows, n, 0.4, &[]);
-            let identity = identity(&band);
             let m = rows.len();
             let b: Vec<f64> = (0..m).map(|i| (2.0 + 0.9 * i as f64).cos()).collect();
             let expected = dense_solve(&s, &b);
             let mut x = b.clone();
-            band.factor_and_solve_mapped(&slots, &identity, &mut x).unwrap();
+            band.factor_and_solve_assembled(&slots, &mut x).unwrap();
             let scale = expected.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
             let error = x.iter().zip(&expected).fold(0.0_f64, |a, (x, e)| a.max((x - e).abs())) / scale;
             assert!(error < 1e-12, "{name}: relative error {error:e}");
@@ -412,9 +400,8 @@ mod tests {
         rows.push(rows[1].clone());
         let copy = rows.len() - 1;
         let Case { j, s, mut band, mut slots } = case(&rows, n, 0.4, &[(copy, 1)]);
-        let identity = identity(&band);
         assert!(matches!(
-            band.factor_and_solve_mapped(&slots, &identity, &mut vec![1.0; rows.len()]),
+            band.factor_and_solve_assembled(&slots, &mut vec![1.0; rows.len()]),
             Err(Breakdown::Singular(_))
         ));
         band.set_dependent_rows(DependentRows::Tolerate);
@@ -423,7 +410,7 @@ mod tests {
         let y: Vec<f64> = (0..rows.len()).map(|i| (1.0 + i as f64).sin()).collect();
         let b: Vec<f64> = s.iter().map(|row| row.iter().zip(&y).map(|(s, y)| s * y).sum()).collect();
         let mut x = b.clone();
-        band.factor_and_solve_mapped(&slots, &identity, &mut x).unwrap();
+        band.factor_and_solve_assembled(&slots, &mut x).unwrap();
         assert_eq!(band.dependent_rows(), 1);
         assert!(x[1] == 0.0 || x[copy] == 0.0, "the dropped row's multiplier is 0: {} {}", x[1], x[copy]);
         let force = |x: &[f64]| (0..n).map(|c| (0..x.len()).map(|r| j[r][c] * x[r]).sum::<f64>()).collect::<Vec<_>>();
@@ -434,13 +421,10 @@ mod tests {
         // nor a non-finite right-hand side spoils the next solve.
         let good = slots.clone();
         slots[0] = f64::NAN;
-        assert_eq!(
-            band.factor_and_solve_mapped(&slots, &identity, &mut vec![1.0; rows.len()]),
-            Err(Breakdown::NonFinite)
-        );
-        band.factor_and_solve_mapped(&good, &identity, &mut vec![f64::NAN; rows.len()]).unwrap();
+        assert_eq!(band.factor_and_solve_assembled(&slots, &mut vec![1.0; rows.len()]), Err(Breakdown::NonFinite));
+        band.factor_and_solve_assembled(&good, &mut vec![f64::NAN; rows.len()]).unwrap();
         let mut again = b.clone();
-        band.factor_and_solve_mapped(&good, &identity, &mut again).unwrap();
+        band.factor_and_solve_assembled(&good, &mut again).unwrap();
         assert_eq!(again, x);
     }
 }
