@@ -19,6 +19,7 @@
 //! May import: `linalg`'s other files.
 
 use super::ldl::{Breakdown, DependentRows, inverse_pivot};
+use super::schur::MAX_RIGHT_HAND_SIDES;
 
 /// The widest band compiled.
 pub(crate) const MAX_WIDTH: usize = 16;
@@ -177,32 +178,78 @@ impl Band {
         Ok(())
     }
 
-    /// Solves `S x = b` in place for each vector, with the last factorization.
+    /// Solves `S x = b` in place for up to [`MAX_RIGHT_HAND_SIDES`] vectors
+    /// in one pass over `L`, with the last factorization (each vector sees
+    /// exactly the operations of a lone solve).
     pub fn solve_many(&self, bs: &mut [&mut [f64]]) {
         assert!(bs.iter().all(|b| b.len() == self.m), "right-hand side of the wrong length");
         crate::with_const!(self.width, W, [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16], {
-            bs.iter_mut().for_each(|b| self.solve_one::<W>(b))
+            match bs {
+                [] => {}
+                [a] => self.solve::<W, 1>([&mut **a]),
+                [a, b] => self.solve::<W, 2>([&mut **a, &mut **b]),
+                [a, b, c] => self.solve::<W, 3>([&mut **a, &mut **b, &mut **c]),
+                [a, b, c, d] => self.solve::<W, 4>([&mut **a, &mut **b, &mut **c, &mut **d]),
+                _ => panic!("at most {MAX_RIGHT_HAND_SIDES} right-hand sides"),
+            }
         })
     }
 
-    /// `L⁻¹`, `D⁻¹`, then `L⁻ᵀ` on `b`, in place by original rows. The
-    /// first `W` rows reach back to the zeros before the first column,
-    /// which `b` does not hold: their loops start later.
-    fn solve_one<const W: usize>(&self, b: &mut [f64]) {
-        let rows = self.lower.as_chunks::<W>().0;
-        let order = &self.order;
-        for i in 0..self.m {
-            let (l, from) = (&rows[i + W], W.saturating_sub(i));
-            let sum: f64 = (from..W).map(|t| l[t] * b[order[i + t - W] as usize]).sum();
-            b[order[i] as usize] -= sum;
-        }
-        for i in 0..self.m {
-            b[order[i] as usize] *= self.inv_d[i + W];
-        }
-        for i in (0..self.m).rev() {
-            let (l, from) = (&rows[i + W], W.saturating_sub(i));
-            let x = b[order[i] as usize];
-            (from..W).for_each(|t| b[order[i + t - W] as usize] -= l[t] * x);
+    /// `L⁻¹`, `D⁻¹`, then `L⁻ᵀ` on `K` vectors of length `m` at once, in
+    /// place by original rows. The first `W` rows reach back to the zeros
+    /// before the first column, which the vectors do not hold: their loops
+    /// start later.
+    fn solve<const W: usize, const K: usize>(&self, bs: [&mut [f64]; K]) {
+        let (m, rows, order) = (self.m, self.lower.as_chunks::<W>().0, &self.order);
+        assert!(bs.iter().all(|b| b.len() == m) && rows.len() == m + W && order.len() == m);
+        let b = bs.map(|b| b.as_mut_ptr());
+        // SAFETY: `order` holds rows < m (a permutation, made in `new`), the
+        // vectors have m values and are distinct borrows, and `rows` has
+        // `m + W` rows, as asserted. Unchecked: the loops are a few entries
+        // long, and their checks cost as much.
+        unsafe {
+            let at = |i: usize| *order.get_unchecked(i) as usize;
+            for i in 0..m {
+                let l = rows.get_unchecked(i + W);
+                let mut sum = [0.0; K];
+                let mut add = |t: usize| {
+                    let r = at(i + t - W);
+                    for k in 0..K {
+                        sum[k] += l[t] * *b[k].add(r);
+                    }
+                };
+                // Whole rows apart, so that their loop is unrolled.
+                if i >= W {
+                    (0..W).for_each(&mut add);
+                } else {
+                    (W - i..W).for_each(&mut add);
+                }
+                let r = at(i);
+                for k in 0..K {
+                    *b[k].add(r) -= sum[k];
+                }
+            }
+            for i in 0..m {
+                let (r, inv) = (at(i), *self.inv_d.get_unchecked(i + W));
+                for k in 0..K {
+                    *b[k].add(r) *= inv;
+                }
+            }
+            for i in (0..m).rev() {
+                let (l, r) = (rows.get_unchecked(i + W), at(i));
+                let x: [f64; K] = std::array::from_fn(|k| *b[k].add(r));
+                let subtract = |t: usize| {
+                    let r = at(i + t - W);
+                    for k in 0..K {
+                        *b[k].add(r) -= l[t] * x[k];
+                    }
+                };
+                if i >= W {
+                    (0..W).for_each(subtract);
+                } else {
+                    (W - i..W).for_each(subtract);
+                }
+            }
         }
     }
 }
