@@ -9,7 +9,7 @@
 //! an index read, a scattered update and a short loop's control on each of
 //! a few entries a row, more than the arithmetic of the band's zeros; a
 //! chain of spatial bodies (a joint's three rows and a normalization row
-//! each) has a band of 7. Wider patterns (nets) keep the column kernel:
+//! each) has a band of 6. Wider patterns (nets) keep the column kernel:
 //! the caller chooses by [`Band::width`] and [`Band::entries`].
 //!
 //! Same pivot test and handling of dependent rows as the other kernels
