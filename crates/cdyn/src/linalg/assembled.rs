@@ -29,7 +29,9 @@ pub(crate) struct AssembledSchur {
     banded: bool,
 }
 
-/// How many times the sparse factor's entries a band may hold and still be chosen.
+/// How many times the sparse factor's entries a band may hold and still be
+/// chosen. Panda's tree has a band of 16 with 2.1 times: there the band
+/// took 176.8 k instructions an AB-3 step against the column kernel's 140.1 k.
 const BAND_WIDER: usize = 2;
 
 impl AssembledSchur {
