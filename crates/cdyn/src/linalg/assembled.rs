@@ -7,7 +7,7 @@
 
 use super::band::{Band, MAX_WIDTH};
 use super::ldl::{Breakdown, DependentRows};
-use super::schur::{LinearSolver, Schur, products};
+use super::schur::{LinearSolver, Schur, below_triangle, products};
 use super::sparse::Pattern;
 
 /// How `S` of a block mass is factored: in a [`Band`] where `Auto` finds
@@ -129,10 +129,7 @@ impl AssembledSchur {
     /// Whether `L` has fewer entries than the full triangle.
     pub(crate) fn is_sparse(&self) -> bool {
         match &self.band {
-            Some((band, _)) if self.banded => {
-                let m = band.slots() - band.entries();
-                band.entries() < m * m.saturating_sub(1) / 2
-            }
+            Some((band, _)) if self.banded => below_triangle(band.entries(), band.slots() - band.entries()),
             _ => self.columns.is_sparse(),
         }
     }

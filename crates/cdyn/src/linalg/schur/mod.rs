@@ -329,7 +329,7 @@ impl Schur {
 
 /// Whether `entries` strictly-lower entries of `L` are fewer than the full
 /// triangle of `m` rows has.
-fn below_triangle(entries: usize, m: usize) -> bool {
+pub(crate) fn below_triangle(entries: usize, m: usize) -> bool {
     entries < m * m.saturating_sub(1) / 2
 }
 
