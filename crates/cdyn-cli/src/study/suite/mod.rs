@@ -123,6 +123,8 @@ pub struct Run {
     /// Whether its automatic energy term was left out, the damping being
     /// stiff against the step (`cdyn::control::gains::STIFF_DISSIPATION_H`).
     pub energy_left_out: bool,
+    /// The most constraint rows one evaluation dropped as dependent.
+    pub dependent_rows: usize,
     /// Mean Newton iterations per step of its projection, if it projects.
     #[serde(serialize_with = "cdyn::json_float::serialize")]
     pub projection_iterations_per_step: Option<f64>,
@@ -170,7 +172,7 @@ pub struct Group {
     pub reference_h: f64,
     /// The method without control the others are compared with (`none` or `theta`).
     pub baseline: String,
-    /// Fewer constraint rows than coordinates. Without free motion (a fully
+    /// Fewer independent constraint rows than coordinates. Without free motion (a fully
     /// driven mechanism) `T` and `V` follow from the drives, `Ψ` is only the
     /// quadrature error of `∫Ė`, and no method can change it: check (d)
     /// then compares `Φ` alone.
@@ -265,7 +267,6 @@ fn run_model(model: &Model) -> Result<(Vec<Group>, f64)> {
     let mut groups = Vec::new();
     for (scheme, h, cases) in &model.setups {
         let every = (model.h / h).round() as u64;
-        let free_motion = cases[0].example.model.m() < cases[0].example.model.n();
         let mut runs: Vec<Run> = cases.iter().map(|c| run_case(c, &reference, every)).collect();
         let of = |pick: &dyn Fn(&Case) -> bool, what: &str| {
             cases.iter().position(pick).ok_or_else(|| anyhow!("{file}: no {what} case"))
@@ -274,6 +275,9 @@ fn run_model(model: &Model) -> Result<(Vec<Group>, f64)> {
         // RATTLE and generalized-α take no right-hand-side control: no robust.
         let robust = if scheme.steps_model() { None } else { Some(of(&|c| c.name == "robust", "robust")?) };
         let projection = of(&|c| c.name == "projection", "projection")?;
+        // Rows dropped as dependent constrain nothing (Bricard's mechanism).
+        let mechanism = &cases[0].example.model;
+        let free_motion = mechanism.m() - runs[none].dependent_rows < mechanism.n();
         let (e_none, e_projection) = (runs[none].max_error, runs[projection].max_error);
         for r in &mut runs {
             r.error_vs_none = r.max_error / e_none;
@@ -337,6 +341,7 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
         steps: 0,
         rate_h: None,
         energy_left_out: false,
+        dependent_rows: 0,
         projection_iterations_per_step: None,
         projection_tolerance: projection.map(|p| p.tolerance),
         linear_momentum_drift: None,
@@ -385,6 +390,7 @@ fn run_case(case: &Case, reference: &[Vec<f64>], every: u64) -> Run {
     };
     (run.linear_momentum_drift, run.momentum_drift) = (largest(true), largest(false));
     run.steps = sim.steps();
+    run.dependent_rows = sim.rank_loss().map_or(0, |r| r.max);
     if run.error.is_none() {
         run.max_error = error;
     }
