@@ -4,6 +4,7 @@
 use crate::control::projection::Failure;
 use crate::dynamics::momentum;
 use crate::error::{Part, Problem, Result};
+use crate::linalg::LinearSolver;
 use crate::model::Model;
 use crate::simulate::settings::Settings;
 use crate::simulate::stepper::Stepper;
@@ -43,6 +44,9 @@ impl<'m> Simulation<'m> {
         let mut system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
         system.set_dependent_rows(settings.dependent_rows);
         system.set_symmetries(momentum::detect(model, q0, v0));
+        if settings.solver == LinearSolver::Auto {
+            system.allow_arrays();
+        }
         Self::start(system, settings, q0, v0)
     }
 

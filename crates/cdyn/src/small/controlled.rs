@@ -1,11 +1,10 @@
 //! A small system with a control law: its state in a fixed-size array,
 //! the right-hand side the integrator steps, and the simulation of it.
 
-use super::dynamics::SmallDynamics;
 use super::{SmallSystem, Whole};
+use crate::control::Control;
 use crate::control::gains::Operators;
 use crate::control::projection::{Failure, Projection};
-use crate::control::{Control, Workspace};
 use crate::dynamics::diagnostics::Measures;
 use crate::dynamics::energy;
 use crate::error::{Error, Result};
@@ -14,7 +13,7 @@ use crate::linalg::mass::{DiagonalMass, MassMatrix};
 use crate::model::check_rows;
 use crate::model::constraint::local;
 use crate::model::force::{Force, Potential, energy_and_gradient};
-use crate::simulate::system::{EvalError, System};
+use crate::simulate::system::{ArrayDynamics, ArrayWork, EvalError, System};
 use crate::simulate::{Settings, Stepper, check_initial_state};
 use num_dual::Dual64;
 use std::sync::Arc;
@@ -42,9 +41,8 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> SmallSimulation<S, N,
             control: settings.control,
             e0,
             evaluations: 0,
-            d: SmallDynamics::new(mass, settings.dependent_rows),
-            rows: [[0.0; M]; 5],
-            w: [0.0; N],
+            d: ArrayDynamics::new(mass, settings.dependent_rows),
+            work: ArrayWork::default(),
         };
         Self::start(controlled, settings, &q0, &v0)
     }
@@ -86,10 +84,8 @@ pub struct SmallControlled<S, const N: usize, const M: usize> {
     control: Control,
     e0: f64,
     evaluations: u64,
-    d: SmallDynamics<N, M>,
-    /// Work space of the control laws, kept so no evaluation initializes it.
-    rows: [[f64; M]; 5],
-    w: [f64; N],
+    d: ArrayDynamics<N, M>,
+    work: ArrayWork<N, M>,
 }
 
 impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControlled<S, N, M> {
@@ -105,25 +101,10 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> Rhs for SmallControll
 
     #[inline(always)]
     fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
-        let (q, v, e) = split(x);
         self.evaluations += 1;
-        let d = &mut self.d;
-        d.evaluate(&self.system, q, v, t).map_err(|b| EvalError::at(b, t))?;
-        let e_dot = energy::power(d.force_power, &d.lambda, &d.phi_t);
-        f[..N].copy_from_slice(&v);
-        f[N..2 * N].copy_from_slice(&d.acc);
-        f[2 * N] = e_dot;
-        if let Some(u) = u {
-            let kinetic = d.mass.kinetic(&v);
-            let psi = energy::psi_from(kinetic, d.potential, e, self.e0);
-            let (u_q, rest) = u.split_at_mut(N);
-            let (u_v, u_e) = rest.split_at_mut(N);
-            u_e[0] = 0.0;
-            let [r0, r1, r2, r3, r4] = &mut self.rows;
-            let work = Workspace { rows: [r0, r1, r2, r3, r4], w: &mut self.w, held: None };
-            self.control.terms(&*d, &v, [psi, kinetic, e_dot], u_q, u_v, work);
-        }
-        Ok(())
+        let system = &self.system;
+        self.d
+            .controlled_rhs(&self.control, self.e0, &mut self.work, (x, t), f, u, |d, q, v| d.evaluate(system, q, v, t))
     }
 }
 
@@ -152,7 +133,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         let l = local(&self.system, q, v, [0.0; N], t);
         let (potential, grad) = energy_and_gradient(&self.system, q);
         let psi = energy::psi(&self.d.mass, &v, potential, e, self.e0);
-        let columns = &SmallDynamics::<N, M>::COLUMNS;
+        let columns = &ArrayDynamics::<N, M>::COLUMNS;
         Measures::of(psi, &grad, &l.phi, &l.phi_dot, |r| (l.jac[r].as_slice(), columns.as_slice()))
     }
     fn operators(&mut self, x: &[f64], t: f64) -> Result<Operators, EvalError> {

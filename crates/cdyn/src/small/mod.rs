@@ -13,8 +13,8 @@
 //!
 //! - here: [`SmallSystem`], the system as the user writes it, and
 //!   [`to_model`];
-//! - `dynamics`: one evaluation of its dynamics in arrays, as the control
-//!   laws read it;
+//! - `dynamics`: its evaluation of the dynamics in arrays (`ArrayDynamics`,
+//!   which a general model of a few coordinates is also stepped through);
 //! - `controlled`: the system with a control law, stepped as a
 //!   [`SmallSimulation`].
 //!

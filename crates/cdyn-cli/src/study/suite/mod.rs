@@ -275,7 +275,6 @@ fn run_model(model: &Model) -> Result<(Vec<Group>, f64)> {
         // RATTLE and generalized-α take no right-hand-side control: no robust.
         let robust = if scheme.steps_model() { None } else { Some(of(&|c| c.name == "robust", "robust")?) };
         let projection = of(&|c| c.name == "projection", "projection")?;
-        // Rows dropped as dependent constrain nothing (Bricard's mechanism).
         let mechanism = &cases[0].example.model;
         let free_motion = mechanism.m() - runs[none].dependent_rows < mechanism.n();
         let (e_none, e_projection) = (runs[none].max_error, runs[projection].max_error);

@@ -2,6 +2,7 @@
 //! steps, and the steps of RATTLE and generalized-α on its model.
 
 use super::evaluated::Evaluated;
+use super::in_arrays::{InArrays, in_arrays};
 use super::{AlphaFailure, EvalError, RattleFailure, System, split_state, split_state_mut};
 use crate::control::evaluation::Evaluation;
 use crate::control::gains::Operators;
@@ -53,6 +54,9 @@ pub struct ControlledSystem<'m> {
     rattle: rattle::Work,
     /// Generalized-α's state and buffers, made before its first step.
     alpha: Option<generalized_alpha::Work>,
+    /// Whether it may be evaluated in arrays ([`Self::allow_arrays`]), and that evaluation.
+    arrays_allowed: bool,
+    arrays: Option<Box<dyn InArrays>>,
 }
 
 impl<'m> ControlledSystem<'m> {
@@ -84,7 +88,20 @@ impl<'m> ControlledSystem<'m> {
             turned: vec![0.0; model.n()],
             rattle: rattle::Work::new(model),
             alpha: None,
+            arrays_allowed: false,
+            arrays: None,
         }
+    }
+
+    /// Lets a small model run in arrays ([`in_arrays`]); [`Self::dynamics`] then hold its last general evaluation.
+    pub(crate) fn allow_arrays(&mut self) {
+        self.arrays_allowed = true;
+        self.choose_arrays();
+    }
+
+    fn choose_arrays(&mut self) {
+        let (model, control, symmetries, rows) = (self.model, &self.control, &self.symmetries, self.dependent_rows);
+        self.arrays = self.arrays_allowed.then(|| in_arrays(model, control, symmetries, rows)).flatten();
     }
 
     /// The momenta the model keeps; the control's corrections are made
@@ -102,12 +119,14 @@ impl<'m> ControlledSystem<'m> {
         let (kinds, targets) = held.filter(|_| self.control.invariants == crate::control::Invariants::Keep).unzip();
         self.held = Held::new(kinds, targets, self.model.n(), self.model.m());
         self.symmetries = symmetries;
+        self.choose_arrays();
     }
 
     /// Sets what a dependent constraint row does (default: an error).
     pub fn set_dependent_rows(&mut self, dependent: DependentRows) {
         self.dynamics.set_dependent_rows(dependent);
         self.dependent_rows = dependent;
+        self.choose_arrays();
     }
 
     /// Counts `n` evaluations made before it (by the run it continues).
@@ -168,8 +187,11 @@ impl Rhs for ControlledSystem<'_> {
 
     fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
         let n = self.model.n();
-        let (q, v, e) = split_state(x, n);
         self.evaluations += 1;
+        if let Some(arrays) = &mut self.arrays {
+            return arrays.eval(self.model, &self.control, self.e0, x, t, f, u);
+        }
+        let (q, v, e) = split_state(x, n);
         // The projected energy law (robust's) takes its products with
         // M⁻¹Φ_qᵀ in a pass over the Jacobian, which also subtracts A's
         // constraint forces (one pass fewer); no law of that kind reads A.
@@ -250,10 +272,11 @@ impl System for ControlledSystem<'_> {
         self.evaluations
     }
     fn take_dependent_rows(&mut self) -> usize {
-        std::mem::take(&mut self.dependent)
+        std::mem::take(&mut self.dependent).max(self.arrays.as_mut().map_or(0, |a| a.take_dropped()))
     }
     fn last_violation(&self) -> f64 {
-        self.dynamics.phi().iter().fold(0.0_f64, |a, p| a.max(p.abs()))
+        let general = || self.dynamics.phi().iter().fold(0.0_f64, |a, p| a.max(p.abs()));
+        self.arrays.as_ref().map_or_else(general, |a| a.last_violation())
     }
     fn measure(&mut self, x: &[f64], t: f64) -> Measures {
         let (q, v, e) = split_state(x, self.model.n());
@@ -298,6 +321,7 @@ impl System for ControlledSystem<'_> {
         self.dynamics.reuse_factorization(control.projection.is_some());
         self.dynamics.keep_potential_rate(self.model, control.reads_potential_rate());
         self.control = control;
+        self.choose_arrays();
     }
     fn symmetries(&self) -> &Symmetries {
         &self.symmetries
@@ -330,8 +354,7 @@ impl System for ControlledSystem<'_> {
         self.alpha = Some(work);
     }
     fn generalized_alpha(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<StepReport, AlphaFailure> {
-        let n = self.model.n();
-        let (q, v, e) = split_state_mut(x, n);
+        let (q, v, e) = split_state_mut(x, self.model.n());
         let work = self.alpha.as_mut().expect("prepare_generalized_alpha before the first step");
         let d = &mut self.dynamics;
         let taken = generalized_alpha::step(self.model, d, q, v, e, t, h, work, &mut self.evaluations);
@@ -345,8 +368,7 @@ impl System for ControlledSystem<'_> {
         })
     }
     fn rattle(&mut self, x: &mut [f64], t: f64, h: f64) -> Result<u32, RattleFailure> {
-        let n = self.model.n();
-        let (q, v, e) = split_state_mut(x, n);
+        let (q, v, e) = split_state_mut(x, self.model.n());
         let work = &mut self.rattle;
         let taken = rattle::step(self.model, &mut self.dynamics, q, v, e, t, h, work, &mut self.evaluations);
         self.dependent = self.dependent.max(self.dynamics.dependent_rows());
@@ -367,8 +389,7 @@ impl System for ControlledSystem<'_> {
     }
     fn project(&mut self, x: &mut [f64], t: f64, h: f64, settings: &Projection) -> Result<u32, Failure> {
         self.rattle.forget();
-        let n = self.model.n();
-        let (q, v, e) = split_state_mut(x, n);
+        let (q, v, e) = split_state_mut(x, self.model.n());
         let target = self.e0 + *e;
         let (model, d) = (self.model, &mut self.dynamics);
         let (momenta, held) = (&mut self.momenta, &mut self.held);

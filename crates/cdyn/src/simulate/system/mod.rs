@@ -4,15 +4,20 @@
 //! Here the interface a [`Stepper`](crate::simulate::Stepper) steps — the
 //! [`System`] trait, its evaluation errors and the failures of the schemes
 //! that step a model — and the state's layout; `controlled` is the
-//! [`ControlledSystem`] of a general [`Model`](crate::model::Model), and
-//! `evaluated` what the control laws read of its evaluations.
+//! [`ControlledSystem`] of a general [`Model`](crate::model::Model),
+//! `evaluated` what the control laws read of its evaluations, `arrays` an
+//! evaluation in fixed-size arrays and `in_arrays` a small model stepped
+//! through it.
 //!
 //! May import: `control`, `dynamics`, `integrate`, `linalg`, `model` (and
 //! `rattle`, `generalized_alpha` beside it).
 
+mod arrays;
 mod controlled;
 mod evaluated;
+mod in_arrays;
 
+pub(crate) use arrays::{ArrayDynamics, ArrayWork};
 pub use controlled::ControlledSystem;
 
 use crate::control::Control;
