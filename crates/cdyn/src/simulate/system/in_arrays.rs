@@ -8,7 +8,7 @@
 
 use super::EvalError;
 use super::arrays::{ArrayDynamics, ArrayWork};
-use crate::control::{Control, Energy, Invariants};
+use crate::control::{Control, Invariants};
 use crate::dynamics::momentum::Symmetries;
 use crate::linalg::DependentRows;
 use crate::linalg::mass::DiagonalMass;
@@ -79,8 +79,8 @@ impl<const N: usize, const M: usize> InArrays for ModelInArrays<N, M> {
 /// The model evaluated in arrays, where it can be: a constant diagonal
 /// mass, between 2 and 4 coordinates and at least one row (at most three),
 /// no unit vectors, and a control whose terms read only what the arrays
-/// hold — no projection (it reuses the general factorization), no law that
-/// holds the momenta or invariants in `symmetries`.
+/// hold: no projection (it reuses the general factorization), no momentum
+/// or invariant of `symmetries` kept (the laws hold them on the general path).
 pub(super) fn in_arrays(
     model: &Model,
     control: &Control,
@@ -89,10 +89,7 @@ pub(super) fn in_arrays(
 ) -> Option<Box<dyn InArrays>> {
     let mass = model.mass()?;
     let keeps_momenta = control.invariants == Invariants::Keep && !symmetries.kept.is_empty();
-    let reads_more = control.projection.is_some()
-        || matches!(control.energy, Energy::Projected { .. })
-        || control.holds_invariants()
-        || keeps_momenta;
+    let reads_more = control.projection.is_some() || keeps_momenta;
     let (n, m, pattern) = (model.n(), model.m(), model.pattern());
     if reads_more || !model.unit_vectors().is_empty() || pattern.nnz() > n * m {
         return None;
@@ -155,6 +152,8 @@ mod tests {
         controls.push(Control::none().with_velocity(Velocity::Gradient(Rate::Auto)));
         controls.push(g.cvsgf_energy().with_geometric(Geometric::Newton(Rate::Auto)));
         controls.push(Control::none().with_geometric(Geometric::Gradient(Gain::Auto)));
+        controls.push(Control::robust());
+        controls.push(Control::robust().with_energy(crate::control::Energy::None));
         for (name, ex) in
             [("pendulum", &pendulum), ("double", &double), ("support", &support), ("damped", &damped), ("sled", &sled)]
         {
@@ -182,9 +181,8 @@ mod tests {
         }
     }
 
-    /// What the arrays cannot hold runs the general path: a projection,
-    /// the laws that hold momenta and invariants, a model that keeps a
-    /// momentum, and models past the compiled sizes.
+    /// What the arrays cannot hold runs the general path: a projection, a
+    /// run that keeps a momentum, models past the compiled sizes.
     #[test]
     fn the_general_path_keeps_what_arrays_do_not_hold() {
         let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
@@ -194,9 +192,7 @@ mod tests {
         };
         assert!(arrays(&pendulum, Control::none(), &none));
         assert!(!arrays(&pendulum, Control::projection(), &none));
-        assert!(!arrays(&pendulum, Control::robust(), &none));
-        let free = Control::robust().with_energy(Energy::None);
-        assert!(!arrays(&pendulum, free, &none), "the coupled gain alone holds invariants");
+        assert!(arrays(&pendulum, Control::robust(), &none), "no momentum to hold");
         let chain = chain(ChainParams { n: 3, ..ChainParams::default() }).unwrap();
         assert!(!arrays(&chain, Control::none(), &none), "6 coordinates");
         let theta = theta_pendulum(PendulumParams::default()).unwrap();
@@ -209,6 +205,7 @@ mod tests {
         let kept = crate::dynamics::momentum::detect(&floating, &q0, &v0);
         assert!(!kept.kept.is_empty());
         assert!(in_arrays(&floating, &Control::none(), &kept, DependentRows::Error).is_none());
+        assert!(in_arrays(&floating, &Control::robust(), &kept, DependentRows::Error).is_none());
         let free = Control::none().with_invariants(Invariants::Free);
         assert!(in_arrays(&floating, &free, &kept, DependentRows::Error).is_some());
     }
