@@ -44,7 +44,8 @@ impl<'m> Simulation<'m> {
         let mut system = ControlledSystem::with_solver(model, settings.control, e0, settings.solver);
         system.set_dependent_rows(settings.dependent_rows);
         system.set_symmetries(momentum::detect(model, q0, v0));
-        if settings.solver == LinearSolver::Auto {
+        // RATTLE and generalized-α step the model, not its right-hand side.
+        if settings.solver == LinearSolver::Auto && !settings.scheme.steps_model() {
             system.allow_arrays();
         }
         Self::start(system, settings, q0, v0)

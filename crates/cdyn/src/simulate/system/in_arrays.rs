@@ -210,6 +210,20 @@ mod tests {
         assert!(in_arrays(&floating, &free, &kept, DependentRows::Error).is_some());
     }
 
+    /// RATTLE and generalized-α step the model themselves, not its
+    /// right-hand side: their runs keep the general path, whose `Φ` the
+    /// violation limit reads after every step.
+    #[test]
+    fn the_schemes_that_step_the_model_keep_the_general_path() {
+        let ex = cartesian_pendulum(PendulumParams::default()).unwrap();
+        for scheme in [Scheme::Rattle, Scheme::GeneralizedAlpha] {
+            let settings = Settings::new(scheme, 1e-2, Control::none()).with_violation_limit(1e-300);
+            let mut sim = Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap();
+            let stopped = (0..100).find_map(|_| sim.step().err());
+            assert!(matches!(stopped, Some(crate::Error::ViolationLimit { .. })), "{scheme:?}: {stopped:?}");
+        }
+    }
+
     /// `|p_b − p_a|² = 1` on `(x_a, y_a, x_b, y_b)`, and `|p|² = 1` on `(x, y)`.
     struct Rod;
     impl crate::Constraint<4, 1> for Rod {
