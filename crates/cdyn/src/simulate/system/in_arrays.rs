@@ -77,8 +77,7 @@ impl<const N: usize, const M: usize> InArrays for ModelInArrays<N, M> {
 }
 
 /// The model evaluated in arrays, where it can be: a constant diagonal
-/// mass, between 2 and 4 coordinates and at least one row (at most three),
-/// no unit vectors, and a control whose terms read only what the arrays
+/// mass, 2 to 4 coordinates and fewer rows (at least one), no unit vectors, and a control whose terms read only what the arrays
 /// hold: no projection (it reuses the general factorization), no momentum
 /// or invariant of `symmetries` kept (the laws hold them on the general path).
 pub(super) fn in_arrays(
