@@ -342,6 +342,7 @@ fn eval_error(e: EvalError, step: u64, t_next: f64) -> Error {
 
 /// Whether every value is finite; without early exit inside a chunk, so
 /// that the test vectorizes.
+#[inline(always)]
 fn all_finite(x: &[f64]) -> bool {
     x.chunks(64).all(|c| c.iter().fold(true, |ok, x| ok & x.is_finite()))
 }
