@@ -167,8 +167,10 @@ impl<'m> ControlledSystem<'m> {
         Ok(model.kinetic(q, v) + model.potential(q, None) - energy)
     }
 
-    /// The dynamics of the latest evaluation. `E₀` and the evaluation count
-    /// are read through [`System::e0`] and [`System::evaluations`].
+    /// The dynamics of the latest general evaluation: of every evaluation,
+    /// unless a [`Simulation`](crate::Simulation) steps a small model in
+    /// arrays. `E₀` and the evaluation count are read through [`System::e0`]
+    /// and [`System::evaluations`].
     pub fn dynamics(&self) -> &Dynamics {
         &self.dynamics
     }
