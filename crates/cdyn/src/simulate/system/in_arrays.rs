@@ -131,9 +131,10 @@ mod tests {
 
     /// Small models of each kind — a rod whose row reads every coordinate,
     /// rows that read some (the double pendulum), a driven support (`Φ_t`),
-    /// a damper (forces), a dependent row — stepped in arrays and through
+    /// a damper (forces), a knife edge (a nonholonomic row) — stepped in arrays and through
     /// the general path (a factorization asked for by name): the same
-    /// trajectories to round-off, under every law the arrays hold.
+    /// trajectories to round-off, under every law the arrays hold, at AB-3,
+    /// RK-4 and ABM-4.
     #[test]
     fn small_models_step_in_arrays_as_through_the_general_path() {
         let pendulum = cartesian_pendulum(PendulumParams::default()).unwrap();
@@ -159,7 +160,7 @@ mod tests {
             for &control in &controls {
                 // The sled keeps its turning rate: in arrays only if free of it.
                 let control = if name == "sled" { control.with_invariants(Invariants::Free) } else { control };
-                for scheme in [Scheme::AdamsBashforth3, Scheme::RungeKutta4] {
+                for scheme in [Scheme::AdamsBashforth3, Scheme::RungeKutta4, Scheme::AdamsBashforthMoulton4] {
                     let settings = Settings::new(scheme, 1e-3, control);
                     let symmetries = crate::dynamics::momentum::detect(&ex.model, &ex.q0, &ex.v0);
                     let chosen = in_arrays(&ex.model, &settings.control, &symmetries, DependentRows::Error);
