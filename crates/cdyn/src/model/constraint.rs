@@ -267,7 +267,7 @@ pub(crate) struct Local<const K: usize, const R: usize> {
 
 /// Elements reading more coordinates than this take their Jacobian from one
 /// [`JetN`] pass, fewer from one scalar dual pass per coordinate.
-const JET_FROM: usize = 5;
+pub(crate) const JET_FROM: usize = 5;
 
 /// Differentiates one element at positions `x`, velocities `v`, free
 /// accelerations `a` and time `t`.

@@ -6,7 +6,8 @@
 //! energy constraint integrates.
 
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::{block_entries, seeded};
+use crate::ad::jet::JetN;
+use crate::model::constraint::{JET_FROM, block_entries, seeded};
 use num_dual::{Dual64, HyperDual64};
 use std::any::Any;
 
@@ -105,11 +106,18 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     }
 }
 
-/// `V(x)` and `∇V(x)`: one scalar dual pass per coordinate (see `constraint.rs`).
+/// `V(x)` and `∇V(x)`: one scalar dual pass per coordinate, or one jet
+/// pass over more than `JET_FROM` (see `constraint.rs`).
 #[inline(always)]
 pub(crate) fn energy_and_gradient<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> (f64, [f64; K]) {
     if K == 0 {
         return (p.energy(x), [0.0; K]);
+    }
+    if K > JET_FROM {
+        let e = p.energy(std::array::from_fn(|j| JetN::<K>::seeded(x[j], j)));
+        let mut gradient = [0.0; K];
+        gradient.copy_from_slice(e.eps.0.as_slice());
+        return (e.re, gradient);
     }
     let mut energy = 0.0;
     let gradient = std::array::from_fn(|j| {
