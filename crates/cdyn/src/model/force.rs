@@ -5,8 +5,8 @@
 //! force on its coordinates; its power `F·v` is the energy input `Ė` that the
 //! energy constraint integrates.
 
-use crate::ad::scalar::Scalar;
 use crate::ad::jet::JetN;
+use crate::ad::scalar::Scalar;
 use crate::model::constraint::{JET_FROM, block_entries, seeded};
 use num_dual::{Dual64, HyperDual64};
 use std::any::Any;
