@@ -321,8 +321,7 @@ pub fn second_order_of<C: Constraint<K, R>, const K: usize, const R: usize>(
 pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x: [f64; K], t: f64) -> [[f64; K]; R] {
     let mut jac = [[0.0; K]; R];
     if K > JET_FROM {
-        let seeded: [JetN<K>; K] = std::array::from_fn(|j| JetN::seeded(x[j], j));
-        let rows = c.eval(seeded, JetN::from_re(t));
+        let rows = c.eval(seeded_jets(&x), JetN::from_re(t));
         for r in 0..R {
             jac[r].copy_from_slice(rows[r].eps.0.as_slice());
         }
@@ -341,4 +340,11 @@ pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x
 #[inline(always)]
 pub(crate) fn seeded<const K: usize>(x: &[f64; K], j: usize) -> [Dual64; K] {
     std::array::from_fn(|i| Dual64::new(x[i], if i == j { 1.0 } else { 0.0 }))
+}
+
+/// `x` as jets, coordinate `j` with unit derivative in direction `j`: the
+/// one pass that gives every first derivative.
+#[inline(always)]
+pub(crate) fn seeded_jets<const K: usize>(x: &[f64; K]) -> [JetN<K>; K] {
+    std::array::from_fn(|j| JetN::seeded(x[j], j))
 }

@@ -5,9 +5,8 @@
 //! force on its coordinates; its power `F·v` is the energy input `Ė` that the
 //! energy constraint integrates.
 
-use crate::ad::jet::JetN;
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::{JET_FROM, block_entries, seeded};
+use crate::model::constraint::{JET_FROM, block_entries, seeded, seeded_jets};
 use num_dual::{Dual64, HyperDual64};
 use std::any::Any;
 
@@ -114,10 +113,8 @@ pub(crate) fn energy_and_gradient<P: Potential<K>, const K: usize>(p: &P, x: [f6
         return (p.energy(x), [0.0; K]);
     }
     if K > JET_FROM {
-        let e = p.energy(std::array::from_fn(|j| JetN::<K>::seeded(x[j], j)));
-        let mut gradient = [0.0; K];
-        gradient.copy_from_slice(e.eps.0.as_slice());
-        return (e.re, gradient);
+        let e = p.energy(seeded_jets(&x));
+        return (e.re, e.eps.0.into());
     }
     let mut energy = 0.0;
     let gradient = std::array::from_fn(|j| {
