@@ -268,6 +268,11 @@ impl Model {
     }
     /// `Φ`, `Φ̇`, `Φ_t`, `γ`, the Jacobian values (in [`Pattern`] order) and `Φ_q a − γ`.
     pub(crate) fn constraints(&self, q: &[f64], v: &[f64], t: f64, out: ConstraintValues<'_>) {
+        // One block spans every row: `out` as it is (slicing seven buffers
+        // per call was a third of a pendulum's constraint pass).
+        if let [block] = &self.constraints[..] {
+            return block.evaluate(q, v, t, out);
+        }
         // The spans are read, not recomputed: a block's `rows` and `width`
         // are calls through its vtable (three a block, each step).
         for (b, &BlockSpan { rows: (r0, r1), entries: (j0, j1) }) in self.constraints.iter().zip(&self.offsets) {

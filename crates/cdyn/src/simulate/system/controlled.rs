@@ -36,8 +36,7 @@ pub struct ControlledSystem<'m> {
     projection: crate::dynamics::manifold::Work,
     /// Right-hand-side evaluations so far.
     evaluations: u64,
-    /// Most rows dropped as dependent by an evaluation since the last
-    /// [`System::take_dependent_rows`].
+    /// Most rows an evaluation dropped as dependent since the last [`System::take_dependent_rows`].
     dependent: usize,
     /// What a dependent row does (as the dynamics are set to).
     dependent_rows: DependentRows,
@@ -45,8 +44,7 @@ pub struct ControlledSystem<'m> {
     symmetries: Symmetries,
     /// Those the corrections keep (none with [`Invariants::Free`](crate::control::Invariants::Free)).
     momenta: Momenta,
-    /// The angular momenta and declared invariants `robust` and
-    /// `projection` hold beside the energy (none with `Free`).
+    /// The angular momenta and declared invariants `robust` and `projection` hold beside the energy (none with `Free`).
     held: Held,
     /// A rotation's field `ξ(q)`, for [`System::momentum`].
     turned: Vec<f64>,
@@ -104,8 +102,7 @@ impl<'m> ControlledSystem<'m> {
         self.arrays = self.arrays_allowed.then(|| in_arrays(model, control, symmetries, rows)).flatten();
     }
 
-    /// The momenta the model keeps; the control's corrections are made
-    /// M-orthogonal to them unless it says [`Invariants::Free`](crate::control::Invariants::Free).
+    /// The momenta the model keeps; corrections are M-orthogonal to them (unless `Invariants::Free`).
     pub fn set_symmetries(&mut self, symmetries: Symmetries) {
         self.momenta = match self.control.invariants {
             crate::control::Invariants::Keep => {
@@ -144,8 +141,7 @@ impl<'m> ControlledSystem<'m> {
         &self.control
     }
 
-    /// Changes an input by `set` at the state `x`, time `t`, and returns
-    /// how much `∫Ė` must move so that `Ψ` stays as it was (see
+    /// Changes an input by `set` at the state `x`, time `t`; returns how much `∫Ė` must move so that `Ψ` stays (see
     /// [`Simulation::set_input`](crate::Simulation::set_input)): the jump of
     /// `V`, or where the constraints moved (a drive's target), the change
     /// of `T + V` as `(q, v)` are projected onto them at once.
@@ -167,32 +163,15 @@ impl<'m> ControlledSystem<'m> {
         Ok(model.kinetic(q, v) + model.potential(q, None) - energy)
     }
 
-    /// The dynamics of the latest general evaluation: of every evaluation,
-    /// unless a [`Simulation`](crate::Simulation) steps a small model in
-    /// arrays. `E₀` and the evaluation count are read through [`System::e0`]
-    /// and [`System::evaluations`].
+    /// The dynamics of the latest general evaluation (of every evaluation, unless a small model runs in arrays).
     pub fn dynamics(&self) -> &Dynamics {
         &self.dynamics
     }
-}
 
-impl Rhs for ControlledSystem<'_> {
-    type Error = EvalError;
-
-    fn state_len(&self) -> usize {
-        2 * self.model.n() + 1
-    }
-
-    fn has_control(&self) -> bool {
-        self.control.is_active()
-    }
-
-    fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
+    /// [`Rhs::eval`] by the general kernels (apart: a small model's call into its arrays skips its set-up).
+    #[inline(never)]
+    fn eval_general(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
         let n = self.model.n();
-        self.evaluations += 1;
-        if let Some(arrays) = &mut self.arrays {
-            return arrays.eval(self.model, &self.control, self.e0, x, t, f, u);
-        }
         let (q, v, e) = split_state(x, n);
         // The projected energy law (robust's) takes its products with
         // M⁻¹Φ_qᵀ in a pass over the Jacobian, which also subtracts A's
@@ -256,6 +235,27 @@ impl Rhs for ControlledSystem<'_> {
         }
         f[n..2 * n].copy_from_slice(self.dynamics.acc());
         Ok(())
+    }
+}
+
+impl Rhs for ControlledSystem<'_> {
+    type Error = EvalError;
+
+    fn state_len(&self) -> usize {
+        2 * self.model.n() + 1
+    }
+
+    fn has_control(&self) -> bool {
+        self.control.is_active()
+    }
+
+    #[inline]
+    fn eval(&mut self, x: &[f64], t: f64, f: &mut [f64], u: Option<&mut [f64]>) -> Result<(), EvalError> {
+        self.evaluations += 1;
+        match &mut self.arrays {
+            Some(arrays) => arrays.eval(self.model, &self.control, self.e0, x, t, f, u),
+            None => self.eval_general(x, t, f, u),
+        }
     }
 }
 
