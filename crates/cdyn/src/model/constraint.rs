@@ -42,6 +42,20 @@ pub trait Constraint<const K: usize, const R: usize>: Send + Sync + 'static {
         (second_order_of(self, x, v, t), self.jacobian(x, t))
     }
 
+    /// `Σ_r w_r ∇²Φ_r` at `(x, t)`, `K × K` and symmetric: the derivative
+    /// of `Φ_xᵀ w` in `x`, which an implicit step's Newton matrix needs.
+    /// The default takes one hyper-dual pass of [`eval`](Self::eval) per
+    /// pair of coordinates ([`curvature_of`]); an element that knows its
+    /// second derivatives (a spatial joint: `A(p)s` is quadratic in `p`)
+    /// may compose them instead.
+    #[inline(always)]
+    fn curvature(&self, x: [f64; K], t: f64, w: &[f64; R]) -> [[f64; K]; K]
+    where
+        Self: Sized,
+    {
+        curvature_of(self, x, t, w)
+    }
+
     /// Which coordinates each row can depend on: an entry `false` here must
     /// be zero at every state, and its products are left out when
     /// `Φ_q M⁻¹ Φ_qᵀ` is assembled (a spherical joint's row reads one
@@ -183,20 +197,12 @@ impl<C: Constraint<K, R>, const K: usize, const R: usize> ConstraintBlock for Co
     }
 
     fn curvatures(&self, q: &[f64], t: f64, lambda: &[f64], scale: f64, out: &mut [f64]) -> usize {
-        // ∂²Φ_r/∂xᵢ∂xⱼ: Φ along x + ε₁eᵢ + ε₂eⱼ, its ε₁ε₂ parts, weighted by λ_r.
-        let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
-        for (e, ((c, idx), block)) in self.items.iter().zip(out.chunks_exact_mut(K * K)).enumerate() {
+        for ((c, idx), (weights, block)) in
+            self.items.iter().zip(lambda.chunks_exact(R).zip(out.chunks_exact_mut(K * K)))
+        {
             let x: [f64; K] = std::array::from_fn(|j| q[idx[j]]);
-            let weights = &lambda[e * R..(e + 1) * R];
-            for i in 0..K {
-                for j in i..K {
-                    let rows =
-                        c.eval(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0)), t.into());
-                    let h = scale * rows.iter().zip(weights).map(|(r, l)| r.eps1eps2 * l).sum::<f64>();
-                    block[i * K + j] = h;
-                    block[j * K + i] = h;
-                }
-            }
+            let h = c.curvature(x, t, weights.try_into().expect("R multipliers an element"));
+            block.iter_mut().zip(h.as_flattened()).for_each(|(b, h)| *b = scale * h);
         }
         self.items.len() * K * K
     }
@@ -334,6 +340,26 @@ pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x
         }
     }
     jac
+}
+
+/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval`: `Φ` along
+/// `x + ε₁eᵢ + ε₂eⱼ`, its `ε₁ε₂` parts, one pass per pair `i ≤ j`.
+pub fn curvature_of<C: Constraint<K, R>, const K: usize, const R: usize>(
+    c: &C,
+    x: [f64; K],
+    t: f64,
+    w: &[f64; R],
+) -> [[f64; K]; K] {
+    let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
+    let mut h = [[0.0; K]; K];
+    for i in 0..K {
+        for j in i..K {
+            let rows = c.eval(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0)), t.into());
+            h[i][j] = rows.iter().zip(w).map(|(r, w)| r.eps1eps2 * w).sum::<f64>();
+            h[j][i] = h[i][j];
+        }
+    }
+    h
 }
 
 /// `x` as dual numbers with unit derivative in coordinate `j`.

@@ -11,7 +11,7 @@ use super::joint_rows::{F, Frame, G, H, JointRows, Place, Side, pose};
 use super::rotation::{rotate_fixed, rotate_jacobian};
 use crate::ad::jet::{Eps, JetN};
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::{Constraint, second_order_of};
+use crate::model::constraint::{Constraint, curvature_of, second_order_of};
 
 /// A joint between two bodies: reads `(r_a, p_a, r_b, p_b)`.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,11 +76,13 @@ impl<const N: usize> Place<JetN<N>> for Seeded<'_> {
 /// width 7), where a jet over both sides' 14 coordinates multiplies the
 /// other side's zeros in every product.
 #[derive(Clone, Copy)]
-struct Sided {
-    x: [f64; 3],
-    d: [[f64; 7]; 3],
+pub(super) struct Sided {
+    pub(super) x: [f64; 3],
+    pub(super) d: [[f64; 7]; 3],
     /// `x`, `ẋ` and `ẍ` along the side's motion at zero acceleration.
     motion: Motion,
+    /// The body-fixed vector `s` it rotates (`x = A(p)s`, plus `r` for a point).
+    pub(super) s: [f64; 3],
 }
 
 /// A vector and its first and second rates.
@@ -90,7 +92,7 @@ type Motion = [[f64; 3]; 3];
 type Halves = [[f64; 7]; 2];
 
 /// What a joint's Jacobian pass reads of one side.
-trait SidedPlace {
+pub(super) trait SidedPlace {
     fn point(&self) -> Sided;
     fn axis(&self, k: usize) -> Sided;
 }
@@ -116,7 +118,7 @@ impl Seeded<'_> {
             turn + if moved { rd[i] } else { 0.0 }
         });
         let curvature = rotate_fixed(pd, s).map(|c| 2.0 * c);
-        Sided { x, d, motion: [x, rate, curvature] }
+        Sided { x, d, motion: [x, rate, curvature], s }
     }
 }
 
@@ -143,7 +145,7 @@ impl SidedPlace for Fixed<'_> {
 
 /// A vector fixed in space.
 fn still(x: [f64; 3]) -> Sided {
-    Sided { x, d: [[0.0; 7]; 3], motion: [x, [0.0; 3], [0.0; 3]] }
+    Sided { x, d: [[0.0; 7]; 3], motion: [x, [0.0; 3], [0.0; 3]], s: x }
 }
 
 /// `[u · w, (u · w)˙, (u · w)¨]` of two moving vectors.
@@ -269,6 +271,15 @@ impl<const R: usize> Constraint<14, R> for BodyToBody<R> {
         self.0.kinematic_derivatives(&a, &b, both)
     }
 
+    fn curvature(&self, x: [f64; 14], t: f64, w: &[f64; R]) -> [[f64; 14]; 14] {
+        if self.0.has_drives() {
+            return curvature_of(self, x, t, w);
+        }
+        let ((ra, pa), (rb, pb)) = (pose(&x, 0), pose(&x, 7));
+        let (a, b) = (Seeded::new(ra, pa, 0, &self.0.a), Seeded::new(rb, pb, 7, &self.0.b));
+        self.0.kinematic_curvature(&a, &b, [Some(0), Some(7)], w)
+    }
+
     fn reads(&self) -> [[bool; 14]; R] {
         self.0.reads(&[0, 7])
     }
@@ -298,6 +309,14 @@ impl<const R: usize> Constraint<7, R> for BodyToGround<R> {
         self.0.kinematic_derivatives(&a, &Fixed(&self.0.b), |[jac, _]| jac)
     }
 
+    fn curvature(&self, x: [f64; 7], t: f64, w: &[f64; R]) -> [[f64; 7]; 7] {
+        if self.0.has_drives() {
+            return curvature_of(self, x, t, w);
+        }
+        let (r, p) = pose(&x, 0);
+        self.0.kinematic_curvature(&Seeded::new(r, p, 0, &self.0.a), &Fixed(&self.0.b), [Some(0), None], w)
+    }
+
     fn reads(&self) -> [[bool; 7]; R] {
         self.0.reads(&[0])
     }
@@ -318,10 +337,11 @@ mod tests {
         }
     }
 
-    /// The joints' composed Jacobians and second-order rows against one jet
-    /// pass and one second-order dual pass of their rows, at poses and rates
-    /// off the constraints with quaternions off unit length; and the entries
-    /// `reads` leaves out are zero in the jet pass.
+    /// The joints' composed Jacobians, second-order rows and curvatures
+    /// against one jet pass, one second-order dual pass and hyper-dual
+    /// passes of their rows, at poses and rates off the constraints with
+    /// quaternions off unit length; and the entries `reads` leaves out are
+    /// zero in the jet pass.
     fn composed_is_the_plain_pass<const R: usize>(kind: JointKind, angle: bool, displacement: bool) {
         let mut x = numbers(R as u64 + 7 * kind.rows() as u64);
         let mut frame =
@@ -372,11 +392,17 @@ mod tests {
                 same(jac.as_flattened(), jacobian_of(&one, q7, t).as_flattened()),
                 "{kind:?} grounded Jacobian along"
             );
+            // The curvature Σ w_r ∇²Φ_r against one hyper-dual pass per pair.
+            let w: [f64; R] = std::array::from_fn(|_| 2.0 * x());
+            let (c, p) = (two.curvature(q, t, &w), curvature_of(&two, q, t, &w));
+            assert!(same(c.as_flattened(), p.as_flattened()), "{kind:?} curvature: {c:?} vs {p:?}");
+            let (c, p) = (one.curvature(q7, t, &w), curvature_of(&one, q7, t, &w));
+            assert!(same(c.as_flattened(), p.as_flattened()), "{kind:?} grounded curvature: {c:?} vs {p:?}");
         }
     }
 
     #[test]
-    fn composed_jacobians_and_rates_equal_the_plain_dual_passes_and_unread_entries_are_zero_for_every_joint() {
+    fn composed_derivatives_equal_the_plain_dual_passes_and_unread_entries_are_zero_for_every_joint() {
         composed_is_the_plain_pass::<3>(JointKind::Spherical, false, false);
         composed_is_the_plain_pass::<5>(JointKind::Revolute, false, false);
         composed_is_the_plain_pass::<6>(JointKind::Revolute, true, false);

@@ -40,6 +40,7 @@ mod body;
 mod chain;
 mod coordinate;
 mod joint;
+mod joint_curvature;
 mod joint_element;
 mod joint_rows;
 mod load;
