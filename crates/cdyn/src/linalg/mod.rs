@@ -10,7 +10,9 @@
 
 mod assembled;
 mod band;
+mod dense_lu;
 mod ldl;
+pub(crate) mod lu;
 pub mod mass;
 mod schur;
 pub(crate) mod sparse;

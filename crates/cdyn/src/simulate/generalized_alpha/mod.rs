@@ -64,8 +64,8 @@ pub(crate) use step::step;
 
 use crate::dynamics::{Breakdown, DependentRows, Dynamics};
 use crate::error::{Error, Result};
+use crate::linalg::lu::Lu;
 use crate::linalg::mass::MassMatrix;
-use crate::linalg::sparse_lu::SparseLu;
 use crate::model::Model;
 
 /// How generalized-α iterates its implicit equations
@@ -212,7 +212,7 @@ pub(crate) struct Work {
     force_entries: usize,
     element_entries: usize,
     values: Vec<f64>,
-    lu: SparseLu,
+    lu: Lu,
     /// `q̈_n`, `a_n`, `λ_n`, and whether they are known (after the first step).
     acc: Vec<f64>,
     aux: Vec<f64>,
