@@ -87,13 +87,9 @@ mod tests {
     use super::*;
     use crate::linalg::sparse_lu::SparseLu;
 
-    /// A reproducible stream of numbers in (−1, 1).
-    fn numbers(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
+    /// The `k`-th of a spread of numbers in (−1, 1) (the golden ratio's multiples, mod 1).
+    fn spread(k: usize) -> f64 {
+        2.0 * ((k as f64 + 1.0) * 0.618_033_988_749_895).fract() - 1.0
     }
 
     /// A saddle-point matrix like the Newton matrix, `[A, Bᵀ; B, 0]`, with
@@ -102,7 +98,6 @@ mod tests {
     #[test]
     fn dense_and_sparse_lu_solve_a_saddle_point_system_alike() {
         let (n, m) = (7, 3);
-        let mut x = numbers(3);
         let mut entries = Vec::new();
         for i in 0..n + m {
             entries.push((i as u32, i as u32));
@@ -119,9 +114,10 @@ mod tests {
         }
         // Twice each entry of A's diagonal (repeats add), zero on the multipliers' diagonal.
         entries.extend((0..n as u32).map(|i| (i, i)));
-        let values: Vec<f64> =
-            entries.iter().map(|&(r, c)| if r == c && r as usize >= n { 0.0 } else { 4.0 * x() }).collect();
-        let b: Vec<f64> = (0..n + m).map(|_| x()).collect();
+        let values: Vec<f64> = (entries.iter().enumerate())
+            .map(|(k, &(r, c))| if r == c && r as usize >= n { 0.0 } else { 4.0 * spread(k) })
+            .collect();
+        let b: Vec<f64> = (0..n + m).map(|i| spread(1000 + i)).collect();
         let mut a = vec![0.0; (n + m) * (n + m)];
         entries.iter().zip(&values).for_each(|(&(r, c), v)| a[r as usize * (n + m) + c as usize] += v);
         let mut dense = DenseLu::new(n + m, &entries);
