@@ -14,6 +14,32 @@ use std::any::Any;
 pub trait Potential<const K: usize>: Send + Sync + 'static {
     /// `V(x)`, for any scalar type (dual numbers give `∇V` and more).
     fn energy<D: Scalar>(&self, x: [D; K]) -> D;
+
+    /// `∇²V(x)`, which an implicit step's Newton matrix needs. The default
+    /// takes one hyper-dual pass of [`energy`](Self::energy) per pair of
+    /// coordinates ([`hessian_of`]); an element that knows its second
+    /// derivatives (a spatial spring) may give them instead.
+    #[inline(always)]
+    fn hessian(&self, x: [f64; K]) -> [[f64; K]; K]
+    where
+        Self: Sized,
+    {
+        hessian_of(self, x)
+    }
+}
+
+/// `∇²V(x)` by hyper-dual passes: `V` along `x + ε₁eᵢ + ε₂eⱼ`, its `ε₁ε₂`
+/// part, one pass per pair `i ≤ j`.
+pub fn hessian_of<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> [[f64; K]; K] {
+    let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
+    let mut h = [[0.0; K]; K];
+    for i in 0..K {
+        for j in i..K {
+            h[i][j] = p.energy(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0))).eps1eps2;
+            h[j][i] = h[i][j];
+        }
+    }
+    h
 }
 
 /// A non-conservative generalized force on `K` coordinates, from their
@@ -82,20 +108,9 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     }
 
     fn hessians(&self, q: &[f64], scale: f64, out: &mut [f64]) -> usize {
-        // ∂²V/∂xᵢ∂xⱼ: V along x + ε₁eᵢ + ε₂eⱼ, its ε₁ε₂ part.
-        let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
-        let hyper = |x: &[f64; K], i: usize, j: usize, p: &P| {
-            p.energy(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0))).eps1eps2
-        };
         for ((p, idx), block) in self.items.iter().zip(out.chunks_exact_mut(K * K)) {
-            let x = std::array::from_fn(|j| q[idx[j]]);
-            for i in 0..K {
-                for j in i..K {
-                    let h = scale * hyper(&x, i, j, p);
-                    block[i * K + j] = h;
-                    block[j * K + i] = h;
-                }
-            }
+            let h = p.hessian(std::array::from_fn(|j| q[idx[j]]));
+            block.iter_mut().zip(h.as_flattened()).for_each(|(b, h)| *b = scale * h);
         }
         self.items.len() * K * K
     }

@@ -5,15 +5,14 @@
 //! Every row of a joint without drives is a component of `x_b − x_a`, a
 //! dot product `u_a · v_b` of vectors on the two sides, `u_a · (x_b − x_a)`
 //! or `|x_b − x_a|²`, where each side's vector is `A(p)s` (plus `r` for a
-//! point). `A(p)s` is a quadratic form in `p`: its Jacobian in `p` is
-//! linear in `p` ([`rotate_jacobian`]), so its second derivatives are that
-//! Jacobian at the unit vectors, whatever the pose. The product rule does
+//! point). `A(p)s` is a quadratic form in `p`, so its second derivatives
+//! are the same at every pose ([`rotate_hessian`]). The product rule does
 //! the rest: `∇²(u · v) = Σᵢ (vᵢ ∇²uᵢ + uᵢ ∇²vᵢ + ∇uᵢ ⊗ ∇vᵢ + ∇vᵢ ⊗ ∇uᵢ)`.
 
 use super::joint::JointKind;
 use super::joint_element::{Sided, SidedPlace};
 use super::joint_rows::{F, G, H, JointRows};
-use super::rotation::rotate_jacobian;
+use super::rotation::rotate_hessian;
 
 /// Where a side's seven coordinates `(r, p)` start among the element's,
 /// `None` for the ground.
@@ -32,13 +31,16 @@ fn wide<const K: usize>(u: &Sided, at: At) -> [[f64; K]; 3] {
 
 /// `out += Σᵢ cᵢ ∇²uᵢ`, on the side's `p` alone (`r` enters linearly).
 fn curve<const K: usize>(out: &mut [[f64; K]; K], u: &Sided, at: At, c: [f64; 3]) {
-    let Some(at) = at else { return };
-    let p = at + 3;
-    for l in 0..4 {
-        // ∂/∂p_l of the linear ∂(A(p)s)/∂p: that Jacobian at p = e_l.
-        let j = rotate_jacobian(std::array::from_fn(|k| if k == l { 1.0 } else { 0.0 }), u.s);
-        for k in 0..4 {
-            out[p + k][p + l] += c[0] * j[0][k] + c[1] * j[1][k] + c[2] * j[2][k];
+    if let Some(at) = at {
+        add_rotation_block(out, at, rotate_hessian(u.s, c));
+    }
+}
+
+/// `out += h` on the `p` of the side whose seven coordinates start at `at`.
+pub(super) fn add_rotation_block<const K: usize>(out: &mut [[f64; K]; K], at: usize, h: [[f64; 4]; 4]) {
+    for k in 0..4 {
+        for l in 0..4 {
+            out[at + 3 + k][at + 3 + l] += h[k][l];
         }
     }
 }

@@ -64,6 +64,20 @@ pub fn rotate_jacobian(p: [f64; 4], s: [f64; 3]) -> [[f64; 4]; 3] {
     })
 }
 
+/// `Σᵢ cᵢ ∂²(A(p)s)ᵢ/∂p²`, 4 × 4, the same at every `p`: `A(p)s` is a
+/// quadratic form in `p`, so the derivative of its Jacobian (linear in
+/// `p`) along `e_l` is that Jacobian at `p = e_l`.
+pub fn rotate_hessian(s: [f64; 3], c: [f64; 3]) -> [[f64; 4]; 4] {
+    let mut h = [[0.0; 4]; 4];
+    for l in 0..4 {
+        let j = rotate_jacobian(std::array::from_fn(|k| if k == l { 1.0 } else { 0.0 }), s);
+        for k in 0..4 {
+            h[k][l] = c[0] * j[0][k] + c[1] * j[1][k] + c[2] * j[2][k];
+        }
+    }
+    h
+}
+
 /// `A(p)ᵀ x`: a space vector in body axes (`|p| = 1`).
 pub fn unrotate(p: [f64; 4], x: [f64; 3]) -> [f64; 3] {
     rotate([p[0], -p[1], -p[2], -p[3]], x)
