@@ -15,6 +15,17 @@ pub trait Potential<const K: usize>: Send + Sync + 'static {
     /// `V(x)`, for any scalar type (dual numbers give `∇V` and more).
     fn energy<D: Scalar>(&self, x: [D; K]) -> D;
 
+    /// `V(x)` and `∇V(x)`. The default differentiates
+    /// [`energy`](Self::energy) ([`energy_and_gradient_of`]); an element
+    /// that knows its gradient (a spatial spring) may give it instead.
+    #[inline(always)]
+    fn energy_and_gradient(&self, x: [f64; K]) -> (f64, [f64; K])
+    where
+        Self: Sized,
+    {
+        energy_and_gradient_of(self, x)
+    }
+
     /// `∇²V(x)`, which an implicit step's Newton matrix needs. The default
     /// takes one hyper-dual pass of [`energy`](Self::energy) per pair of
     /// coordinates ([`hessian_of`]); an element that knows its second
@@ -86,7 +97,7 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
     fn energy_and_gradient(&self, q: &[f64], grad: &mut [f64]) -> f64 {
         let mut total = 0.0;
         for (p, idx) in &self.items {
-            let (energy, gradient) = energy_and_gradient(p, std::array::from_fn(|j| q[idx[j]]));
+            let (energy, gradient) = p.energy_and_gradient(std::array::from_fn(|j| q[idx[j]]));
             total += energy;
             for j in 0..K {
                 grad[idx[j]] += gradient[j];
@@ -123,7 +134,7 @@ impl<P: Potential<K>, const K: usize> PotentialBlock for PotentialGroup<P, K> {
 /// `V(x)` and `∇V(x)`: one scalar dual pass per coordinate, or one jet
 /// pass over more than `JET_FROM` (see `constraint.rs`).
 #[inline(always)]
-pub(crate) fn energy_and_gradient<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> (f64, [f64; K]) {
+pub fn energy_and_gradient_of<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> (f64, [f64; K]) {
     if K == 0 {
         return (p.energy(x), [0.0; K]);
     }

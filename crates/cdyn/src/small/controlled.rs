@@ -12,7 +12,7 @@ use crate::integrate::{Buffer, Rhs};
 use crate::linalg::mass::{DiagonalMass, MassMatrix};
 use crate::model::check_rows;
 use crate::model::constraint::local;
-use crate::model::force::{Force, Potential, energy_and_gradient};
+use crate::model::force::{Force, Potential};
 use crate::simulate::system::{ArrayDynamics, ArrayWork, EvalError, System};
 use crate::simulate::{Settings, Stepper, check_initial_state};
 use num_dual::Dual64;
@@ -131,7 +131,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
     fn measure(&mut self, x: &[f64], t: f64) -> Measures {
         let (q, v, e) = split(x);
         let l = local(&self.system, q, v, [0.0; N], t);
-        let (potential, grad) = energy_and_gradient(&self.system, q);
+        let (potential, grad) = self.system.energy_and_gradient(q);
         let psi = energy::psi(&self.d.mass, &v, potential, e, self.e0);
         let columns = &ArrayDynamics::<N, M>::COLUMNS;
         Measures::of(psi, &grad, &l.phi, &l.phi_dot, |r| (l.jac[r].as_slice(), columns.as_slice()))

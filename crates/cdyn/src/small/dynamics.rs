@@ -5,7 +5,7 @@ use super::{SmallSystem, Whole};
 use crate::linalg::Breakdown;
 use crate::linalg::mass::MassMatrix;
 use crate::model::constraint::local;
-use crate::model::force::{Force, energy_and_gradient};
+use crate::model::force::{Force, Potential};
 use crate::simulate::system::ArrayDynamics;
 
 impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
@@ -18,7 +18,7 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
         v: [f64; N],
         t: f64,
     ) -> Result<(), Breakdown> {
-        let (potential, grad) = energy_and_gradient(system, q);
+        let (potential, grad) = system.energy_and_gradient(q);
         let force = system.force(q, v, t);
         self.potential = potential;
         self.grad_potential = grad;

@@ -7,10 +7,7 @@
 //! torques are forces.
 
 use super::joint::FRICTION_SLIP;
-use super::joint_curvature::add_rotation_block;
-use super::rotation::{
-    cross, rotate_fixed, rotate_hessian, rotate_jacobian, space_rate as rate, torque_on_parameters as on_parameters,
-};
+use super::rotation::{cross, rotate_fixed, space_rate as rate, torque_on_parameters as on_parameters};
 use crate::ad::scalar::Scalar;
 use crate::model::force::{Force, Potential};
 
@@ -157,51 +154,13 @@ fn potential<D: Scalar>(s: &SpringEnergy, a: End<D>, b: End<D>) -> D {
     stretch * stretch * (0.5 * s.k)
 }
 
-impl SpringEnergy {
-    /// `∇²V` in closed form, where 105 hyper-dual passes (`K = 14`) took
-    /// most of a generalized-α step of the flyball governor. With
-    /// `g = x_b − x_a`, `ℓ = |g|` and `n = g/ℓ`:
-    /// `∇²V = k ∇ℓ ⊗ ∇ℓ + k (ℓ − ℓ₀) ((∇gᵀ∇g − ∇ℓ ⊗ ∇ℓ)/ℓ + Σᵢ nᵢ ∇²gᵢ)`,
-    /// `∇g` an end's `(I, ∂(A s)/∂p)` and `∇²gᵢ` its rotation's, the same
-    /// at every pose ([`rotate_hessian`]).
-    fn hessian_at<const K: usize>(&self, x: &[f64; K]) -> [[f64; K]; K] {
-        let end = |at: usize, s: [f64; 3]| -> ([f64; 3], [[f64; K]; 3]) {
-            let p = std::array::from_fn(|i| x[at + 3 + i]);
-            let (arm, jacobian) = (rotate_fixed(p, s), rotate_jacobian(p, s));
-            let mut d = [[0.0; K]; 3];
-            for i in 0..3 {
-                d[i][at + i] = 1.0;
-                d[i][at + 3..at + 7].copy_from_slice(&jacobian[i]);
-            }
-            (std::array::from_fn(|i| x[at + i] + arm[i]), d)
-        };
-        let (xa, da) = end(0, self.sa);
-        let (xb, db) = if self.ground { (self.sb, [[0.0; K]; 3]) } else { end(7, self.sb) };
-        let g: [f64; 3] = std::array::from_fn(|i| xb[i] - xa[i]);
-        let l = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-        let n = g.map(|g| g / l);
-        let dg: [[f64; K]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| db[i][j] - da[i][j]));
-        let dl: [f64; K] = std::array::from_fn(|j| n[0] * dg[0][j] + n[1] * dg[1][j] + n[2] * dg[2][j]);
-        let force = self.k * (l - self.length);
-        let mut h = [[0.0; K]; K];
-        for a in 0..K {
-            for b in 0..K {
-                let gg = dg[0][a] * dg[0][b] + dg[1][a] * dg[1][b] + dg[2][a] * dg[2][b];
-                h[a][b] = self.k * dl[a] * dl[b] + force * (gg - dl[a] * dl[b]) / l;
-            }
-        }
-        add_rotation_block(&mut h, 0, rotate_hessian(self.sa, n.map(|n| -force * n)));
-        if !self.ground {
-            add_rotation_block(&mut h, 7, rotate_hessian(self.sb, n.map(|n| force * n)));
-        }
-        h
-    }
-}
-
 impl Potential<14> for SpringEnergy {
     fn energy<D: Scalar>(&self, x: [D; 14]) -> D {
         let (a, b) = self.ends(&x);
         potential(self, a, b)
+    }
+    fn energy_and_gradient(&self, x: [f64; 14]) -> (f64, [f64; 14]) {
+        self.gradient_at(&x)
     }
     fn hessian(&self, x: [f64; 14]) -> [[f64; 14]; 14] {
         self.hessian_at(&x)
@@ -212,6 +171,9 @@ impl Potential<7> for SpringEnergy {
     fn energy<D: Scalar>(&self, x: [D; 7]) -> D {
         let (a, b) = self.ends(&x);
         potential(self, a, b)
+    }
+    fn energy_and_gradient(&self, x: [f64; 7]) -> (f64, [f64; 7]) {
+        self.gradient_at(&x)
     }
     fn hessian(&self, x: [f64; 7]) -> [[f64; 7]; 7] {
         self.hessian_at(&x)
@@ -386,32 +348,5 @@ pub(crate) struct BodyTorque {
 impl Force<4> for BodyTorque {
     fn force<D: Scalar>(&self, p: [D; 4], _pd: [D; 4], _t: D) -> [D; 4] {
         on_parameters(p, self.n.map(D::from))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::force::hessian_of;
-
-    /// The spring's closed-form Hessian against one hyper-dual pass per
-    /// pair, between two bodies and to the ground, at poses with
-    /// quaternions off unit length and the spring stretched and compressed.
-    #[test]
-    fn the_springs_hessian_is_the_hyper_dual_passes() {
-        let spread = |k: usize| 2.0 * ((k as f64 + 1.0) * 0.618_033_988_749_895).fract() - 1.0;
-        for (case, length) in [(0, 0.2), (1, 3.0)] {
-            let v = |i: usize| spread(100 * case + i);
-            let spring =
-                |ground| SpringEnergy { sa: [v(0), v(1), v(2)], sb: [v(3), v(4), v(5)], ground, k: 7.0, length };
-            let x: [f64; 14] = std::array::from_fn(|i| v(10 + i));
-            let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(a, b)| (a - b).abs() <= 1e-13 * (1.0 + b.abs()));
-            let (two, one) = (spring(false), spring(true));
-            let (c, p) = (Potential::<14>::hessian(&two, x), hessian_of::<_, 14>(&two, x));
-            assert!(close(c.as_flattened(), p.as_flattened()), "{c:?} vs {p:?}");
-            let x7: [f64; 7] = std::array::from_fn(|i| x[i]);
-            let (c, p) = (Potential::<7>::hessian(&one, x7), hessian_of::<_, 7>(&one, x7));
-            assert!(close(c.as_flattened(), p.as_flattened()), "grounded: {c:?} vs {p:?}");
-        }
     }
 }

@@ -50,6 +50,7 @@ mod placing;
 mod posing;
 pub mod rotation;
 mod sketch;
+mod spring;
 mod stops;
 #[cfg(feature = "urdf")]
 mod urdf;
