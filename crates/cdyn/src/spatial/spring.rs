@@ -10,9 +10,10 @@ use super::load::SpringEnergy;
 use super::rotation::{rotate_fixed, rotate_hessian, rotate_jacobian};
 
 impl SpringEnergy {
-    /// `ℓ = |g|`, `n = g/ℓ` and `∇g` (3 × `K`) of `g = x_b − x_a`, each
-    /// end's `∇x` being `(I, ∂(A s)/∂p)` on its body's coordinates.
-    fn line<const K: usize>(&self, x: &[f64; K]) -> (f64, [f64; 3], [[f64; K]; 3]) {
+    /// `ℓ = |g|`, `n = g/ℓ`, `∇g` (3 × `K`) and `∇ℓ = nᵀ∇g` of
+    /// `g = x_b − x_a`, each end's `∇x` being `(I, ∂(A s)/∂p)` on its
+    /// body's coordinates.
+    fn line<const K: usize>(&self, x: &[f64; K]) -> (f64, [f64; 3], [[f64; K]; 3], [f64; K]) {
         let end = |at: usize, s: [f64; 3]| -> ([f64; 3], [[f64; K]; 3]) {
             let p = std::array::from_fn(|i| x[at + 3 + i]);
             let (arm, jacobian) = (rotate_fixed(p, s), rotate_jacobian(p, s));
@@ -27,27 +28,25 @@ impl SpringEnergy {
         let (xb, db) = if self.ground { (self.sb, [[0.0; K]; 3]) } else { end(7, self.sb) };
         let g: [f64; 3] = std::array::from_fn(|i| xb[i] - xa[i]);
         let l = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-        let dg = std::array::from_fn(|i| std::array::from_fn(|j| db[i][j] - da[i][j]));
-        (l, g.map(|g| g / l), dg)
+        let n = g.map(|g| g / l);
+        let dg: [[f64; K]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| db[i][j] - da[i][j]));
+        let dl = std::array::from_fn(|j| n[0] * dg[0][j] + n[1] * dg[1][j] + n[2] * dg[2][j]);
+        (l, n, dg, dl)
     }
 
-    /// `V = ½ k (ℓ − ℓ₀)²` and `∇V = k (ℓ − ℓ₀) ∇ℓ`, `∇ℓ = nᵀ∇g`, in closed
-    /// form: the jet pass rotated both ends on 14-wide numbers (a fifth of
-    /// the flyball governor's RK-4 run).
+    /// `V = ½ k (ℓ − ℓ₀)²` and `∇V = k (ℓ − ℓ₀) ∇ℓ` (the jet pass was a
+    /// fifth of the flyball governor's RK-4 run).
     pub(super) fn gradient_at<const K: usize>(&self, x: &[f64; K]) -> (f64, [f64; K]) {
-        let (l, n, dg) = self.line(x);
-        let force = self.k * (l - self.length);
-        let gradient = std::array::from_fn(|j| force * (n[0] * dg[0][j] + n[1] * dg[1][j] + n[2] * dg[2][j]));
-        (0.5 * self.k * (l - self.length) * (l - self.length), gradient)
+        let (l, _, _, dl) = self.line(x);
+        let stretch = l - self.length;
+        (0.5 * self.k * stretch * stretch, dl.map(|d| self.k * stretch * d))
     }
 
     /// `∇²V = k ∇ℓ ⊗ ∇ℓ + k (ℓ − ℓ₀) ((∇gᵀ∇g − ∇ℓ ⊗ ∇ℓ)/ℓ + Σᵢ nᵢ ∇²gᵢ)`
-    /// in closed form, `∇²gᵢ` the ends' rotations', the same at every pose
-    /// ([`rotate_hessian`]): 105 hyper-dual passes (`K = 14`) took most of
-    /// a generalized-α step of the flyball governor.
+    /// (the hyper-dual passes took most of a generalized-α step of the
+    /// flyball governor).
     pub(super) fn hessian_at<const K: usize>(&self, x: &[f64; K]) -> [[f64; K]; K] {
-        let (l, n, dg) = self.line(x);
-        let dl: [f64; K] = std::array::from_fn(|j| n[0] * dg[0][j] + n[1] * dg[1][j] + n[2] * dg[2][j]);
+        let (l, n, dg, dl) = self.line(x);
         let force = self.k * (l - self.length);
         let mut h = [[0.0; K]; K];
         for a in 0..K {
