@@ -342,20 +342,25 @@ pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x
     jac
 }
 
-/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval`: `Φ` along
-/// `x + ε₁eᵢ + ε₂eⱼ`, its `ε₁ε₂` parts, one pass per pair `i ≤ j`.
+/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval` ([`second_derivatives`]).
 pub fn curvature_of<C: Constraint<K, R>, const K: usize, const R: usize>(
     c: &C,
     x: [f64; K],
     t: f64,
     w: &[f64; R],
 ) -> [[f64; K]; K] {
+    second_derivatives(&x, |y| c.eval(y, t.into()).iter().zip(w).map(|(r, w)| r.eps1eps2 * w).sum())
+}
+
+/// The second derivatives of a scalar function at `x`: `f` along
+/// `x + ε₁eᵢ + ε₂eⱼ`, whose `ε₁ε₂` part `f` returns, one pass per pair `i ≤ j`.
+#[inline(always)]
+pub(crate) fn second_derivatives<const K: usize>(x: &[f64; K], f: impl Fn([HyperDual64; K]) -> f64) -> [[f64; K]; K] {
     let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
     let mut h = [[0.0; K]; K];
     for i in 0..K {
         for j in i..K {
-            let rows = c.eval(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0)), t.into());
-            h[i][j] = rows.iter().zip(w).map(|(r, w)| r.eps1eps2 * w).sum::<f64>();
+            h[i][j] = f(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0)));
             h[j][i] = h[i][j];
         }
     }

@@ -6,8 +6,8 @@
 //! energy constraint integrates.
 
 use crate::ad::scalar::Scalar;
-use crate::model::constraint::{JET_FROM, block_entries, seeded, seeded_jets};
-use num_dual::{Dual64, HyperDual64};
+use crate::model::constraint::{JET_FROM, block_entries, second_derivatives, seeded, seeded_jets};
+use num_dual::Dual64;
 use std::any::Any;
 
 /// Potential energy `V(x)` of `K` coordinates.
@@ -39,18 +39,9 @@ pub trait Potential<const K: usize>: Send + Sync + 'static {
     }
 }
 
-/// `∇²V(x)` by hyper-dual passes: `V` along `x + ε₁eᵢ + ε₂eⱼ`, its `ε₁ε₂`
-/// part, one pass per pair `i ≤ j`.
+/// `∇²V(x)` by hyper-dual passes of `p.energy` ([`second_derivatives`]).
 pub fn hessian_of<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> [[f64; K]; K] {
-    let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
-    let mut h = [[0.0; K]; K];
-    for i in 0..K {
-        for j in i..K {
-            h[i][j] = p.energy(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0))).eps1eps2;
-            h[j][i] = h[i][j];
-        }
-    }
-    h
+    second_derivatives(&x, |y| p.energy(y).eps1eps2)
 }
 
 /// A non-conservative generalized force on `K` coordinates, from their

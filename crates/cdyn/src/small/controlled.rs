@@ -126,7 +126,7 @@ impl<S: SmallSystem<N, M>, const N: usize, const M: usize> System for SmallContr
         std::mem::take(&mut self.d.dropped)
     }
     fn last_violation(&self) -> f64 {
-        self.d.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
+        self.d.max_violation()
     }
     fn measure(&mut self, x: &[f64], t: f64) -> Measures {
         let (q, v, e) = split(x);

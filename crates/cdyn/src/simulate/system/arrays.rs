@@ -132,7 +132,7 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
         let mut lambda = rhs;
         self.solve(&mut lambda);
         // A = M⁻¹ (G − Φ_qᵀ λ)   (Eq. 8)
-        self.subtract_weighted_jt(&lambda, &mut acc);
+        self.add_weighted_jt(&lambda, -1.0, &mut acc);
         (self.lambda, self.acc) = (lambda, acc);
         Ok(())
     }
@@ -229,15 +229,9 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
         }
     }
 
-    /// `out −= M⁻¹ Φ_qᵀ y`
-    #[inline(always)]
-    pub(crate) fn subtract_weighted_jt(&self, y: &[f64; M], out: &mut [f64]) {
-        let weight = self.mass.inverse();
-        for r in 0..M {
-            for c in 0..N {
-                out[c] -= weight[c] * self.jac[r][c] * y[r];
-            }
-        }
+    /// The largest `|Φ|` of the last evaluation.
+    pub(crate) fn max_violation(&self) -> f64 {
+        self.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
     }
 }
 
@@ -264,13 +258,14 @@ impl<const N: usize, const M: usize> Evaluation for ArrayDynamics<N, M> {
     fn add_constraint_response(&self, b: &mut [f64], out: &mut [f64]) {
         let b: &mut [f64; M] = b.try_into().expect("one value per constraint row");
         self.solve(b);
-        self.subtract_weighted_jt(b, out);
+        self.add_weighted_jt(b, -1.0, out);
     }
     fn solve_many(&self, bs: &mut [&mut [f64]]) {
         for b in bs.iter_mut() {
             self.solve((&mut **b).try_into().expect("one value per constraint row"));
         }
     }
+    #[inline(always)]
     fn add_weighted_jt(&self, y: &[f64], scale: f64, out: &mut [f64]) {
         let weight = self.mass.inverse();
         for r in 0..M {

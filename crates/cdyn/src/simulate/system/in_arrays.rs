@@ -66,7 +66,7 @@ impl<const N: usize, const M: usize> InArrays for ModelInArrays<N, M> {
         self.d.controlled_rhs(control, e0, &mut self.work, (x, t), f, u, evaluate)
     }
     fn last_violation(&self) -> f64 {
-        self.d.phi.iter().fold(0.0_f64, |a, p| a.max(p.abs()))
+        self.d.max_violation()
     }
     fn take_dropped(&mut self) -> usize {
         std::mem::take(&mut self.d.dropped)
