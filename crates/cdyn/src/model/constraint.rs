@@ -342,7 +342,7 @@ pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x
     jac
 }
 
-/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval` ([`second_derivatives`]).
+/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval`, one per pair of coordinates.
 pub fn curvature_of<C: Constraint<K, R>, const K: usize, const R: usize>(
     c: &C,
     x: [f64; K],

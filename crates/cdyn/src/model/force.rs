@@ -39,7 +39,7 @@ pub trait Potential<const K: usize>: Send + Sync + 'static {
     }
 }
 
-/// `∇²V(x)` by hyper-dual passes of `p.energy` ([`second_derivatives`]).
+/// `∇²V(x)` by hyper-dual passes of `p.energy`, one per pair of coordinates.
 pub fn hessian_of<P: Potential<K>, const K: usize>(p: &P, x: [f64; K]) -> [[f64; K]; K] {
     second_derivatives(&x, |y| p.energy(y).eps1eps2)
 }
