@@ -88,21 +88,25 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
         v: [f64; N],
         t: f64,
     ) -> Result<(), Breakdown> {
+        // Every output an element writes is read back value by value (`read_each`).
         let mut grad = [0.0; N];
         self.potential = model.potential(&q, Some(&mut grad));
+        let grad = read_each(&grad);
         let mut force = grad.map(|g| -g);
         self.force_power = model.add_forces(&q, &v, t, &mut force);
+        let force = read_each(&force);
         self.grad_potential = grad;
         let mut acc = [0.0; N];
         self.mass.solve(&force, &mut acc);
         let (mut rhs, mut gamma, mut values) = ([0.0; M], [0.0; M], [[0.0; N]; M]);
+        let (mut phi, mut phi_dot, mut phi_t) = ([0.0; M], [0.0; M], [0.0; M]);
         let jac = values.as_flattened_mut();
         let out = ConstraintValues {
             free_acc: &acc,
             rhs: &mut rhs,
-            phi: &mut self.phi,
-            phi_dot: &mut self.phi_dot,
-            phi_t: &mut self.phi_t,
+            phi: &mut phi,
+            phi_dot: &mut phi_dot,
+            phi_t: &mut phi_t,
             gamma: &mut gamma,
             jac: match places {
                 Some(places) => &mut jac[..places.len()],
@@ -110,6 +114,9 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
             },
         };
         model.constraints(&q, &v, t, out);
+        let values = values.map(|row| read_each(&row));
+        (self.phi, self.phi_dot, self.phi_t) = (read_each(&phi), read_each(&phi_dot), read_each(&phi_t));
+        let rhs = read_each(&rhs);
         self.jac = match places {
             None => values,
             Some(places) => {
@@ -117,7 +124,7 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
                 for (&(r, c), x) in places.iter().zip(values.as_flattened()) {
                     rows[r as usize][c as usize] += x;
                 }
-                rows
+                rows.map(|row| read_each(&row))
             }
         };
         self.finish(rhs, acc)
@@ -277,6 +284,18 @@ impl<const N: usize, const M: usize> Evaluation for ArrayDynamics<N, M> {
     fn phi_t(&self) -> &[f64] {
         &self.phi_t
     }
+}
+
+/// `a`, read value by value. A model's element writes its outputs a value
+/// at a time, through a call the compiler cannot see into; read as vectors
+/// right after, two such writes still on their way to the cache cannot be
+/// forwarded to one load, which then waits for both to reach the cache
+/// (the general step of Example 1 took 71 ns instead of 56, the double
+/// pendulum's 153 ns instead of 117).
+#[inline(always)]
+fn read_each<const K: usize>(a: &[f64; K]) -> [f64; K] {
+    // SAFETY: each pointer is to an initialized `f64` of the borrowed array.
+    std::array::from_fn(|i| unsafe { std::ptr::read_volatile(&a[i]) })
 }
 
 /// The work space of the control laws on arrays, kept so that no
