@@ -78,6 +78,7 @@ pub mod linalg;
 pub mod model;
 pub mod models;
 pub mod planar;
+mod random;
 pub mod record;
 pub mod reference;
 pub mod simulate;

@@ -6,7 +6,7 @@
 //! projections onto the constraint manifold shared by assembly
 //! ([`assemble`]) and the exact projection.
 //!
-//! May import: `error`, `ad`, `linalg`, `model`.
+//! May import: `error`, `ad`, `linalg`, `model`, `random`.
 
 pub mod assemble;
 pub mod diagnostics;

@@ -328,13 +328,10 @@ mod tests {
     use crate::model::constraint::jacobian_of;
     use crate::model::timefn::TimeFn;
 
-    /// A reproducible stream of numbers in (−1, 1).
+    /// A reproducible stream of numbers in [−1, 1).
     fn numbers(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
+        let mut lcg = crate::random::Lcg(seed);
+        move || lcg.next()
     }
 
     /// The joints' composed Jacobians, second-order rows and curvatures

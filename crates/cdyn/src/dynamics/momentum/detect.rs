@@ -7,19 +7,9 @@ use crate::linalg::mass::MassMatrix;
 use crate::linalg::{dot, norm};
 use crate::model::Model;
 use crate::model::angular::Generator;
+use crate::random::Lcg;
 
 use super::*;
-
-/// A small deterministic generator for the sample states.
-struct Lcg(u64);
-
-impl Lcg {
-    /// Uniform in `[−1, 1)`.
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-}
 
 /// Times at which the random samples are taken (time-dependent forces
 /// and drives are seen there).

@@ -23,7 +23,7 @@
 //! the kinetic energy of the motion relative to the momenta), so that `Ψ`
 //! still decays at its rate (docs: "Corrections that keep the momenta").
 //!
-//! May import: `linalg`, `model`, and the rest of `dynamics`.
+//! May import: `linalg`, `model`, `random`, and the rest of `dynamics`.
 
 use crate::model::Model;
 use crate::model::angular::Generator;
