@@ -231,6 +231,10 @@ pub(crate) struct Work {
     v0: Vec<f64>,
     /// The Newton right-hand side and solution, `n + m`.
     rhs: Vec<f64>,
+    /// The last accepted iterate (`q̈`, then `λ`) and the full correction
+    /// taken from it, `n + m`: where a damped iterate steps back to.
+    base: Vec<f64>,
+    along: Vec<f64>,
     /// The sizes of the residual's terms, `n` (see `settled`).
     terms: Vec<f64>,
 }
@@ -238,6 +242,11 @@ pub(crate) struct Work {
 /// A Newton correction larger than this fraction of the one before makes
 /// the next iterate refactor the matrix.
 const SLOW_CONTRACTION: f64 = 0.5;
+
+/// The shortest share of a correction a damped Newton iterate takes
+/// (halved from 1 while the residual does not shrink): past it the
+/// iteration goes on from there, to converge or run out of iterations.
+const MIN_DAMPING: f64 = 1.0 / 256.0;
 
 /// A position correction this small (relative to the largest coordinate)
 /// is round-off: Newton stops there whatever its tolerance.

@@ -60,6 +60,8 @@ impl Work {
             q0: vec![0.0; n],
             v0: vec![0.0; n],
             rhs: vec![0.0; n + m],
+            base: vec![0.0; n + m],
+            along: vec![0.0; n + m],
             terms: vec![0.0; n],
         }
     }

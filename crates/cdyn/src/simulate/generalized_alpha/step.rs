@@ -43,6 +43,20 @@ pub(crate) fn step(
     let t1 = t + h;
     let (mut iterations, mut last) = (0, f64::INFINITY);
     let mut refactor = true;
+    // Damped Newton (with `Newton::Converge`): an iterate whose residual is
+    // no smaller than that of the last accepted one (`base`, from which the
+    // correction `along` was taken) is not accepted. A correction from a
+    // matrix of an earlier iterate is made again from the base's own
+    // matrix; one from the base's matrix is taken in halves. Where Newton
+    // converges the residuals shrink and every correction is taken whole,
+    // as without damping; a force that saturates, as regularized friction
+    // does, otherwise throws the iterates back and forth across its knee.
+    let damps = matches!(w.settings.newton, Newton::Converge { .. });
+    let (mut damping, mut base_residual, mut exact): (f64, f64, bool) = (1.0, f64::INFINITY, true);
+    // Whether a correction of this step was not accepted: from then on,
+    // every iterate gets its own matrix (full Newton converges at once
+    // where a stale matrix crawls, near the knee that needed the damping).
+    let mut damped = false;
     let correction = loop {
         *evaluations += 1;
         // A fresh Newton matrix with tolerated dependent rows: the full
@@ -54,6 +68,28 @@ pub(crate) fn step(
             w.find_dropped(d);
         }
         residual(model, d, w, c_q, gamma_prime);
+        let size = w.rhs.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if damps && size >= base_residual && (!exact || damping > MIN_DAMPING) {
+            if let Newton::Converge { max_iterations, .. } = w.settings.newton
+                && iterations == max_iterations
+            {
+                return Err(Failure::NotConverged { correction: last, iterations });
+            }
+            // Back to the base: its own matrix, or half the step.
+            damped = true;
+            (damping, refactor) = if exact { (0.5 * damping, false) } else { (0.0, true) };
+            if !exact {
+                // The base's residual is evaluated again, and accepted.
+                (base_residual, exact) = (f64::INFINITY, true);
+            }
+            let (base, along) = (&w.base, &w.along);
+            for (i, a) in w.acc_new.iter_mut().chain(w.lambda_new.iter_mut()).enumerate() {
+                *a = base[i] + damping * along[i];
+            }
+            states(w, q, v);
+            iterations += 1;
+            continue;
+        }
         // The last correction did not halve the one before. Where the
         // iterate already solves the equations (its residual), the
         // corrections are round-off magnified by a near-singular matrix (a
@@ -66,19 +102,21 @@ pub(crate) fn step(
         {
             break last;
         }
+        refactor |= damped;
         if refactor {
             newton_matrix(model, d, q, v, t1, c_q, c_v, w);
             if w.lu.factor(&w.values).is_err() {
                 return Err(singular(model, d, q, v, t1, iterations));
             }
         }
+        exact = refactor;
         w.lu.solve(&mut w.rhs);
         let correction = beta_prime * w.rhs[..n].iter().fold(0.0_f64, |a, x| a.max(x.abs())) / scale;
         // Converging slower than halving a correction: the matrix of the
         // step's start is too far from the iterate's (the multipliers and
         // the configuration moved), so the next correction gets a fresh
         // one. A fixed count keeps one factorization a step.
-        refactor = matches!(w.settings.newton, Newton::Converge { .. }) && correction > SLOW_CONTRACTION * last;
+        refactor = damps && correction > SLOW_CONTRACTION * last;
         last = correction;
         if !correction.is_finite() || w.rhs[n..].iter().any(|x| !x.is_finite()) {
             return Err(singular(model, d, q, v, t1, iterations));
@@ -91,11 +129,11 @@ pub(crate) fn step(
             Newton::Fixed { iterations: fixed } if iterations == fixed => break correction,
             _ => {}
         }
-        for (a, dq) in w.acc_new.iter_mut().zip(&w.rhs[..n]) {
-            *a += beta_prime * dq;
-        }
-        for (l, dmu) in w.lambda_new.iter_mut().zip(&w.rhs[n..]) {
-            *l += beta_prime * dmu;
+        (damping, base_residual) = (1.0, size);
+        let (base, along) = (&mut w.base, &mut w.along);
+        for (i, a) in w.acc_new.iter_mut().chain(w.lambda_new.iter_mut()).enumerate() {
+            (base[i], along[i]) = (*a, beta_prime * w.rhs[i]);
+            *a += along[i];
         }
         states(w, q, v);
         iterations += 1;
