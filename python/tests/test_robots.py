@@ -242,6 +242,33 @@ def test_joint_trajectories_agree_with_pinocchio(relative, t_end, joints):
     assert worst[0] < 1e-8 and worst[1] < 1e-8, worst
 
 
+# Z1's joints have regularized Coulomb friction (slip 0.01 rad/s) on light
+# wrist links: too stiff for RK-4 at H, whose refusal names
+# generalized_alpha, which then takes it (its Newton iteration damped
+# across the friction law's knee). Halving its step moves the joints by
+# its O(h²) error only.
+def test_z1s_friction_refuses_rk4_and_runs_under_generalized_alpha():
+    robot = Robot(Z1)
+
+    def run(scheme, h):
+        scenario = {
+            "model": {"kind": "spatial", "urdf": str(robot.path), "gravity": GRAVITY},
+            "integrator": {"scheme": scheme, "h": h, "t_end": 0.05},
+            "output": {"every": round(0.01 / h)},
+        }
+        return cdyn.run(cdyn.from_dict(scenario))
+
+    with pytest.raises(Exception, match="generalized_alpha"):
+        run("rk4", H)
+    coarse, fine = run("generalized_alpha", H), run("generalized_alpha", H / 2)
+    assert coarse.error is None and fine.error is None, (coarse.error, fine.error)
+    a, b = robot.cdyn_joints(coarse.q, coarse.v), robot.cdyn_joints(fine.q, fine.v)
+    travel = max(abs(values[-1][0] - values[0][0]) for values in a.values())
+    gap = max(abs(wrapped(x[0] - y[0])) for name in a for x, y in zip(a[name], b[name]))
+    print("Z1 travel", travel, "h against h/2", gap)
+    assert travel > 1e-3 and gap < 1e-3 * travel, (travel, gap)
+
+
 def test_panda_at_its_zero_pose_is_refused_past_joint_4s_limit():
     scenario = cdyn.from_dict(
         {
