@@ -6,12 +6,13 @@ the same machine), microseconds per call:
 - cdyn (`examples/robot_step.rs`): a step of AB-3 without control (one
   evaluation of the dynamics in redundant coordinates: M(q) by blocks,
   Φ_q and γ by automatic differentiation, S factored), of AB-3 with
-  `robust`, and of RK-4 (four evaluations), h = 1e-4, best of 5 trials;
+  `robust`, of RK-4 (four evaluations) and of generalized-α (implicit),
+  h = 1e-4, best of 5 trials;
 - Pinocchio: `pin.aba` (forward dynamics in joint coordinates) called from
   Python, best of 5 trials of 20 000 calls, less the same call on a model
   of one revolute joint (the per-call floor of Python and the bindings,
   0.3-0.5 µs here), which leaves the C++ ABA's own cost;
-- MuJoCo: `mj_step` with its Euler and RK4 integrators, looped in C
+- MuJoCo: `mj_step` with its Euler, RK4 and implicitfast integrators, looped in C
   (`nstep`), on the URDF with its visual and collision elements removed
   (MuJoCo cannot read the package's meshes) and contacts off.
 
@@ -102,8 +103,9 @@ def main():
     root = robots_dir()
     floor = best_per_call(aba_call(floor_model()))
     print(f"Pinocchio per-call floor (ABA of one revolute joint from Python): {floor:.3f} µs")
-    print("| Robot | n, m | cdyn AB-3 | cdyn AB-3, robust | cdyn RK-4 | Pinocchio ABA (C++) | MuJoCo Euler | MuJoCo RK4 |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| Robot | n, m | cdyn AB-3 | cdyn AB-3, robust | cdyn RK-4 | cdyn generalized-α | Pinocchio ABA (C++) "
+          "| MuJoCo Euler | MuJoCo RK4 | MuJoCo implicitfast |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for name, relative in ROBOTS:
         path = os.path.join(root, relative)
         out = subprocess.run([binary, path], check=True, capture_output=True, text=True).stdout
@@ -112,8 +114,10 @@ def main():
         mj = mujoco_model(path)
         euler = mujoco_step(mj, mujoco.mjtIntegrator.mjINT_EULER)
         rk4 = mujoco_step(mj, mujoco.mjtIntegrator.mjINT_RK4)
+        implicit = mujoco_step(mj, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
         print(f"| {name} | {cdyn['n']}, {cdyn['m']} | {cdyn['ab3_us']:.2f} | {cdyn['ab3_robust_us']:.2f} "
-              f"| {cdyn['rk4_us']:.2f} | {aba:.2f} | {euler:.2f} | {rk4:.2f} |")
+              f"| {cdyn['rk4_us']:.2f} | {cdyn['alpha_us']:.2f} | {aba:.2f} | {euler:.2f} | {rk4:.2f} "
+              f"| {implicit:.2f} |")
 
 
 if __name__ == "__main__":

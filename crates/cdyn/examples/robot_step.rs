@@ -2,8 +2,9 @@
 //! docs/robots.md (`tools/robot-costs.sh`): `robot_step ROBOT.urdf [STEPS]`
 //! prints one JSON line with microseconds per step (best of 5 trials) of
 //! AB-3 without control (one evaluation of the dynamics a step), AB-3
-//! with `robust` and RK-4 without control (four evaluations), at h = 1e-4
-//! from the zero pose under gravity. Runs restart every 100 steps, and
+//! with `robust`, RK-4 without control (four evaluations) and
+//! generalized-α (implicit: Newton corrections, one factorization each),
+//! at h = 1e-4 from the zero pose under gravity. Runs restart every 100 steps, and
 //! where a step fails, outside the clock, so that a robot whose friction
 //! makes these steps unstable (Z1, xArm7) is timed on finite states only.
 
@@ -52,8 +53,9 @@ fn main() {
     let ab3 = time(Scheme::AdamsBashforth3, Control::none());
     let robust = time(Scheme::AdamsBashforth3, methods::robust());
     let rk4 = time(Scheme::RungeKutta4, Control::none());
+    let alpha = time(Scheme::GeneralizedAlpha, Control::none());
     println!(
-        "{{\"n\": {}, \"m\": {}, \"ab3_us\": {ab3:.3}, \"ab3_robust_us\": {robust:.3}, \"rk4_us\": {rk4:.3}}}",
+        "{{\"n\": {}, \"m\": {}, \"ab3_us\": {ab3:.3}, \"ab3_robust_us\": {robust:.3}, \"rk4_us\": {rk4:.3}, \"alpha_us\": {alpha:.3}}}",
         built.model.n(),
         built.model.m()
     );
