@@ -2,7 +2,8 @@
 //! oscillator against the scheme's recurrence solved by hand, the damping
 //! of a mode far above `1/h` per step equal to `ρ∞`, `Φ` at the Newton
 //! tolerance on fixed, driven and nonholonomic mechanisms, the fixed
-//! iteration count, and the errors it gives. (Order 2: `convergence.rs`;
+//! iteration count, Newton damped across a friction law's knee, and the
+//! errors it gives. (Order 2: `convergence.rs`;
 //! the stiff flyball governor at h = 1e-3: `spatial.rs`.)
 
 use cdyn::models::{ChainParams, FourBarParams, chain, four_bar};
