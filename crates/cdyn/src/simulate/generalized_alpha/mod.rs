@@ -139,9 +139,11 @@ impl Default for GeneralizedAlpha {
 }
 
 impl GeneralizedAlpha {
-    /// `ρ∞ = 0.9`, Newton to 1e-10 within 20 corrections.
+    /// `ρ∞ = 0.9`, Newton to 1e-10 within 50 corrections: room for the
+    /// damping, whose halvings (to 1/256) and return to the last accepted
+    /// iterate take up to 9 evaluations each time the residual grows.
     pub fn new() -> Self {
-        Self { rho_inf: 0.9, newton: Newton::converge(1e-10, 20) }
+        Self { rho_inf: 0.9, newton: Newton::converge(1e-10, 50) }
     }
 
     /// Checks `ρ∞` and the iteration's bounds.
