@@ -291,7 +291,7 @@ impl<const N: usize, const M: usize> Evaluation for ArrayDynamics<N, M> {
 /// right after, two such writes still on their way to the cache cannot be
 /// forwarded to one load, which then waits for both to reach the cache
 /// (the general step of Example 1 took 71 ns instead of 56, the double
-/// pendulum's 153 ns instead of 117).
+/// pendulum's 170 ns instead of 117).
 #[inline(always)]
 fn read_each<const K: usize>(a: &[f64; K]) -> [f64; K] {
     // SAFETY: each pointer is to an initialized `f64` of the borrowed array.
