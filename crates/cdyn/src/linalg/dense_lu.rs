@@ -86,11 +86,7 @@ impl DenseLu {
 mod tests {
     use super::*;
     use crate::linalg::sparse_lu::SparseLu;
-
-    /// The `k`-th of a spread of numbers in (−1, 1) (the golden ratio's multiples, mod 1).
-    fn spread(k: usize) -> f64 {
-        2.0 * ((k as f64 + 1.0) * 0.618_033_988_749_895).fract() - 1.0
-    }
+    use crate::random::Lcg;
 
     /// A saddle-point matrix like the Newton matrix, `[A, Bᵀ; B, 0]`, with
     /// repeated entries and a zero diagonal block that needs pivoting:
@@ -114,10 +110,10 @@ mod tests {
         }
         // Twice each entry of A's diagonal (repeats add), zero on the multipliers' diagonal.
         entries.extend((0..n as u32).map(|i| (i, i)));
-        let values: Vec<f64> = (entries.iter().enumerate())
-            .map(|(k, &(r, c))| if r == c && r as usize >= n { 0.0 } else { 4.0 * spread(k) })
-            .collect();
-        let b: Vec<f64> = (0..n + m).map(|i| spread(1000 + i)).collect();
+        let mut random = Lcg(7);
+        let values: Vec<f64> =
+            entries.iter().map(|&(r, c)| if r == c && r as usize >= n { 0.0 } else { 4.0 * random.next() }).collect();
+        let b: Vec<f64> = (0..n + m).map(|_| random.next()).collect();
         let mut a = vec![0.0; (n + m) * (n + m)];
         entries.iter().zip(&values).for_each(|(&(r, c), v)| a[r as usize * (n + m) + c as usize] += v);
         let mut dense = DenseLu::new(n + m, &entries);

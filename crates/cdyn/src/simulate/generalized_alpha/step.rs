@@ -51,7 +51,10 @@ pub(crate) fn step(
     // converges the residuals shrink and every correction is taken whole,
     // as without damping; a force that saturates, as regularized friction
     // does, otherwise throws the iterates back and forth across its knee.
-    let damps = matches!(w.settings.newton, Newton::Converge { .. });
+    let newton = w.settings.newton;
+    let damps = matches!(newton, Newton::Converge { .. });
+    let exhausted =
+        |iterations| matches!(newton, Newton::Converge { max_iterations, .. } if iterations == max_iterations);
     let (mut damping, mut base_residual, mut exact): (f64, f64, bool) = (1.0, f64::INFINITY, true);
     // Whether a correction of this step was not accepted: from then on,
     // every iterate gets its own matrix (full Newton converges at once
@@ -70,17 +73,16 @@ pub(crate) fn step(
         residual(model, d, w, c_q, gamma_prime);
         let size = w.rhs.iter().map(|x| x * x).sum::<f64>().sqrt();
         if damps && size >= base_residual && (!exact || damping > MIN_DAMPING) {
-            if let Newton::Converge { max_iterations, .. } = w.settings.newton
-                && iterations == max_iterations
-            {
+            if exhausted(iterations) {
                 return Err(Failure::NotConverged { correction: last, iterations });
             }
-            // Back to the base: its own matrix, or half the step.
+            // Back to the base: half the step, or the base itself, whose
+            // residual is evaluated again and accepted, for its own matrix.
             damped = true;
-            (damping, refactor) = if exact { (0.5 * damping, false) } else { (0.0, true) };
-            if !exact {
-                // The base's residual is evaluated again, and accepted.
-                (base_residual, exact) = (f64::INFINITY, true);
+            if exact {
+                (damping, refactor) = (0.5 * damping, false);
+            } else {
+                (damping, refactor, base_residual, exact) = (0.0, true, f64::INFINITY, true);
             }
             let (base, along) = (&w.base, &w.along);
             for (i, a) in w.acc_new.iter_mut().chain(w.lambda_new.iter_mut()).enumerate() {
@@ -95,7 +97,7 @@ pub(crate) fn step(
         // corrections are round-off magnified by a near-singular matrix (a
         // mechanism near a singular position), and no iteration improves
         // on it: the step ends, reporting the correction it could not make.
-        if let Newton::Converge { tolerance, .. } = w.settings.newton
+        if let Newton::Converge { tolerance, .. } = newton
             && refactor
             && iterations > 0
             && settled(model, d, w, q, v, c_q, gamma_prime, tolerance)
@@ -121,9 +123,9 @@ pub(crate) fn step(
         if !correction.is_finite() || w.rhs[n..].iter().any(|x| !x.is_finite()) {
             return Err(singular(model, d, q, v, t1, iterations));
         }
-        match w.settings.newton {
+        match newton {
             Newton::Converge { tolerance, .. } if correction <= tolerance + round_off => break correction,
-            Newton::Converge { max_iterations, .. } if iterations == max_iterations => {
+            Newton::Converge { .. } if exhausted(iterations) => {
                 return Err(Failure::NotConverged { correction, iterations });
             }
             Newton::Fixed { iterations: fixed } if iterations == fixed => break correction,

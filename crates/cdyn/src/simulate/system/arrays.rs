@@ -114,11 +114,10 @@ impl<const N: usize, const M: usize> ArrayDynamics<N, M> {
             },
         };
         model.constraints(&q, &v, t, out);
-        let values = values.map(|row| read_each(&row));
         (self.phi, self.phi_dot, self.phi_t) = (read_each(&phi), read_each(&phi_dot), read_each(&phi_t));
         let rhs = read_each(&rhs);
         self.jac = match places {
-            None => values,
+            None => values.map(|row| read_each(&row)),
             Some(places) => {
                 let mut rows = [[0.0; N]; M];
                 for (&(r, c), x) in places.iter().zip(values.as_flattened()) {
