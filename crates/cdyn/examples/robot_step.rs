@@ -4,9 +4,11 @@
 //! AB-3 without control (one evaluation of the dynamics a step), AB-3
 //! with `robust`, RK-4 without control (four evaluations) and
 //! generalized-α (implicit: Newton corrections, one factorization each),
-//! at h = 1e-4 from the zero pose under gravity. Runs restart every 100 steps, and
-//! where a step fails, outside the clock, so that a robot whose friction
-//! makes these steps unstable (Z1, xArm7) is timed on finite states only.
+//! at h = 1e-4 from the zero pose under gravity. Runs restart every 100 steps,
+//! and where a step fails: the failed step's time is on the clock but it is
+//! not counted as a step, so that a robot whose friction makes these steps
+//! unstable (Z1, xArm7) is timed on finite states only (a failure adds the
+//! cost of one step to the run, never a step to the count).
 
 use cdyn::control::methods;
 use cdyn::{Control, Scheme, Settings, Simulation};

@@ -342,24 +342,39 @@ pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x
     jac
 }
 
-/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval`, one per pair of coordinates.
+/// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval`, one per pair of the
+/// coordinates some row [`reads`](Constraint::reads) (a joint's angle on
+/// two bodies: 36 pairs of their Euler parameters, not 105 of all 14).
 pub fn curvature_of<C: Constraint<K, R>, const K: usize, const R: usize>(
     c: &C,
     x: [f64; K],
     t: f64,
     w: &[f64; R],
 ) -> [[f64; K]; K] {
-    second_derivatives(&x, |y| c.eval(y, t.into()).iter().zip(w).map(|(r, w)| r.eps1eps2 * w).sum())
+    let rows = c.reads();
+    let read = std::array::from_fn(|j| rows.iter().any(|row| row[j]));
+    second_derivatives_of(&x, &read, |y| c.eval(y, t.into()).iter().zip(w).map(|(r, w)| r.eps1eps2 * w).sum())
 }
 
 /// The second derivatives of a scalar function at `x`: `f` along
 /// `x + ε₁eᵢ + ε₂eⱼ`, whose `ε₁ε₂` part `f` returns, one pass per pair `i ≤ j`.
 #[inline(always)]
 pub(crate) fn second_derivatives<const K: usize>(x: &[f64; K], f: impl Fn([HyperDual64; K]) -> f64) -> [[f64; K]; K] {
+    second_derivatives_of(x, &[true; K], f)
+}
+
+/// As [`second_derivatives`], where `f` depends on the coordinates marked
+/// in `read` only (the others' rows and columns are zero).
+#[inline(always)]
+fn second_derivatives_of<const K: usize>(
+    x: &[f64; K],
+    read: &[bool; K],
+    f: impl Fn([HyperDual64; K]) -> f64,
+) -> [[f64; K]; K] {
     let unit = |k: usize, i: usize| if k == i { 1.0 } else { 0.0 };
     let mut h = [[0.0; K]; K];
-    for i in 0..K {
-        for j in i..K {
+    for i in (0..K).filter(|&i| read[i]) {
+        for j in (i..K).filter(|&j| read[j]) {
             h[i][j] = f(std::array::from_fn(|k| HyperDual64::new(x[k], unit(k, i), unit(k, j), 0.0)));
             h[j][i] = h[i][j];
         }

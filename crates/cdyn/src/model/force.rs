@@ -5,6 +5,7 @@
 //! force on its coordinates; its power `F·v` is the energy input `Ė` that the
 //! energy constraint integrates.
 
+use crate::ad::jet::JetN;
 use crate::ad::scalar::Scalar;
 use crate::model::constraint::{JET_FROM, block_entries, second_derivatives, seeded, seeded_jets};
 use num_dual::Dual64;
@@ -178,6 +179,24 @@ impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
 
     fn jacobians(&self, q: &[f64], v: &[f64], t: f64, c_q: f64, c_v: f64, out: &mut [f64]) -> usize {
         for ((f, idx), block) in self.items.iter().zip(out.chunks_exact_mut(K * K)) {
+            if K > JET_FROM {
+                // One jet pass, coordinate `j`'s position and rate seeded
+                // alike in direction `j`: where each scalar pass evaluated the
+                // force again (a joint's friction on two bodies' rotations,
+                // K = 8, its angle by `atan2` eight times).
+                let seed = |x: &[f64], c: f64| {
+                    std::array::from_fn(|j| {
+                        let mut jet = JetN::<K>::seeded(x[idx[j]], j);
+                        jet.eps.0[j] = c;
+                        jet
+                    })
+                };
+                let forces = f.force(seed(q, c_q), seed(v, c_v), JetN::from_re(t));
+                for (row, force) in block.chunks_exact_mut(K).zip(&forces) {
+                    row.iter_mut().zip(force.eps.0.iter()).for_each(|(b, d)| *b = -d);
+                }
+                continue;
+            }
             for j in 0..K {
                 let x = std::array::from_fn(|k| Dual64::new(q[idx[k]], if k == j { c_q } else { 0.0 }));
                 let xd = std::array::from_fn(|k| Dual64::new(v[idx[k]], if k == j { c_v } else { 0.0 }));
@@ -196,5 +215,68 @@ impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::Lcg;
+
+    /// A force on `K` coordinates, nonlinear in positions, rates and time.
+    struct Wobble;
+    impl<const K: usize> Force<K> for Wobble {
+        fn force<D: Scalar>(&self, x: [D; K], xd: [D; K], t: D) -> [D; K] {
+            std::array::from_fn(|i| {
+                (x[i] * x[(i + 1) % K] + t).sin() * xd[(i + 2) % K] - xd[i] * xd[i] * x[(i + 3) % K]
+            })
+        }
+    }
+
+    /// `−(c_q ∂f/∂q + c_v ∂f/∂v)` of a group — by a jet pass over more than
+    /// `JET_FROM` coordinates, by scalar passes over fewer — against central
+    /// differences of its forces, on coordinates shuffled among others.
+    fn jacobians_match_differences<const K: usize>() {
+        let mut random = Lcg(K as u64);
+        let n = K + 3;
+        // Distinct, out of order (5 is prime to n = 6 and 11).
+        let idx: [usize; K] = std::array::from_fn(|i| (5 * i + 2) % n);
+        let group = ForceGroup { items: vec![(Wobble, idx)] };
+        let (q, v): (Vec<f64>, Vec<f64>) =
+            ((0..n).map(|_| random.next()).collect(), (0..n).map(|_| random.next()).collect());
+        let (t, c_q, c_v) = (0.3, 0.7, -1.9);
+        let mut block = vec![0.0; K * K];
+        assert_eq!(group.jacobians(&q, &v, t, c_q, c_v, &mut block), K * K);
+        let forces = |q: &[f64], v: &[f64]| {
+            let mut f = vec![0.0; n];
+            group.add_forces(q, v, t, &mut f);
+            f
+        };
+        let step = 1e-6;
+        for (j, &c) in idx.iter().enumerate() {
+            let shifted = |x: &[f64], by: f64| {
+                let mut x = x.to_vec();
+                x[c] += by;
+                x
+            };
+            let dq = (forces(&shifted(&q, step), &v), forces(&shifted(&q, -step), &v));
+            let dv = (forces(&q, &shifted(&v, step)), forces(&q, &shifted(&v, -step)));
+            for (i, &r) in idx.iter().enumerate() {
+                let by_q = (dq.0[r] - dq.1[r]) / (2.0 * step);
+                let by_v = (dv.0[r] - dv.1[r]) / (2.0 * step);
+                let expected = -(c_q * by_q + c_v * by_v);
+                assert!(
+                    (block[i * K + j] - expected).abs() < 1e-8,
+                    "K = {K}, ({i}, {j}): {} vs {expected}",
+                    block[i * K + j]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn force_jacobians_match_central_differences() {
+        jacobians_match_differences::<3>();
+        jacobians_match_differences::<8>();
     }
 }

@@ -65,6 +65,16 @@ impl JointCoordinate {
         }
     }
 
+    /// Marks in `read` the coordinates [`at`](Self::at) depends on: an
+    /// angle turns with the sides' Euler parameters alone, a displacement
+    /// moves with their positions too.
+    pub(super) fn reads(&self, sides: [Option<usize>; 2], read: &mut [bool]) {
+        let from = if self.rotary { 3 } else { 0 };
+        for k in sides.into_iter().flatten() {
+            read[7 * k + from..7 * k + 7].fill(true);
+        }
+    }
+
     /// `θ` of the joint whose sides are `sides` (a body's slot in `x`, or
     /// the ground) in the coordinates `x` of `K / 7` bodies.
     pub(super) fn at<D: Scalar, const K: usize>(&self, x: &[D; K], sides: [Option<usize>; 2], reference: D) -> D {
@@ -95,6 +105,12 @@ impl<const K: usize> Constraint<K, 1> for Mimic {
         let leader = self.leader.0.at(&x, self.leader.1, zero);
         [self.follower.0.at(&x, self.follower.1, leader * self.multiplier + self.offset)]
     }
+    fn reads(&self) -> [[bool; K]; 1] {
+        let mut read = [false; K];
+        self.leader.0.reads(self.leader.1, &mut read);
+        self.follower.0.reads(self.follower.1, &mut read);
+        [read]
+    }
 }
 
 /// The row holding a joint at a stop of its limit: `g = s (θ − bound)`,
@@ -111,6 +127,11 @@ impl<const K: usize> Constraint<K, 1> for StopRow {
     fn eval<D: Scalar>(&self, x: [D; K], _t: D) -> [D; 1] {
         let b = (K == 14).then_some(1);
         [self.coordinate.at(&x, [Some(0), b], D::from(self.bound)) * self.sign]
+    }
+    fn reads(&self) -> [[bool; K]; 1] {
+        let mut read = [false; K];
+        self.coordinate.reads([Some(0), (K == 14).then_some(1)], &mut read);
+        [read]
     }
 }
 
@@ -166,5 +187,54 @@ impl JointSpace {
         let x: [Dual2_64; 14] = std::array::from_fn(|k| Dual2_64::new(q[body(k)], v[body(k)], a[body(k)]));
         let theta = r.coordinate.in_range(&x, [Some(0), r.b.map(|_| 1)], r.range);
         [theta.re, theta.v1, theta.v2]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::constraint::{curvature_of, jacobian_of, second_derivatives};
+    use crate::random::Lcg;
+
+    /// A joint coordinate on random frames, revolute or prismatic.
+    fn coordinate(rotary: bool, random: &mut Lcg) -> JointCoordinate {
+        let mut frame = || Frame {
+            s: std::array::from_fn(|_| random.next()),
+            axes: std::array::from_fn(|_| std::array::from_fn(|_| random.next())),
+        };
+        JointCoordinate { rotary, a: frame(), b: frame() }
+    }
+
+    /// What a row reads holds every non-zero of its Jacobian (a jet pass),
+    /// and its curvature over those coordinates alone is the curvature over
+    /// all of them, to the bit: for a stop on one body or two and a
+    /// `<mimic>` between two joints, of angles and of displacements.
+    fn reads_cover_the_derivatives<C: Constraint<K, 1>, const K: usize>(row: &C, random: &mut Lcg) {
+        for _ in 0..10 {
+            let x: [f64; K] = std::array::from_fn(|_| random.next());
+            let (jac, reads) = (jacobian_of(row, x, 0.0), row.reads());
+            assert!(jac[0].iter().zip(&reads[0]).all(|(j, &r)| r || *j == 0.0), "{jac:?} {reads:?}");
+            let all = second_derivatives(&x, |y| row.eval(y, 0.0.into())[0].eps1eps2 * 1.5);
+            assert_eq!(curvature_of(row, x, 0.0, &[1.5]), all);
+        }
+    }
+
+    #[test]
+    fn joint_coordinate_rows_read_what_they_depend_on() {
+        let mut random = Lcg(3);
+        for rotary in [true, false] {
+            let stop = StopRow { coordinate: coordinate(rotary, &mut random), bound: 0.3, sign: -1.0 };
+            reads_cover_the_derivatives::<_, 7>(&stop, &mut random);
+            reads_cover_the_derivatives::<_, 14>(&stop, &mut random);
+            let follower = (coordinate(rotary, &mut random), [Some(0), Some(1)]);
+            let leader = (coordinate(!rotary, &mut random), [Some(2), None]);
+            let mimic = Mimic { follower, leader, multiplier: 0.8, offset: 0.1 };
+            reads_cover_the_derivatives::<_, 21>(&mimic, &mut random);
+        }
+        // An angle does not read the bodies' positions; a displacement does.
+        let stop = |rotary, random: &mut Lcg| StopRow { coordinate: coordinate(rotary, random), bound: 0.0, sign: 1.0 };
+        let read = <StopRow as Constraint<14, 1>>::reads(&stop(true, &mut random))[0];
+        assert_eq!(read.iter().filter(|r| **r).count(), 8);
+        assert!(<StopRow as Constraint<14, 1>>::reads(&stop(false, &mut random))[0].iter().all(|r| *r));
     }
 }
