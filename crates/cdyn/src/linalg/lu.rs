@@ -1,22 +1,32 @@
-//! The Newton matrix's LU: dense where the pattern fills a sixth of the
-//! matrix or more, sparse otherwise. A sparse LU's analysis and index
-//! bookkeeping cost more than the arithmetic of the zeros it skips until
-//! the pattern is thin: generalized-α without control, µs per step, faer's
-//! sparse LU against [`DenseLu`] (best of 5 runs of 2 000 steps):
+//! The Newton matrix's LU: in dense storage up to `DENSE_UP_TO` unknowns
+//! (or where the pattern fills a sixth of the matrix or more), by faer's
+//! sparse LU beyond. The dense kernel eliminates along the pattern of its
+//! factors, in an order that keeps them sparse ([`DenseLu`]), so it skips
+//! what a sparse LU skips without that LU's analysis and index
+//! bookkeeping; past some hundreds of unknowns, clearing and scattering
+//! the dense matrix costs more. Generalized-α without control, h = 1e-3,
+//! µs per step (best of 5 runs of 2 000 steps, 2026-12-07):
 //!
-//! | model | unknowns | pattern's share | sparse | dense |
-//! |---|---|---|---|---|
-//! | planar chain, 10 links | 30 | 0.22 | 7.2 | 4.4 |
-//! | planar chain, 13 links | 39 | 0.17 | 6.3 | 6.6 |
-//! | planar chain, 16 links | 48 | 0.14 | 11.6 | 13.2 |
-//! | spatial chain, 6 bodies | 66 | 0.30 | 36.8 | 21.5 |
-//! | spatial chain, 10 bodies | 110 | 0.19 | 59.4 | 57.3 |
-//! | spatial chain, 12 bodies | 132 | 0.16 | 74.7 | 83.2 |
+//! | model | unknowns | dense | sparse |
+//! |---|---|---|---|
+//! | planar chain, 10 links | 30 | 4.2 | 7.3 |
+//! | planar chain, 50 links | 150 | 15.3 | 25.6 |
+//! | planar chain, 100 links | 300 | 35.4 | 51.0 |
+//! | planar chain, 200 links | 600 | 86.3 | 155.3 |
+//! | planar chain, 300 links | 900 | 178.8 | 164.0 |
+//! | spatial chain, 6 bodies | 66 | 20.0 | 37.8 |
+//! | spatial chain, 50 bodies | 550 | 148.1 | 326.9 |
+//! | spatial chain, 100 bodies | 1 100 | 404.0 | 680.3 |
 //!
-//! Both kinds cross over near a share of 0.18, where the rule sits.
+//! (Before the dense kernel eliminated along the pattern, with partial
+//! pivoting over whole rows, the two crossed over near a share of 0.18:
+//! the spatial chain of 12 bodies, 132 unknowns, 83.2 against 74.7 µs.)
 
 use super::dense_lu::DenseLu;
 use super::sparse_lu::{Singular, SparseLu};
+
+/// The most unknowns factored in dense storage, whatever the pattern.
+const DENSE_UP_TO: usize = 600;
 
 /// The share of a pattern's entries from which it is factored densely.
 const DENSE_FROM: f64 = 0.18;
@@ -24,20 +34,22 @@ const DENSE_FROM: f64 = 0.18;
 /// A square system with a fixed pattern, factored many times.
 #[derive(Clone)]
 pub(crate) enum Lu {
-    Dense(DenseLu),
-    /// Boxed: its analysis is some hundreds of bytes, the dense kernel's a few vectors.
+    /// Both boxed: each holds some hundreds of bytes besides its buffers.
+    Dense(Box<DenseLu>),
     Sparse(Box<SparseLu>),
 }
 
 impl Lu {
     /// The `dim × dim` pattern with these entries (repeats add; list every
     /// diagonal entry, even a structural zero, for the sparse pivoting).
-    pub(crate) fn new(dim: usize, entries: &[(u32, u32)]) -> Self {
+    /// The first `leading` unknowns are those of a positive definite block
+    /// (the coordinates', see [`DenseLu::new`]).
+    pub(crate) fn new(dim: usize, leading: usize, entries: &[(u32, u32)]) -> Self {
         let mut distinct = entries.to_vec();
         distinct.sort_unstable();
         distinct.dedup();
-        if distinct.len() as f64 >= DENSE_FROM * (dim * dim) as f64 {
-            Self::Dense(DenseLu::new(dim, entries))
+        if dim <= DENSE_UP_TO || distinct.len() as f64 >= DENSE_FROM * (dim * dim) as f64 {
+            Self::Dense(Box::new(DenseLu::new(dim, leading, entries)))
         } else {
             Self::Sparse(Box::new(SparseLu::new(dim, entries)))
         }

@@ -3,8 +3,9 @@
 //! factorization (`schur`; its pivot test and the dense factorization in
 //! `ldl`; in a band, `band`; the choice between them for an `S` its caller
 //! assembles, `assembled`), and the symbolic analysis of a sparse `S`
-//! (`sparse`, done once per model); the sparse LU of an implicit step's
-//! Newton matrix (`sparse_lu`).
+//! (`sparse`, done once per model); the LU of an implicit step's Newton
+//! matrix (`lu`: in dense storage along its factors' pattern, `dense_lu`,
+//! or by faer's sparse LU, `sparse_lu`).
 //!
 //! May import: `error`.
 

@@ -47,7 +47,7 @@ impl Work {
             force_entries,
             element_entries,
             values: vec![0.0; entries.len()],
-            lu: Lu::new(n + m, &entries),
+            lu: Lu::new(n + m, n, &entries),
             acc: vec![0.0; n],
             aux: vec![0.0; n],
             lambda: vec![0.0; m],
