@@ -14,7 +14,7 @@ use super::joint_rows::{F, Frame, G, H, Place, Side, dot, pose};
 use crate::ad::scalar::Scalar;
 use crate::limit::JointLimit;
 use crate::model::constraint::Constraint;
-use num_dual::Dual2_64;
+use num_dual::{Dual2_64, Dual64};
 
 /// The coordinate of one revolute or prismatic joint, with its frames on
 /// both sides (as its rows have them).
@@ -182,11 +182,24 @@ impl JointSpace {
     /// for the range an angle is in).
     /// Panics if `i` is not below [`JointSpace::joints`]' count or a slice is short.
     pub fn at(&self, i: usize, q: &[f64], v: &[f64], a: &[f64]) -> [f64; 3] {
+        let theta = self.read(i, |c| Dual2_64::new(q[c], v[c], a[c]));
+        [theta.re, theta.v1, theta.v2]
+    }
+
+    /// `(θ, θ̇)` of the `i`-th joint read at `(q, v)`, as [`at`](Self::at)
+    /// gives them, by a first-order pass (what a joint limit reads every step).
+    pub fn rate(&self, i: usize, q: &[f64], v: &[f64]) -> [f64; 2] {
+        let theta = self.read(i, |c| Dual64::new(q[c], v[c]));
+        [theta.re, theta.eps]
+    }
+
+    /// The `i`-th joint's coordinate of its bodies' coordinates, each
+    /// (its index in the state) made a scalar by `scalar`.
+    fn read<D: Scalar>(&self, i: usize, scalar: impl Fn(usize) -> D) -> D {
         let r = &self.read[i];
         let body = |k: usize| SpatialBody::of(if k < 7 { r.a } else { r.b.unwrap_or(r.a) }).first + k % 7;
-        let x: [Dual2_64; 14] = std::array::from_fn(|k| Dual2_64::new(q[body(k)], v[body(k)], a[body(k)]));
-        let theta = r.coordinate.in_range(&x, [Some(0), r.b.map(|_| 1)], r.range);
-        [theta.re, theta.v1, theta.v2]
+        let x: [D; 14] = std::array::from_fn(|k| scalar(body(k)));
+        r.coordinate.in_range(&x, [Some(0), r.b.map(|_| 1)], r.range)
     }
 }
 

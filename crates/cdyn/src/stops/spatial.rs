@@ -21,8 +21,6 @@ pub struct MechanismStops {
     mechanism: Mechanism,
     space: JointSpace,
     reads: LimitReads,
-    /// The accelerations the coordinates are read with (not used: zeros).
-    zeros: Vec<f64>,
     /// Each joint's coordinate at the start, where given: a periodic stop's
     /// gap is read nearest its gap there.
     start: Vec<Option<f64>>,
@@ -39,7 +37,7 @@ impl MechanismStops {
             |index: usize| Problem::NoCoordinate { index, kind: mechanism.joints[index].kind.name() }.into();
         let reads = LimitReads::new(mechanism.stops(), space.joints(), limits, n, no_coordinate)?;
         let start = vec![None; mechanism.joints.len()];
-        Ok(Self { zeros: vec![0.0; n], mechanism, space, reads, start })
+        Ok(Self { mechanism, space, reads, start })
     }
 
     /// The stops of a mechanism started at the joint coordinates `start`
@@ -65,8 +63,7 @@ impl MechanismStops {
 
     /// `(θ, θ̇)` of the `i`-th joint read.
     fn at(&self, i: usize, q: &[f64], v: &[f64]) -> [f64; 2] {
-        let [x, rate, _] = self.space.at(i, q, v, &self.zeros);
-        [x, rate]
+        self.space.rate(i, q, v)
     }
 }
 
@@ -83,8 +80,17 @@ impl Unilateral for MechanismStops {
     /// periodic stop's gap the one nearest its gap at its joint's start
     /// where given ([`MechanismStops::starting_at`]).
     fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()> {
+        // A joint's two stops follow each other: its coordinate is read once.
+        let last = std::cell::Cell::new((usize::MAX, [0.0; 2]));
         self.reads.gaps(q, v, gaps, |i, stop| {
-            let [x, rate] = self.at(i, q, v);
+            let [x, rate] = match last.get() {
+                (read, at) if read == i => at,
+                _ => {
+                    let at = self.at(i, q, v);
+                    last.set((i, at));
+                    at
+                }
+            };
             let [g, rate] = self.mechanism.stop_gap(stop, x, rate);
             match (self.start[stop.joint], self.mechanism.stop_period(stop)) {
                 (Some(start), Some(period)) => {
