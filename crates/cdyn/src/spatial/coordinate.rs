@@ -232,6 +232,28 @@ mod tests {
         }
     }
 
+    /// A joint's `(θ, θ̇)` by the first-order pass is the second-order
+    /// pass's, for a revolute joint between two bodies and a prismatic one
+    /// on the ground.
+    #[test]
+    fn a_joints_rate_is_read_as_its_acceleration_pass_reads_it() {
+        let mut random = Lcg(5);
+        let joints =
+            [(0, coordinate(true, &mut random), 1, Some(0), None), (1, coordinate(false, &mut random), 0, None, None)];
+        let space = JointSpace::new(joints);
+        for _ in 0..10 {
+            let mut state = || -> Vec<f64> { (0..14).map(|_| random.next()).collect() };
+            let (q, v, a) = (state(), state(), state());
+            for i in 0..2 {
+                let [theta, rate, _] = space.at(i, &q, &v, &a);
+                let [first, first_rate] = space.rate(i, &q, &v);
+                // The same products, summed in another order: θ̇ to round-off.
+                assert_eq!(first, theta);
+                assert!((first_rate - rate).abs() <= 1e-14 * (1.0 + rate.abs()), "{first_rate} vs {rate}");
+            }
+        }
+    }
+
     #[test]
     fn joint_coordinate_rows_read_what_they_depend_on() {
         let mut random = Lcg(3);
