@@ -111,6 +111,11 @@ impl<const K: usize> Constraint<K, 1> for Mimic {
         self.follower.0.reads(self.follower.1, &mut read);
         [read]
     }
+    /// `w (∇²θ_follower − m ∇²θ_leader)`, in closed form.
+    fn curvature(&self, x: [f64; K], _t: f64, w: &[f64; 1]) -> [[f64; K]; K] {
+        let (f, l) = (self.follower.0.hessian(&x, self.follower.1), self.leader.0.hessian(&x, self.leader.1));
+        std::array::from_fn(|i| std::array::from_fn(|j| w[0] * (f[i][j] - self.multiplier * l[i][j])))
+    }
 }
 
 /// The row holding a joint at a stop of its limit: `g = s (θ − bound)`,
@@ -132,6 +137,11 @@ impl<const K: usize> Constraint<K, 1> for StopRow {
         let mut read = [false; K];
         self.coordinate.reads([Some(0), (K == 14).then_some(1)], &mut read);
         [read]
+    }
+    /// `w s ∇²θ`, in closed form.
+    fn curvature(&self, x: [f64; K], _t: f64, w: &[f64; 1]) -> [[f64; K]; K] {
+        let scale = w[0] * self.sign;
+        self.coordinate.hessian(&x, [Some(0), (K == 14).then_some(1)]).map(|row| row.map(|h| scale * h))
     }
 }
 
@@ -209,26 +219,47 @@ mod tests {
     use crate::model::constraint::{curvature_of, jacobian_of, second_derivatives};
     use crate::random::Lcg;
 
-    /// A joint coordinate on random frames, revolute or prismatic.
+    /// A joint coordinate on random frames (orthonormal axes, as a joint's
+    /// are), revolute or prismatic.
     fn coordinate(rotary: bool, random: &mut Lcg) -> JointCoordinate {
-        let mut frame = || Frame {
-            s: std::array::from_fn(|_| random.next()),
-            axes: std::array::from_fn(|_| std::array::from_fn(|_| random.next())),
+        let mut frame = || {
+            let s = std::array::from_fn(|_| random.next());
+            let mut axes: [[f64; 3]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| random.next()));
+            for k in 0..3 {
+                for j in 0..k {
+                    let along = dot(axes[k], axes[j]);
+                    axes[k] = std::array::from_fn(|i| axes[k][i] - along * axes[j][i]);
+                }
+                let norm = dot(axes[k], axes[k]).sqrt();
+                axes[k] = axes[k].map(|x| x / norm);
+            }
+            Frame { s, axes }
         };
         JointCoordinate { rotary, a: frame(), b: frame() }
     }
 
     /// What a row reads holds every non-zero of its Jacobian (a jet pass),
     /// and its curvature over those coordinates alone is the curvature over
-    /// all of them, to the bit: for a stop on one body or two and a
-    /// `<mimic>` between two joints, of angles and of displacements.
+    /// all of them, to the bit; its closed-form curvature is the hyper-dual
+    /// passes' to round-off: for a stop on one body or two and a `<mimic>`
+    /// between two joints, of angles and of displacements.
     fn reads_cover_the_derivatives<C: Constraint<K, 1>, const K: usize>(row: &C, random: &mut Lcg) {
         for _ in 0..10 {
-            let x: [f64; K] = std::array::from_fn(|_| random.next());
+            let mut x: [f64; K] = std::array::from_fn(|_| random.next());
+            // Unit Euler parameters, as a state near its constraints has them.
+            for body in x.chunks_exact_mut(7) {
+                let norm = body[3..].iter().map(|e| e * e).sum::<f64>().sqrt();
+                body[3..].iter_mut().for_each(|e| *e /= norm);
+            }
             let (jac, reads) = (jacobian_of(row, x, 0.0), row.reads());
             assert!(jac[0].iter().zip(&reads[0]).all(|(j, &r)| r || *j == 0.0), "{jac:?} {reads:?}");
             let all = second_derivatives(&x, |y| row.eval(y, 0.0.into())[0].eps1eps2 * 1.5);
             assert_eq!(curvature_of(row, x, 0.0, &[1.5]), all);
+            // The closed form the rows give.
+            let closed = row.curvature(x, 0.0, &[1.5]);
+            let scale = all.iter().flatten().fold(1.0_f64, |m, h| m.max(h.abs()));
+            let gap = closed.iter().flatten().zip(all.iter().flatten()).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(gap <= 1e-13 * scale, "{gap:e} of {scale:e}");
         }
     }
 

@@ -39,6 +39,7 @@ mod actuator;
 mod body;
 mod chain;
 mod coordinate;
+mod coordinate_curvature;
 mod joint;
 mod joint_curvature;
 mod joint_element;
