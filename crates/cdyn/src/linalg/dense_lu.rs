@@ -1,12 +1,15 @@
 //! A square system with a fixed pattern that fills much of it, factored
 //! densely by LU: the Newton matrix of an implicit step on a model of a
-//! few bodies (which pattern goes here: [`super::lu`]). It is first
-//! eliminated in its given order, coordinates before multipliers, along
-//! the pattern of the factors (found once, `Elimination`): `M` dominates
-//! the coordinates' block, so its pivots need no row exchange, and the
-//! multipliers' pivots are those of `Φ_q M⁻¹ Φ_qᵀ`, which the coordinates'
-//! elimination fills in. Where a pivot is too small for that (a singular or
-//! indefinite matrix), the matrix is factored again with partial pivoting.
+//! few bodies or a few hundred unknowns (which pattern goes here:
+//! [`super::lu`]). It is first eliminated without row exchanges, in an
+//! order that keeps its factors sparse (`positions`: the coordinates in
+//! order, each multiplier right after the last coordinate its row reads),
+//! along the pattern of the factors (found once, `Elimination`): `M`
+//! dominates the coordinates' block, so their pivots need no exchange, and
+//! a multiplier's pivot is its entry of `Φ_q M⁻¹ Φ_qᵀ`, which the
+//! elimination of its coordinates fills in. Where a pivot is too small for
+//! that (a singular or indefinite matrix), the matrix is factored again
+//! with partial pivoting.
 
 use super::sparse_lu::Singular;
 
@@ -103,10 +106,11 @@ impl Elimination {
 
 /// The order of elimination: the `leading` unknowns (a positive definite
 /// block's: the coordinates) in their order, each other one (a multiplier)
-/// right after the last leading unknown its row reads, where its pivot is
-/// complete and its row has filled only what that unknown's had. Putting
-/// every multiplier last instead fills the factors of a tree of bodies
-/// almost densely (UR5: 65 k of the dense 155 k products).
+/// right after the last leading unknown its row reads, where its pivot has
+/// gathered the terms of every coordinate it reads and its row has filled
+/// in little beyond that coordinate's. Putting every multiplier last
+/// instead fills the factors of a tree of bodies almost densely (UR5: 65 k
+/// of the dense 155 k products, against 21.9 k in this order).
 fn positions(dim: usize, leading: usize, entries: &[(u32, u32)]) -> Vec<usize> {
     let mut last = vec![0; dim];
     for &(r, c) in entries {
