@@ -343,8 +343,8 @@ pub fn jacobian_of<C: Constraint<K, R>, const K: usize, const R: usize>(c: &C, x
 }
 
 /// `Σ_r w_r ∇²Φ_r` by hyper-dual passes of `c.eval`, one per pair of the
-/// coordinates some row [`reads`](Constraint::reads) (a joint's angle on
-/// two bodies: 36 pairs of their Euler parameters, not 105 of all 14).
+/// coordinates some row [`reads`](Constraint::reads) (an element that
+/// reads 8 of its 14 coordinates: 36 pairs, not 105).
 pub fn curvature_of<C: Constraint<K, R>, const K: usize, const R: usize>(
     c: &C,
     x: [f64; K],

@@ -181,9 +181,9 @@ impl<F: Force<K>, const K: usize> ForceBlock for ForceGroup<F, K> {
         for ((f, idx), block) in self.items.iter().zip(out.chunks_exact_mut(K * K)) {
             if K > JET_FROM {
                 // One jet pass, coordinate `j`'s position and rate seeded
-                // alike in direction `j`: where each scalar pass evaluated the
-                // force again (a joint's friction on two bodies' rotations,
-                // K = 8, its angle by `atan2` eight times).
+                // alike in direction `j`, where each scalar pass evaluated
+                // the whole force again (a rotary damper with friction on two
+                // bodies' Euler parameters, K = 8: its rotations eight times).
                 let seed = |x: &[f64], c: f64| {
                     std::array::from_fn(|j| {
                         let mut jet = JetN::<K>::seeded(x[idx[j]], j);

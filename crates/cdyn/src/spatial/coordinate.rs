@@ -128,20 +128,26 @@ pub(crate) struct StopRow {
     pub sign: f64,
 }
 
+impl StopRow {
+    /// Its joint's sides among its `K` coordinates: one body, or two.
+    fn sides<const K: usize>() -> [Option<usize>; 2] {
+        [Some(0), (K == 14).then_some(1)]
+    }
+}
+
 impl<const K: usize> Constraint<K, 1> for StopRow {
     fn eval<D: Scalar>(&self, x: [D; K], _t: D) -> [D; 1] {
-        let b = (K == 14).then_some(1);
-        [self.coordinate.at(&x, [Some(0), b], D::from(self.bound)) * self.sign]
+        [self.coordinate.at(&x, StopRow::sides::<K>(), D::from(self.bound)) * self.sign]
     }
     fn reads(&self) -> [[bool; K]; 1] {
         let mut read = [false; K];
-        self.coordinate.reads([Some(0), (K == 14).then_some(1)], &mut read);
+        self.coordinate.reads(StopRow::sides::<K>(), &mut read);
         [read]
     }
     /// `w s ∇²θ`, in closed form.
     fn curvature(&self, x: [f64; K], _t: f64, w: &[f64; 1]) -> [[f64; K]; K] {
         let scale = w[0] * self.sign;
-        self.coordinate.hessian(&x, [Some(0), (K == 14).then_some(1)]).map(|row| row.map(|h| scale * h))
+        self.coordinate.hessian(&x, StopRow::sides::<K>()).map(|row| row.map(|h| scale * h))
     }
 }
 
