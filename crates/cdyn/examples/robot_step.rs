@@ -3,7 +3,8 @@
 //! prints one JSON line with microseconds per step (best of 5 trials) of
 //! AB-3 without control (one evaluation of the dynamics a step), AB-3
 //! with `robust`, RK-4 without control (four evaluations) and
-//! generalized-α (implicit: Newton corrections, one factorization each),
+//! generalized-α (implicit: Newton corrections, one factorization a step
+//! unless the corrections slow down),
 //! at h = 1e-4 from the zero pose under gravity. Runs restart every 100 steps,
 //! and where a step fails: the failed step's time is on the clock but it is
 //! not counted as a step, so that a robot whose friction makes these steps

@@ -95,6 +95,16 @@ impl Elimination {
         (0..self.below_at.len() - 1).map(|k| self.below(k).len() * width(k)).sum()
     }
 
+    /// Zeros the entries of the factors (the diagonal, `L` and `U`) in the
+    /// row-major `n × n` matrix `a`.
+    fn clear(&self, a: &mut [f64], n: usize) {
+        for k in 0..n {
+            a[k * n + k] = 0.0;
+            self.below(k).iter().for_each(|&i| a[i as usize * n + k] = 0.0);
+            self.right(k).iter().for_each(|&(s, e)| a[k * n + s as usize..k * n + e as usize].fill(0.0));
+        }
+    }
+
     fn below(&self, k: usize) -> &[u32] {
         &self.below[self.below_at[k]..self.below_at[k + 1]]
     }
@@ -157,19 +167,28 @@ impl DenseLu {
         if values.iter().any(|x| !x.is_finite()) {
             return Err(Singular);
         }
-        self.scatter(values);
-        if !self.eliminate_in_order() {
-            self.scatter(values);
+        let in_order = self.order.is_some();
+        self.scatter(values, in_order);
+        if !(in_order && self.eliminate_in_order()) {
+            if in_order {
+                self.scatter(values, false);
+            }
             self.eliminate_with_pivoting()?;
         }
         self.factored = true;
         Ok(())
     }
 
-    /// The matrix of `values`.
-    fn scatter(&mut self, values: &[f64]) {
-        let a = &mut self.a;
-        a.fill(0.0);
+    /// The matrix of `values`: cleared only on the factors' pattern, which
+    /// is all the elimination in order and its solves read (the rest of the
+    /// dense matrix, clear at 600 unknowns, was most of such a step: the
+    /// planar chain of 200 links), or cleared whole for partial pivoting.
+    fn scatter(&mut self, values: &[f64], on_pattern: bool) {
+        let (n, a) = (self.dim, &mut self.a);
+        match (&self.order, on_pattern) {
+            (Some(order), true) => order.clear(a, n),
+            _ => a.fill(0.0),
+        }
         for (&at, &x) in self.at.iter().zip(values) {
             a[at] += x;
         }
@@ -336,7 +355,8 @@ mod tests {
     /// two neighbouring bodies. It is eliminated in order (each multiplier
     /// after its joint's last coordinate, no row exchanged) along a pattern
     /// far from dense, and solves as the sparse LU does; a body with a zero
-    /// pivot in that order falls back to partial pivoting and still solves.
+    /// pivot in that order falls back to partial pivoting and still solves,
+    /// and the next matrix is eliminated in order again.
     #[test]
     fn a_chains_newton_matrix_is_eliminated_in_order_or_else_with_pivoting() {
         let (bodies, size) = (8, 3);
@@ -368,10 +388,10 @@ mod tests {
             put(n + r, n + r, 0.0);
         }
         let b: Vec<f64> = (0..n + m).map(|_| random.next()).collect();
-        let solve = |values: &[f64], pivoted: bool| {
-            let mut dense = DenseLu::new(n + m, n, &entries);
-            let order = dense.order.as_ref().expect("an order that saves products");
-            assert!(4 * order.products() < (1..n + m).map(|k| k * k).sum::<usize>());
+        let mut dense = DenseLu::new(n + m, n, &entries);
+        let order = dense.order.as_ref().expect("an order that saves products");
+        assert!(4 * order.products() < (1..n + m).map(|k| k * k).sum::<usize>());
+        let mut solve = |values: &[f64], pivoted: bool| {
             dense.factor(values).unwrap();
             assert_eq!(dense.pivoted, pivoted);
             let mut x = b.clone();
@@ -389,8 +409,12 @@ mod tests {
         solve(&values, false);
         // The first coordinate's own entry (the first listed) cancelled:
         // its in-order pivot is 0 while its column below is not.
+        let regular = values.clone();
         values[0] = 0.0;
         solve(&values, true);
+        // In order again, after the pivoting filled the matrix off the
+        // factors' pattern (which the elimination in order does not clear).
+        solve(&regular, false);
     }
 
     /// A zero column and a non-finite entry are refused, not solved.

@@ -45,10 +45,13 @@ impl Lu {
     /// The first `leading` unknowns are those of a positive definite block
     /// (the coordinates', see [`DenseLu::new`]).
     pub(crate) fn new(dim: usize, leading: usize, entries: &[(u32, u32)]) -> Self {
-        let mut distinct = entries.to_vec();
-        distinct.sort_unstable();
-        distinct.dedup();
-        if dim <= DENSE_UP_TO || distinct.len() as f64 >= DENSE_FROM * (dim * dim) as f64 {
+        let share = || {
+            let mut distinct = entries.to_vec();
+            distinct.sort_unstable();
+            distinct.dedup();
+            distinct.len() as f64 / (dim * dim) as f64
+        };
+        if dim <= DENSE_UP_TO || share() >= DENSE_FROM {
             Self::Dense(Box::new(DenseLu::new(dim, leading, entries)))
         } else {
             Self::Sparse(Box::new(SparseLu::new(dim, entries)))
