@@ -37,6 +37,11 @@ pub(crate) struct DenseLu {
     /// right-hand side in that order.
     position: Vec<usize>,
     permuted: Vec<f64>,
+    /// `L`'s entries of an elimination in order, column after column as
+    /// `Elimination::below` lists their rows: the forward substitution
+    /// reads them in sequence (from the dense matrix, by computed index,
+    /// it was UR5's most frequent line of a generalized-α step).
+    lower: Vec<f64>,
     factored: bool,
 }
 
@@ -148,6 +153,7 @@ impl DenseLu {
         let at = moved.iter().map(|&(r, c)| r as usize * dim + c as usize).collect();
         let order = Elimination::new(dim, &moved);
         let dense: usize = (1..dim).map(|k| k * k).sum();
+        let entries_of_l = order.below.len();
         Self {
             dim,
             at,
@@ -157,6 +163,7 @@ impl DenseLu {
             order: (2 * order.products() <= dense).then_some(order),
             position,
             permuted: vec![0.0; dim],
+            lower: vec![0.0; entries_of_l],
             factored: false,
         }
     }
@@ -204,15 +211,21 @@ impl DenseLu {
             let (upper, lower) = a.split_at_mut((k + 1) * n);
             let pivot_row = &upper[k * n..];
             let p = pivot_row[k];
-            let largest = order.below(k).iter().fold(0.0_f64, |m, &i| m.max(lower[(i as usize - k - 1) * n + k].abs()));
-            if p == 0.0 || !p.is_finite() || p.abs() * GROWTH <= largest {
+            if p == 0.0 || !p.is_finite() {
                 return false;
             }
-            let inv = 1.0 / p;
-            for &i in order.below(k) {
+            let (inv, bound) = (1.0 / p, p.abs() * GROWTH);
+            let column = &mut self.lower[order.below_at[k]..order.below_at[k + 1]];
+            for (&i, kept) in order.below(k).iter().zip(column) {
                 let row = &mut lower[(i as usize - k - 1) * n..(i as usize - k) * n];
+                // Checked as each entry is divided: the factorization
+                // falls back before anything it wrote is read.
+                if row[k].abs() >= bound {
+                    return false;
+                }
                 let l = row[k] * inv;
                 row[k] = l;
+                *kept = l;
                 if l == 0.0 {
                     continue;
                 }
@@ -269,10 +282,13 @@ impl DenseLu {
     fn solve_in_order(&self, b: &mut [f64]) {
         let (n, a) = (self.dim, &self.a);
         if let (false, Some(order)) = (self.pivoted, &self.order) {
+            assert!(b.len() == n, "a right-hand side of the wrong length");
             for k in 0..n {
                 let x = b[k];
-                for &i in order.below(k) {
-                    b[i as usize] -= a[i as usize * n + k] * x;
+                let column = &self.lower[order.below_at[k]..order.below_at[k + 1]];
+                for (&i, l) in order.below(k).iter().zip(column) {
+                    // SAFETY: `Elimination::new` lists rows `k < i < n` below pivot `k`, and `b` has `n` entries.
+                    unsafe { *b.get_unchecked_mut(i as usize) -= l * x };
                 }
             }
             for k in (0..n).rev() {
@@ -355,8 +371,8 @@ mod tests {
     /// two neighbouring bodies. It is eliminated in order (each multiplier
     /// after its joint's last coordinate, no row exchanged) along a pattern
     /// far from dense, and solves as the sparse LU does; a body with a zero
-    /// pivot in that order falls back to partial pivoting and still solves,
-    /// and the next matrix is eliminated in order again.
+    /// or a vanishing pivot in that order falls back to partial pivoting
+    /// and still solves, and the next matrix is eliminated in order again.
     #[test]
     fn a_chains_newton_matrix_is_eliminated_in_order_or_else_with_pivoting() {
         let (bodies, size) = (8, 3);
@@ -411,6 +427,10 @@ mod tests {
         // its in-order pivot is 0 while its column below is not.
         let regular = values.clone();
         values[0] = 0.0;
+        solve(&values, true);
+        // A pivot small against the entries it divides (1e-10 against
+        // about 0.1): the elimination in order stops part-way and pivots.
+        values[0] = 1e-10;
         solve(&values, true);
         // In order again, after the pivoting filled the matrix off the
         // factors' pattern (which the elimination in order does not clear).
