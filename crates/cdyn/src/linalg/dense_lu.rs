@@ -41,7 +41,7 @@ pub(crate) struct DenseLu {
     /// `Elimination::below` lists their rows: the forward substitution
     /// reads them in sequence (from the dense matrix, by computed index,
     /// it was UR5's most frequent line of a generalized-α step).
-    lower: Vec<f64>,
+    l_columns: Vec<f64>,
     factored: bool,
 }
 
@@ -163,7 +163,7 @@ impl DenseLu {
             order: (2 * order.products() <= dense).then_some(order),
             position,
             permuted: vec![0.0; dim],
-            lower: vec![0.0; entries_of_l],
+            l_columns: vec![0.0; entries_of_l],
             factored: false,
         }
     }
@@ -215,7 +215,7 @@ impl DenseLu {
                 return false;
             }
             let (inv, bound) = (1.0 / p, p.abs() * GROWTH);
-            let column = &mut self.lower[order.below_at[k]..order.below_at[k + 1]];
+            let column = &mut self.l_columns[order.below_at[k]..order.below_at[k + 1]];
             for (&i, kept) in order.below(k).iter().zip(column) {
                 let row = &mut lower[(i as usize - k - 1) * n..(i as usize - k) * n];
                 // Checked as each entry is divided: the factorization
@@ -285,7 +285,7 @@ impl DenseLu {
             assert!(b.len() == n, "a right-hand side of the wrong length");
             for k in 0..n {
                 let x = b[k];
-                let column = &self.lower[order.below_at[k]..order.below_at[k + 1]];
+                let column = &self.l_columns[order.below_at[k]..order.below_at[k + 1]];
                 for (&i, l) in order.below(k).iter().zip(column) {
                     // SAFETY: `Elimination::new` lists rows `k < i < n` below pivot `k`, and `b` has `n` entries.
                     unsafe { *b.get_unchecked_mut(i as usize) -= l * x };
