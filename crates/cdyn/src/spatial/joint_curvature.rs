@@ -58,7 +58,7 @@ fn outer<const K: usize>(out: &mut [[f64; K]; K], g: &[[f64; K]; 3], h: &[[f64; 
 /// coordinates start at `at_u` and `v` of the other side: only the two
 /// blocks between the sides (a side's vector has no gradient on the
 /// other's coordinates), where [`outer`] runs over every pair of the
-/// element's (UR5: 6 % of a generalized-α step, nine tenths of it zeros).
+/// element's (UR5: 4 % of a generalized-α step, nine tenths of it zeros).
 fn outer_across<const K: usize>(out: &mut [[f64; K]; K], u: &Sided, at_u: At, v: &Sided, at_v: At, w: f64) {
     let (Some(at_u), Some(at_v)) = (at_u, at_v) else { return };
     for i in 0..7 {
