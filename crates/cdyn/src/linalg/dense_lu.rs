@@ -21,7 +21,9 @@ pub(crate) struct DenseLu {
     dim: usize,
     /// Where each listed entry lands in the row-major matrix.
     at: Vec<usize>,
-    /// The matrix, then its factors: unit lower `L` below the diagonal, `U` on and above.
+    /// The matrix, then its factors: `U` on and above the diagonal, unit
+    /// lower `L` below it after partial pivoting (in `l_columns` after an
+    /// elimination in order).
     a: Vec<f64>,
     /// Row `j` was swapped with row `pivot[j] ≥ j` at elimination step `j`
     /// (with partial pivoting, `pivoted`).
@@ -153,14 +155,15 @@ impl DenseLu {
         let at = moved.iter().map(|&(r, c)| r as usize * dim + c as usize).collect();
         let order = Elimination::new(dim, &moved);
         let dense: usize = (1..dim).map(|k| k * k).sum();
-        let entries_of_l = order.below.len();
+        let order = (2 * order.products() <= dense).then_some(order);
+        let entries_of_l = order.as_ref().map_or(0, |o| o.below.len());
         Self {
             dim,
             at,
             a: vec![0.0; dim * dim],
             pivot: vec![0; dim],
             pivoted: false,
-            order: (2 * order.products() <= dense).then_some(order),
+            order,
             position,
             permuted: vec![0.0; dim],
             l_columns: vec![0.0; entries_of_l],
@@ -223,8 +226,8 @@ impl DenseLu {
                 if row[k].abs() >= bound {
                     return false;
                 }
+                // `L` is read from `l_columns` only: its place in `a` is left as it is.
                 let l = row[k] * inv;
-                row[k] = l;
                 *kept = l;
                 if l == 0.0 {
                     continue;

@@ -5,43 +5,26 @@
 //! step (231 for its fingers' `<mimic>` on three bodies).
 //!
 //! A displacement is `(x_a − x_b) · h_b`, an angle `atan2(s, c)` with
-//! `c = f_a · f_b` and `s = f_a · g_b`: dot products of vectors `A(p)s`
-//! (plus `r` for a point), whose gradient in `p` is `rotate_jacobian` and
-//! whose second derivatives, `A(p)s` being quadratic in `p`, are the
-//! constant `rotate_hessian`. The product rule and the derivatives of
-//! `atan2` do the rest.
+//! `c = f_a · f_b` and `s = f_a · g_b`: dot products of the sides' vectors
+//! `A(p)s` (plus `r` for a point), differentiated twice as a joint's rows
+//! are (`joint_curvature`); the derivatives of `atan2` do the rest.
 
 use super::coordinate::JointCoordinate;
+use super::joint_curvature::{At, curve, outer, wide};
+use super::joint_element::{Sided, sided, still};
 use super::joint_rows::{F, G, H, pose};
-use super::rotation::{rotate_fixed, rotate_hessian, rotate_jacobian};
 
-/// A side's vector over an element's `K` coordinates.
-struct Vector<const K: usize> {
-    x: [f64; 3],
-    grad: [[f64; K]; 3],
-    /// The body-fixed vector it rotates, and where its body's `p` starts
-    /// (`None` on the ground, where it is fixed).
-    s: [f64; 3],
-    p_at: Option<usize>,
-}
-
-/// `s` rotated by the body in `slot` (moved by its `r` when `moved`), or
-/// `s` itself on the ground.
-fn vector<const K: usize>(x: &[f64; K], slot: Option<usize>, s: [f64; 3], moved: bool) -> Vector<K> {
-    let Some(k) = slot else {
-        return Vector { x: s, grad: [[0.0; K]; 3], s, p_at: None };
-    };
-    let (r, p) = pose(x, 7 * k);
-    let (y, jacobian) = (rotate_fixed(p, s), rotate_jacobian(p, s));
-    let mut grad = [[0.0; K]; 3];
-    for i in 0..3 {
-        grad[i][7 * k + 3..7 * k + 7].copy_from_slice(&jacobian[i]);
-        if moved {
-            grad[i][7 * k + i] = 1.0;
+/// `s` rotated by the body in `slot` (moved by its `r` when `moved`), as a
+/// joint's rows have it, with where the body's coordinates start; `s`
+/// itself on the ground.
+fn vector<const K: usize>(x: &[f64; K], slot: Option<usize>, s: [f64; 3], moved: bool) -> (Sided, At) {
+    match slot {
+        None => (still(s), None),
+        Some(k) => {
+            let (r, p) = pose(x, 7 * k);
+            (sided(r, p, ([0.0; 3], [0.0; 4]), s, moved), Some(7 * k))
         }
     }
-    let x = std::array::from_fn(|i| y[i] + if moved { r[i] } else { 0.0 });
-    Vector { x, grad, s, p_at: Some(7 * k + 3) }
 }
 
 /// A scalar with its gradient and second derivatives.
@@ -51,23 +34,16 @@ struct Second<const K: usize> {
     hess: [[f64; K]; K],
 }
 
-/// `u · v`: `∇²(u · v) = Σᵢ (vᵢ ∇²uᵢ + uᵢ ∇²vᵢ + ∇uᵢ ⊗ ∇vᵢ + ∇vᵢ ⊗ ∇uᵢ)`.
-fn dot<const K: usize>(u: &Vector<K>, v: &Vector<K>) -> Second<K> {
+/// `u · v`, its gradient and, by the product rule of the joints'
+/// curvatures ([`outer`], [`curve`]), its second derivatives.
+fn dot<const K: usize>((u, at_u): &(Sided, At), (v, at_v): &(Sided, At)) -> Second<K> {
+    let (gu, gv) = (wide::<K>(u, *at_u), wide::<K>(v, *at_v));
     let value = (0..3).map(|i| u.x[i] * v.x[i]).sum();
-    let grad = std::array::from_fn(|j| (0..3).map(|i| u.grad[i][j] * v.x[i] + u.x[i] * v.grad[i][j]).sum());
-    let mut hess: [[f64; K]; K] = std::array::from_fn(|j| {
-        std::array::from_fn(|l| (0..3).map(|i| u.grad[i][j] * v.grad[i][l] + v.grad[i][j] * u.grad[i][l]).sum())
-    });
-    for (w, weights) in [(u, v.x), (v, u.x)] {
-        if let Some(at) = w.p_at {
-            let h = rotate_hessian(w.s, weights);
-            for k in 0..4 {
-                for l in 0..4 {
-                    hess[at + k][at + l] += h[k][l];
-                }
-            }
-        }
-    }
+    let grad = std::array::from_fn(|j| (0..3).map(|i| gu[i][j] * v.x[i] + u.x[i] * gv[i][j]).sum());
+    let mut hess = [[0.0; K]; K];
+    outer(&mut hess, &gu, &gv, 1.0);
+    curve(&mut hess, u, *at_u, v.x);
+    curve(&mut hess, v, *at_v, u.x);
     Second { value, grad, hess }
 }
 
@@ -79,8 +55,8 @@ impl JointCoordinate {
         let [a, b] = sides;
         if self.rotary {
             let fa = vector(x, a, self.a.axes[F], false);
-            let c = dot(&fa, &vector(x, b, self.b.axes[F], false));
-            let s = dot(&fa, &vector(x, b, self.b.axes[G], false));
+            let c = dot::<K>(&fa, &vector(x, b, self.b.axes[F], false));
+            let s = dot::<K>(&fa, &vector(x, b, self.b.axes[G], false));
             // θ = atan2(s, c): ∇θ = (c∇s − s∇c)/ρ, ρ = c² + s², and
             // ∇²θ = (c∇²s − s∇²c + ∇s⊗∇c − ∇c⊗∇s)/ρ − ∇θ ⊗ ∇ρ/ρ.
             let rho = c.value * c.value + s.value * s.value;
@@ -97,7 +73,7 @@ impl JointCoordinate {
         } else {
             let (pa, pb) = (vector(x, a, self.a.s, true), vector(x, b, self.b.s, true));
             let hb = vector(x, b, self.b.axes[H], false);
-            let (along_a, along_b) = (dot(&pa, &hb), dot(&pb, &hb));
+            let (along_a, along_b) = (dot::<K>(&pa, &hb), dot::<K>(&pb, &hb));
             std::array::from_fn(|j| std::array::from_fn(|l| along_a.hess[j][l] - along_b.hess[j][l]))
         }
     }

@@ -16,10 +16,10 @@ use super::rotation::rotate_hessian;
 
 /// Where a side's seven coordinates `(r, p)` start among the element's,
 /// `None` for the ground.
-type At = Option<usize>;
+pub(super) type At = Option<usize>;
 
 /// A side vector's gradient over the element's `K` coordinates.
-fn wide<const K: usize>(u: &Sided, at: At) -> [[f64; K]; 3] {
+pub(super) fn wide<const K: usize>(u: &Sided, at: At) -> [[f64; K]; 3] {
     let mut g = [[0.0; K]; 3];
     if let Some(at) = at {
         for i in 0..3 {
@@ -30,7 +30,7 @@ fn wide<const K: usize>(u: &Sided, at: At) -> [[f64; K]; 3] {
 }
 
 /// `out += Σᵢ cᵢ ∇²uᵢ`, on the side's `p` alone (`r` enters linearly).
-fn curve<const K: usize>(out: &mut [[f64; K]; K], u: &Sided, at: At, c: [f64; 3]) {
+pub(super) fn curve<const K: usize>(out: &mut [[f64; K]; K], u: &Sided, at: At, c: [f64; 3]) {
     if let Some(at) = at {
         add_rotation_block(out, at, rotate_hessian(u.s, c));
     }
@@ -46,7 +46,7 @@ pub(super) fn add_rotation_block<const K: usize>(out: &mut [[f64; K]; K], at: us
 }
 
 /// `out += w Σᵢ (gᵢ ⊗ hᵢ + hᵢ ⊗ gᵢ)` of two vectors' gradients.
-fn outer<const K: usize>(out: &mut [[f64; K]; K], g: &[[f64; K]; 3], h: &[[f64; K]; 3], w: f64) {
+pub(super) fn outer<const K: usize>(out: &mut [[f64; K]; K], g: &[[f64; K]; 3], h: &[[f64; K]; 3], w: f64) {
     for i in 0..K {
         for j in 0..K {
             out[i][j] += w * (0..3).map(|c| g[c][i] * h[c][j] + h[c][i] * g[c][j]).sum::<f64>();

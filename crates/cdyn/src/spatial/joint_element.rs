@@ -98,28 +98,33 @@ pub(super) trait SidedPlace {
 }
 
 impl Seeded<'_> {
-    /// `x` rotated by the body, moved by `r` when `moved`, with its
-    /// derivatives and rates. `A(p) x` is a quadratic form in `p`, so along
-    /// `p + s ṗ` its second rate is `2 A(ṗ) x`.
     #[inline(always)]
     fn sided(&self, s: [f64; 3], moved: bool) -> Sided {
-        let (y, jacobian) = (rotate_fixed(self.p, s), rotate_jacobian(self.p, s));
-        let mut d = [[0.0; 7]; 3];
-        for i in 0..3 {
-            d[i][3..7].copy_from_slice(&jacobian[i]);
-            if moved {
-                d[i][i] = 1.0;
-            }
-        }
-        let x = [0, 1, 2].map(|i| y[i] + if moved { self.r[i] } else { 0.0 });
-        let (rd, pd) = self.rates;
-        let rate = [0, 1, 2].map(|i| {
-            let turn: f64 = (0..4).map(|k| d[i][3 + k] * pd[k]).sum();
-            turn + if moved { rd[i] } else { 0.0 }
-        });
-        let curvature = rotate_fixed(pd, s).map(|c| 2.0 * c);
-        Sided { x, d, motion: [x, rate, curvature], s }
+        sided(self.r, self.p, self.rates, s, moved)
     }
+}
+
+/// `s` rotated by the body at `(r, p)`, moved by `r` when `moved`, with its
+/// derivatives in the body's seven coordinates and its rates along
+/// `(ṙ, ṗ)`. `A(p) s` is a quadratic form in `p`, so along `p + t ṗ` its
+/// second rate is `2 A(ṗ) s`.
+#[inline(always)]
+pub(super) fn sided(r: [f64; 3], p: [f64; 4], (rd, pd): ([f64; 3], [f64; 4]), s: [f64; 3], moved: bool) -> Sided {
+    let (y, jacobian) = (rotate_fixed(p, s), rotate_jacobian(p, s));
+    let mut d = [[0.0; 7]; 3];
+    for i in 0..3 {
+        d[i][3..7].copy_from_slice(&jacobian[i]);
+        if moved {
+            d[i][i] = 1.0;
+        }
+    }
+    let x = [0, 1, 2].map(|i| y[i] + if moved { r[i] } else { 0.0 });
+    let rate = [0, 1, 2].map(|i| {
+        let turn: f64 = (0..4).map(|k| d[i][3 + k] * pd[k]).sum();
+        turn + if moved { rd[i] } else { 0.0 }
+    });
+    let curvature = rotate_fixed(pd, s).map(|c| 2.0 * c);
+    Sided { x, d, motion: [x, rate, curvature], s }
 }
 
 impl SidedPlace for Seeded<'_> {
@@ -144,7 +149,7 @@ impl SidedPlace for Fixed<'_> {
 }
 
 /// A vector fixed in space.
-fn still(x: [f64; 3]) -> Sided {
+pub(super) fn still(x: [f64; 3]) -> Sided {
     Sided { x, d: [[0.0; 7]; 3], motion: [x, [0.0; 3], [0.0; 3]], s: x }
 }
 

@@ -62,7 +62,7 @@ impl LimitReads {
         q: &[f64],
         v: &[f64],
         gaps: &mut [[f64; 2]],
-        gap: impl Fn(usize, Stop) -> [f64; 2],
+        mut gap: impl FnMut(usize, Stop) -> [f64; 2],
     ) -> Result<()> {
         self.check_state(q, v)?;
         for ((out, &stop), &i) in gaps.iter_mut().zip(&self.stops).zip(&self.stop_reads) {

@@ -60,11 +60,6 @@ impl MechanismStops {
     pub fn mechanism(&self) -> &Mechanism {
         &self.mechanism
     }
-
-    /// `(θ, θ̇)` of the `i`-th joint read.
-    fn at(&self, i: usize, q: &[f64], v: &[f64]) -> [f64; 2] {
-        self.space.rate(i, q, v)
-    }
 }
 
 impl Unilateral for MechanismStops {
@@ -81,13 +76,13 @@ impl Unilateral for MechanismStops {
     /// where given ([`MechanismStops::starting_at`]).
     fn gaps(&self, q: &[f64], v: &[f64], gaps: &mut [[f64; 2]]) -> Result<()> {
         // A joint's two stops follow each other: its coordinate is read once.
-        let last = std::cell::Cell::new((usize::MAX, [0.0; 2]));
+        let mut last: Option<(usize, [f64; 2])> = None;
         self.reads.gaps(q, v, gaps, |i, stop| {
-            let [x, rate] = match last.get() {
-                (read, at) if read == i => at,
+            let [x, rate] = match last {
+                Some((read, at)) if read == i => at,
                 _ => {
-                    let at = self.at(i, q, v);
-                    last.set((i, at));
+                    let at = self.space.rate(i, q, v);
+                    last = Some((i, at));
                     at
                 }
             };
@@ -118,7 +113,7 @@ impl Unilateral for MechanismStops {
 
     /// Joints (by index) faster than their limit's `velocity`.
     fn overspeed(&self, q: &[f64], v: &[f64], exceeded: &mut dyn FnMut(usize, f64)) -> Result<()> {
-        self.reads.overspeed(q, v, |i| self.at(i, q, v)[1], exceeded)
+        self.reads.overspeed(q, v, |i| self.space.rate(i, q, v)[1], exceeded)
     }
 
     fn joint(&self, stop: usize) -> String {
