@@ -114,6 +114,12 @@ pub enum Problem {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A mechanism that joint coordinates cannot describe, or an element they do not model yet.
+    #[error("in joint coordinates: {reason}")]
+    JointCoordinates {
+        /// Why.
+        reason: String,
+    },
     /// A joint without a coordinate of its own where one is needed.
     #[error("joint {index} is {kind}: only revolute and prismatic joints have a coordinate (to couple or to limit)")]
     NoCoordinate {

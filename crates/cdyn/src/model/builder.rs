@@ -269,6 +269,14 @@ impl ModelBuilder {
         self.kinetic_element(ByMap::<T, V>(t), at)
     }
 
+    /// A kinetic energy and a potential given whole, in closed form, over
+    /// the first coordinates (a tree of bodies in joint coordinates).
+    pub(crate) fn whole(mut self, kinetic: Box<dyn KineticBlock>, potential: Option<Box<dyn PotentialBlock>>) -> Self {
+        self.kinetic.push(kinetic);
+        self.potentials.extend(potential);
+        self
+    }
+
     fn kinetic_element<E: KineticElement<K>, const K: usize>(mut self, e: E, at: [usize; K]) -> Self {
         if self.check_indices("a kinetic energy", &at) {
             let item = (e, at);

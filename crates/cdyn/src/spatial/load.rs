@@ -244,6 +244,13 @@ impl Law {
     }
 }
 
+/// The law on a coordinate that is the joint's own (a tree in joint coordinates).
+impl Force<1> for Law {
+    fn force<D: Scalar>(&self, _x: [D; 1], [rate]: [D; 1], _t: D) -> [D; 1] {
+        [self.resist(rate)]
+    }
+}
+
 /// A rotary damper between two bodies: reads `(p_a, p_b)`; the axis in `a`'s axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct BodyRotaryDamper {

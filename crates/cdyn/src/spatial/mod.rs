@@ -53,6 +53,7 @@ pub mod rotation;
 mod sketch;
 mod spring;
 mod stops;
+mod tree;
 #[cfg(feature = "urdf")]
 mod urdf;
 mod visual;
@@ -67,6 +68,7 @@ pub use load::Load;
 pub use mechanism::{Built, Coupling, Mechanism};
 pub use named::MergedLink;
 pub use sketch::{Anchor, Limb, Sketch};
+pub use tree::InJoints;
 #[cfg(feature = "urdf")]
 pub use urdf::{UrdfRobot, from_urdf, read_urdf};
 pub use visual::{Shape, Visual};

@@ -156,16 +156,29 @@ pub(super) fn add_joint(
     add_joint_law(builder, joint, fa, fb)
 }
 
-/// A revolute or prismatic joint's damping and friction, as a torque about
-/// (a force along) its axis, carried by `a`, between its bodies.
-fn add_joint_law(builder: ModelBuilder, joint: &Joint, fa: Frame, fb: Frame) -> Result<ModelBuilder> {
+/// A joint's damping and friction, checked: `None` without either, an
+/// error on a joint that has no coordinate for them to resist.
+pub(super) fn joint_law(joint: &Joint) -> Result<Option<Law>> {
     let law = Law {
         damping: crate::error::non_negative("damping", joint.damping)?,
         friction: crate::error::non_negative("friction", joint.friction)?,
     };
     if law.damping == 0.0 && law.friction == 0.0 {
-        return Ok(builder);
+        return Ok(None);
     }
+    if !matches!(joint.kind, JointKind::Revolute | JointKind::Prismatic) {
+        let key = if law.damping != 0.0 { "damping" } else { "friction" };
+        return Err(Problem::JointKey { key, kind: joint.kind.name(), wanted: false }.into());
+    }
+    Ok(Some(law))
+}
+
+/// A revolute or prismatic joint's damping and friction, as a torque about
+/// (a force along) its axis, carried by `a`, between its bodies.
+fn add_joint_law(builder: ModelBuilder, joint: &Joint, fa: Frame, fb: Frame) -> Result<ModelBuilder> {
+    let Some(law) = joint_law(joint)? else {
+        return Ok(builder);
+    };
     let (a_at, b_at) = (SpatialBody::of(joint.a), joint.b.map(SpatialBody::of));
     Ok(match (joint.kind, b_at) {
         (JointKind::Revolute, Some(b)) => {
@@ -184,10 +197,7 @@ fn add_joint_law(builder: ModelBuilder, joint: &Joint, fa: Frame, fb: Frame) -> 
         (JointKind::Prismatic, None) => {
             builder.force(Slide { sa: fa.s, sb: fb.s, axis: fa.axes[2], ground: true, law }, a_at.coordinates())
         }
-        (kind, _) => {
-            let key = if law.damping != 0.0 { "damping" } else { "friction" };
-            return Err(Problem::JointKey { key, kind: kind.name(), wanted: false }.into());
-        }
+        (kind, _) => unreachable!("joint_law gives a law to revolute and prismatic joints only, not {kind:?}"),
     })
 }
 

@@ -19,11 +19,11 @@ use crate::error::{Problem, Result};
 /// A joint of the tree: its index, the body beyond it, the body (or the
 /// ground) before it, and `+1` when the body beyond is `a` (`θ` measures
 /// `a` relative to `b`), `−1` when it is `b`.
-struct Edge {
-    joint: usize,
-    beyond: usize,
-    before: Option<usize>,
-    sign: f64,
+pub(super) struct Edge {
+    pub joint: usize,
+    pub beyond: usize,
+    pub before: Option<usize>,
+    pub sign: f64,
 }
 
 impl Mechanism {
@@ -121,7 +121,7 @@ impl Mechanism {
 
     /// The joints of a spanning tree, breadth first from the ground and
     /// then from each body no joint holds to it, in joint order.
-    fn spanning_tree(&self) -> Vec<Edge> {
+    pub(super) fn spanning_tree(&self) -> Vec<Edge> {
         let mut reached = vec![false; self.bodies.len()];
         let mut edges = Vec::new();
         let mut frontier: Vec<Option<usize>> = vec![None];
@@ -167,7 +167,7 @@ impl Mechanism {
 }
 
 /// A joint's point and unit axis, in space at the defined pose.
-fn line(joint: &Joint) -> ([f64; 3], [f64; 3]) {
+pub(super) fn line(joint: &Joint) -> ([f64; 3], [f64; 3]) {
     let axis = joint.axis.unwrap_or([0.0, 0.0, 1.0]);
     let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
     (joint.point, axis.map(|x| x / norm))

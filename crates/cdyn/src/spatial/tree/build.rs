@@ -1,0 +1,201 @@
+//! A mechanism's tree and its model in joint coordinates, with what the
+//! formulation does not model yet refused by name.
+
+use super::dynamics::TreeKinetic;
+use super::gravity::TreeGravity;
+use super::motion::{Inertia, M3};
+use super::{Node, Shared, Tree};
+use crate::ad::scalar::Scalar;
+use crate::error::{Error, Part, Problem, Result};
+use crate::model::Model;
+use crate::model::constraint::Constraint;
+use crate::model::force::PotentialBlock;
+use crate::spatial::joint::JointKind;
+use crate::spatial::mechanism::Mechanism;
+use crate::spatial::placing::joint_law;
+use crate::spatial::posing::line;
+use crate::spatial::rotation::rotate;
+use std::sync::Arc;
+
+/// A mechanism in joint coordinates ([`Mechanism::in_joint_coordinates`]):
+/// its model, the initial state, and the joint behind each coordinate.
+#[non_exhaustive]
+pub struct InJoints {
+    /// The model: coordinate `k` is joint `joints[k]`'s angle (displacement).
+    pub model: Model,
+    /// All coordinates 0: the pose the mechanism is defined in.
+    pub q0: Vec<f64>,
+    /// All rates 0.
+    pub v0: Vec<f64>,
+    /// The mechanism's joint of each coordinate, in joint order.
+    pub joints: Vec<usize>,
+}
+
+impl InJoints {
+    /// The bodies' positions and velocities in the mechanism's own
+    /// coordinates (seven per body, as [`Mechanism::build`] has them) at
+    /// joint coordinates `theta` and rates `rate`.
+    pub fn bodies(&self, mechanism: &Mechanism, theta: &[f64], rate: &[f64]) -> Result<(Vec<f64>, Vec<f64>)> {
+        let pairs = |x: &[f64]| self.joints.iter().copied().zip(x.iter().copied()).collect::<Vec<_>>();
+        mechanism.state_at_joints(&pairs(theta), &pairs(rate))
+    }
+}
+
+/// `x_f − m x_l − offset`: a `<mimic>` coupling between two joint coordinates.
+struct Coupled {
+    multiplier: f64,
+    offset: f64,
+}
+
+impl Constraint<2, 1> for Coupled {
+    fn eval<D: Scalar>(&self, [follower, leader]: [D; 2], _t: D) -> [D; 1] {
+        [follower - leader * self.multiplier - self.offset]
+    }
+}
+
+fn refuse(part: Part, reason: impl Into<String>) -> Error {
+    Problem::JointCoordinates { reason: reason.into() }.at(part)
+}
+
+impl Mechanism {
+    /// The mechanism in joint coordinates: one per revolute and prismatic
+    /// joint, in joint order, counted from the pose it is defined in.
+    /// Its joints must form a tree on the ground (each body held to the
+    /// ground by one path of joints); bodies welded by fixed joints ride
+    /// with their parent, and those welded to the ground are ground. The
+    /// joints' damping and friction and `<mimic>` couplings (one row
+    /// each) are modelled; drives, limits, loads, actuators and bodies'
+    /// own initial velocities are refused for now, by name.
+    pub fn in_joint_coordinates(&self) -> Result<InJoints> {
+        if self.bodies.is_empty() {
+            return Err(Problem::NoBodies.into());
+        }
+        let poses = self.poses()?;
+        self.refuse_what_is_not_modelled()?;
+        let edges = self.spanning_tree();
+        let mut joined = vec![false; self.bodies.len()];
+        for e in &edges {
+            joined[e.beyond] = true;
+        }
+        if let Some(k) = joined.iter().position(|&j| !j) {
+            let part = Part::Body { index: k, name: self.bodies[k].name.clone() };
+            return Err(refuse(part, "the body is not joined to the ground (the tree needs a fixed base)"));
+        }
+        if let Some(index) = (0..self.joints.len()).find(|&k| !edges.iter().any(|e| e.joint == k)) {
+            let part = Part::Element { index, kind: self.joints[index].kind.name() };
+            return Err(refuse(part, "the joint closes a loop (the bodies' joints must form a tree)"));
+        }
+        let moving = |k: usize| matches!(self.joints[k].kind, JointKind::Revolute | JointKind::Prismatic);
+        let joints: Vec<usize> = (0..self.joints.len()).filter(|&k| moving(k)).collect();
+        if joints.is_empty() {
+            return Err(refuse(Part::Model, "no revolute or prismatic joint: nothing moves"));
+        }
+        // The node carrying each body, parents first.
+        let mut carrier: Vec<Option<usize>> = vec![None; self.bodies.len()];
+        let mut nodes: Vec<Node> = Vec::with_capacity(joints.len());
+        for e in &edges {
+            let parent = e.before.and_then(|b| carrier[b]);
+            if !moving(e.joint) {
+                carrier[e.beyond] = parent;
+                continue;
+            }
+            let joint = &self.joints[e.joint];
+            if joint.axis.is_none_or(|a| a == [0.0; 3] || a.iter().any(|x| !x.is_finite())) {
+                return Err(
+                    Problem::ZeroAxis { name: "axis" }.at(Part::Element { index: e.joint, kind: joint.kind.name() })
+                );
+            }
+            let (point, axis) = line(joint);
+            nodes.push(Node {
+                parent,
+                coordinate: joints.iter().position(|&k| k == e.joint).expect("a moving joint"),
+                rotary: joint.kind == JointKind::Revolute,
+                axis: axis.map(|x| e.sign * x),
+                point,
+                inertia: Inertia::default(),
+            });
+            carrier[e.beyond] = Some(nodes.len() - 1);
+        }
+        for (k, body) in self.bodies.iter().enumerate() {
+            if let Some(t) = carrier[k] {
+                let p = poses[k].1;
+                // R J′ Rᵀ, with R's columns the body axes in space.
+                let columns: [[f64; 3]; 3] =
+                    std::array::from_fn(|j| rotate(p, std::array::from_fn(|i| f64::from(u8::from(i == j)))));
+                let rj: M3 = std::array::from_fn(|i| {
+                    std::array::from_fn(|l| (0..3).map(|m| columns[m][i] * body.inertia[m][l]).sum())
+                });
+                let world: M3 =
+                    std::array::from_fn(|i| std::array::from_fn(|l| (0..3).map(|m| rj[i][m] * columns[m][l]).sum()));
+                nodes[t].inertia = nodes[t].inertia.plus(&Inertia::of_body(body.mass, body.position, world));
+            }
+        }
+        let n = joints.len();
+        let shared = Arc::new(Shared::new(Tree { nodes, n }));
+        let gravity = (self.gravity != [0.0; 3]).then(|| {
+            Box::new(TreeGravity { shared: shared.clone(), gravity: self.gravity }) as Box<dyn PotentialBlock>
+        });
+        let names = joints.iter().map(|k| format!("joint {k}")).collect();
+        let mut builder =
+            Model::builder(vec![0.0; n]).coordinate_names(names).whole(Box::new(TreeKinetic(shared)), gravity);
+        for (c, &k) in joints.iter().enumerate() {
+            let at = Part::Element { index: k, kind: self.joints[k].kind.name() };
+            if let Some(law) = joint_law(&self.joints[k]).map_err(|e| e.at(at))? {
+                builder = builder.force(law, [c]);
+            }
+        }
+        for (k, coupling) in self.couplings.iter().enumerate() {
+            let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
+            let coordinate = |joint: usize| {
+                joints.iter().position(|&j| j == joint).ok_or_else(|| {
+                    let kind = self.joints.get(joint).map_or("missing", |j| j.kind.name());
+                    Error::from(Problem::NoCoordinate { index: joint, kind }).at(at.clone())
+                })
+            };
+            let (f, l) = (coordinate(coupling.follower)?, coordinate(coupling.leader)?);
+            for (name, value) in [("multiplier", coupling.multiplier), ("offset", coupling.offset)] {
+                crate::error::finite(name, value).map_err(|e| e.at(at.clone()))?;
+            }
+            builder = builder.constrain(Coupled { multiplier: coupling.multiplier, offset: coupling.offset }, [f, l]);
+        }
+        Ok(InJoints { model: builder.build()?, q0: vec![0.0; n], v0: vec![0.0; n], joints })
+    }
+
+    fn refuse_what_is_not_modelled(&self) -> Result<()> {
+        for (index, body) in self.bodies.iter().enumerate() {
+            if body.velocity != [0.0; 3] || body.angular_velocity != [0.0; 3] {
+                let part = Part::Body { index, name: body.name.clone() };
+                return Err(refuse(part, "a body's own velocity is not read: start the joints at their rates"));
+            }
+        }
+        for (index, joint) in self.joints.iter().enumerate() {
+            let part = Part::Element { index, kind: joint.kind.name() };
+            let reason = match joint.kind {
+                JointKind::Revolute | JointKind::Prismatic | JointKind::Fixed => None,
+                kind => Some(format!("a {} joint has more or less than one coordinate", kind.name())),
+            };
+            let reason = reason
+                .or_else(|| {
+                    (joint.angle.is_some() || joint.displacement.is_some())
+                        .then(|| "drives are not modelled yet".into())
+                })
+                .or_else(|| joint.limit.is_some().then(|| "joint limits are not modelled yet".into()));
+            if let Some(reason) = reason {
+                return Err(refuse(part, reason));
+            }
+        }
+        if let Some(load) = self.loads.first() {
+            return Err(refuse(
+                Part::Element { index: self.joints.len(), kind: load.kind() },
+                "loads are not modelled yet",
+            ));
+        }
+        if !self.actuators.is_empty() {
+            return Err(refuse(
+                Part::Element { index: self.actuators[0].joint, kind: "actuator" },
+                "actuators are not modelled yet",
+            ));
+        }
+        Ok(())
+    }
+}

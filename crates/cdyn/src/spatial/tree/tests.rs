@@ -1,0 +1,199 @@
+//! The tree in joint coordinates in layers: its closed forms against
+//! finite differences of its own `T` and `V`, its accelerations against
+//! the same mechanism in body coordinates (a different formulation: seven
+//! coordinates per body, the joints as constraint rows, `M(q)` and the
+//! rows by automatic differentiation), and the energy over a run.
+
+use crate::dynamics::Dynamics;
+use crate::linalg::mass::DenseMass;
+use crate::spatial::{Body, Coupling, Joint, JointKind, Mechanism};
+use crate::{Control, Scheme, Settings, Simulation};
+
+/// A branched tree: a revolute root on a tilted axis, a revolute joint on
+/// it, a prismatic joint beyond, a revolute joint given child first (its
+/// `θ` counts the parent against the child), a body welded to the second
+/// body, and a second branch from the root; full inertia tensors and
+/// bodies turned away from the space axes.
+fn branched() -> Mechanism {
+    let tensor = |a: f64, b: f64, c: f64, d: f64| [[a, d, 0.3 * d], [d, b, -0.5 * d], [0.3 * d, -0.5 * d, c]];
+    let body = |name: &str, m: f64, r: [f64; 3], p: [f64; 4], j: [[f64; 3]; 3]| {
+        let norm = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Body::new(name, m, [1.0; 3]).with_inertia(j).with_position(r).with_orientation(p.map(|x| x / norm))
+    };
+    let bodies = vec![
+        body("root", 2.0, [0.1, 0.05, -0.2], [0.9, 0.1, -0.2, 0.3], tensor(0.05, 0.06, 0.04, 0.01)),
+        body("arm", 1.5, [0.4, 0.0, -0.3], [0.7, 0.3, 0.1, -0.2], tensor(0.03, 0.02, 0.025, 0.004)),
+        body("slider", 0.8, [0.6, 0.2, -0.35], [1.0, 0.0, 0.0, 0.0], tensor(0.01, 0.012, 0.009, 0.002)),
+        body("hand", 0.5, [0.7, 0.35, -0.5], [0.8, -0.3, 0.4, 0.1], tensor(0.004, 0.005, 0.003, 0.001)),
+        body("weld", 0.3, [0.45, -0.1, -0.25], [0.6, 0.0, 0.6, 0.2], tensor(0.002, 0.003, 0.0025, 0.0005)),
+        body("branch", 1.1, [-0.25, 0.15, -0.4], [0.9, -0.1, 0.0, 0.4], tensor(0.02, 0.015, 0.018, 0.003)),
+    ];
+    let joint = |kind, a, b, point, axis: Option<[f64; 3]>| {
+        let j = Joint::new(kind, a, b, point);
+        match axis {
+            Some(axis) => j.with_axis(axis),
+            None => j,
+        }
+    };
+    let joints = vec![
+        joint(JointKind::Revolute, 0, None, [0.0; 3], Some([0.0, 0.3, 1.0])),
+        joint(JointKind::Revolute, 1, Some(0), [0.3, 0.0, -0.1], Some([1.0, 0.2, 0.0])),
+        joint(JointKind::Prismatic, 2, Some(1), [0.5, 0.1, -0.2], Some([0.2, 1.0, 0.1])),
+        joint(JointKind::Revolute, 2, Some(3), [0.6, 0.3, -0.4], Some([0.0, 1.0, 1.0])),
+        joint(JointKind::Fixed, 4, Some(1), [0.45, -0.1, -0.25], Some([0.0, 0.0, 1.0])),
+        joint(JointKind::Revolute, 5, Some(0), [-0.2, 0.1, -0.3], Some([0.3, -0.2, 1.0])),
+    ];
+    Mechanism::new([0.0, -1.2, -9.81]).with_bodies(bodies).with_joints(joints)
+}
+
+/// A state of `n` coordinates, reproducibly spread over `±scale`.
+fn spread(n: usize, seed: u64, scale: f64) -> Vec<f64> {
+    let mut s = seed;
+    (0..n)
+        .map(|_| {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            scale * (2.0 * ((s >> 11) as f64 / (1u64 << 53) as f64) - 1.0)
+        })
+        .collect()
+}
+
+#[test]
+fn the_closed_forms_agree_with_finite_differences_of_the_energies() {
+    let built = branched().in_joint_coordinates().unwrap();
+    let model = &built.model;
+    let n = model.n();
+    assert_eq!(n, 5);
+    for seed in 1..4 {
+        let (q, v) = (spread(n, seed, 1.2), spread(n, seed + 10, 2.0));
+        let mut mass = DenseMass::new(n);
+        let (mut grad_q, mut mdot_v) = (vec![0.0; n], vec![0.0; n]);
+        let energy = model.mass_at(&q, &v, &mut mass, &mut grad_q, &mut mdot_v).unwrap();
+        let m = mass.matrix().to_vec();
+        let kinetic = |q: &[f64], v: &[f64]| model.kinetic(q, v);
+        assert!((energy - kinetic(&q, &v)).abs() < 1e-14 * energy);
+        let unit = |i: usize| -> Vec<f64> { (0..n).map(|k| f64::from(u8::from(k == i))).collect() };
+        let sum = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(a, b)| a + b).collect() };
+        let along = |x: &[f64], d: &[f64], s: f64| -> Vec<f64> { x.iter().zip(d).map(|(x, d)| x + s * d).collect() };
+        let scale = m.iter().fold(0.0_f64, |s, x| s.max(x.abs()));
+        for i in 0..n {
+            for j in 0..n {
+                // T is quadratic in v: M_ij = T(e_i + e_j) − T(e_i) − T(e_j) (also for i = j).
+                let exact = kinetic(&q, &sum(&unit(i), &unit(j))) - kinetic(&q, &unit(i)) - kinetic(&q, &unit(j));
+                assert!((m[i * n + j] - exact).abs() < 1e-13 * scale, "M[{i}][{j}] = {} vs {exact}", m[i * n + j]);
+            }
+            let e = 1e-6;
+            let fd = (kinetic(&along(&q, &unit(i), e), &v) - kinetic(&along(&q, &unit(i), -e), &v)) / (2.0 * e);
+            assert!((grad_q[i] - fd).abs() < 1e-7 * energy, "∂T/∂θ_{i} = {} vs {fd}", grad_q[i]);
+        }
+        // Ṁ θ̇ = d/ds M(θ + s θ̇) θ̇.
+        let mass_along = |s: f64| {
+            let mut mass = DenseMass::new(n);
+            let (mut g, mut d) = (vec![0.0; n], vec![0.0; n]);
+            model.mass_at(&along(&q, &v, s), &v, &mut mass, &mut g, &mut d).unwrap();
+            mass.matrix().to_vec()
+        };
+        let (plus, minus) = (mass_along(1e-6), mass_along(-1e-6));
+        for i in 0..n {
+            let fd: f64 = (0..n).map(|j| (plus[i * n + j] - minus[i * n + j]) / 2e-6 * v[j]).sum();
+            assert!((mdot_v[i] - fd).abs() < 1e-7 * energy, "(Ṁ θ̇)_{i} = {} vs {fd}", mdot_v[i]);
+        }
+        // Gravity: ∇V and ∇²V.
+        let potential = |q: &[f64]| model.potential(q, None);
+        let mut grad = vec![0.0; n];
+        let v0 = model.potential(&q, Some(&mut grad));
+        assert!((v0 - potential(&q)).abs() < 1e-15 * v0.abs().max(1.0));
+        let mut entries = Vec::new();
+        model.iteration_entries(&mut entries);
+        let mut hessian = vec![0.0; entries.len()];
+        model.iteration_values(&q, &v, 0.0, 1.0, 0.0, &mut hessian);
+        for i in 0..n {
+            let e = 1e-6;
+            let fd = (potential(&along(&q, &unit(i), e)) - potential(&along(&q, &unit(i), -e))) / (2.0 * e);
+            assert!((grad[i] - fd).abs() < 1e-7, "∂V/∂θ_{i} = {} vs {fd}", grad[i]);
+            let gradient_at = |s: f64| {
+                let mut g = vec![0.0; n];
+                model.potential(&along(&q, &unit(i), s), Some(&mut g));
+                g
+            };
+            let (gp, gm) = (gradient_at(e), gradient_at(-e));
+            for j in 0..n {
+                let fd = (gp[j] - gm[j]) / (2.0 * e);
+                let at = entries.iter().position(|&(r, c)| (r as usize, c as usize) == (j, i)).unwrap();
+                assert!((hessian[at] - fd).abs() < 1e-6, "∂²V/∂θ_{j}∂θ_{i} = {} vs {fd}", hessian[at]);
+            }
+        }
+    }
+}
+
+#[test]
+fn joint_accelerations_agree_with_the_mechanism_in_body_coordinates() {
+    let mut mechanism = branched();
+    // Damping and friction act on both formulations' joint rates.
+    mechanism.joints[1] = mechanism.joints[1].clone().with_damping(0.7).with_friction(0.2);
+    mechanism.joints[2] = mechanism.joints[2].clone().with_damping(1.3);
+    let in_joints = mechanism.in_joint_coordinates().unwrap();
+    let bodies = mechanism.build().unwrap();
+    let n = in_joints.model.n();
+    let (mut tree, mut full) = (Dynamics::new(&in_joints.model), Dynamics::new(&bodies.model));
+    let mut worst: f64 = 0.0;
+    for seed in 1..6 {
+        let (theta, rate) = (spread(n, seed, 1.5), spread(n, seed + 20, 3.0));
+        tree.evaluate(&in_joints.model, &theta, &rate, 0.0).unwrap();
+        let (q, v) = in_joints.bodies(&mechanism, &theta, &rate).unwrap();
+        full.evaluate(&bodies.model, &q, &v, 0.0).unwrap();
+        let read = mechanism.joint_coordinates(&q, &v, full.acc()).unwrap();
+        for (c, &joint) in in_joints.joints.iter().enumerate() {
+            let [_, r, a] = read[joint].unwrap();
+            assert!((r - rate[c]).abs() < 1e-12, "joint {joint}: rate {r} vs {}", rate[c]);
+            let scale = a.abs().max(1.0);
+            worst = worst.max((tree.acc()[c] - a).abs() / scale);
+            assert!((tree.acc()[c] - a).abs() < 1e-9 * scale, "joint {joint}: θ̈ {} vs {a}", tree.acc()[c]);
+        }
+    }
+    assert!(worst > 0.0, "two formulations agree to round-off, not bit for bit");
+}
+
+#[test]
+fn a_mimic_coupling_holds_and_energy_is_kept_over_a_run() {
+    let mechanism = branched().with_couplings(vec![Coupling::new(5, 1, -0.5, 0.1)]);
+    let built = mechanism.in_joint_coordinates().unwrap();
+    assert_eq!(built.model.m(), 1);
+    let mut q0 = built.q0.clone();
+    // Start on the coupling: θ_5 = −0.5 θ_1 + 0.1 with θ_1 = 0.
+    q0[4] = 0.1;
+    // Without control: RK-4 keeps a linear row's Φ and Φ̇ to round-off, and
+    // the energy to its truncation error.
+    let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::none());
+    let mut sim = Simulation::new(&built.model, settings, &q0, &built.v0).unwrap();
+    let e0 = built.model.potential(&q0, None);
+    sim.run::<crate::Error>(2.0, 1000, |_| Ok(())).unwrap();
+    let end = sim.measure();
+    assert!(end.phi.abs() < 1e-12 && end.phi_dot.abs() < 1e-12, "|Φ| = {}, |Φ̇| = {}", end.phi, end.phi_dot);
+    assert!(end.psi.abs() < 1e-9 * e0.abs(), "Ψ = {} of E = {e0}", end.psi);
+    let q = sim.q();
+    assert!(q[0].abs() > 0.1, "the tree moved under gravity: {q:?}");
+}
+
+#[test]
+fn what_joint_coordinates_cannot_describe_is_refused_by_name() {
+    let loop_closed = branched().with_joints({
+        let mut j = branched().joints;
+        j.push(Joint::new(JointKind::Spherical, 3, Some(5), [0.2, 0.2, -0.5]));
+        j
+    });
+    let message = |m: Mechanism| m.in_joint_coordinates().err().map(|e| e.to_string()).unwrap_or_default();
+    let text = message(loop_closed);
+    assert!(text.contains("spherical") && text.contains("coordinate"), "{text}");
+    let mut looped = branched();
+    looped.joints.push(Joint::new(JointKind::Revolute, 3, Some(5), [0.2, 0.2, -0.5]).with_axis([0.0, 0.0, 1.0]));
+    let text = message(looped);
+    // The breadth-first tree reaches `hand` through the new joint first, so the older one closes the loop.
+    assert!(text.contains("element 3 (revolute)") && text.contains("closes a loop"), "{text}");
+    let mut floating = branched();
+    floating.joints.remove(5);
+    let text = message(floating);
+    assert!(text.contains("branch") && text.contains("not joined to the ground"), "{text}");
+    let mut limited = branched();
+    limited.joints[0] = limited.joints[0].clone().with_limit(crate::spatial::JointLimit::new(-1.0, 1.0));
+    assert!(message(limited).contains("limits are not modelled"));
+}
