@@ -42,6 +42,7 @@ mod snapshot;
 mod spatial;
 mod start;
 mod stepping;
+mod tree;
 mod turns;
 mod unilateral;
 
@@ -50,4 +51,5 @@ pub use snapshot::StopSnapshot;
 pub use spatial::MechanismStops;
 pub use start::{START_SLACK, check_start};
 pub use stepping::{StopSimulation, run_with_stops};
+pub use tree::TreeStops;
 pub use unilateral::{Change, Event, Report, Unilateral};

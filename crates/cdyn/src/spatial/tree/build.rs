@@ -7,6 +7,7 @@ use super::motion::{Inertia, M3};
 use super::{Node, Shared, Tree};
 use crate::ad::scalar::Scalar;
 use crate::error::{Error, Part, Problem, Result};
+use crate::limit::Stop;
 use crate::model::Model;
 use crate::model::constraint::Constraint;
 use crate::model::force::PotentialBlock;
@@ -53,6 +54,18 @@ impl Constraint<2, 1> for Coupled {
     }
 }
 
+/// `s (θ − bound)`: a held stop.
+struct Bound {
+    bound: f64,
+    sign: f64,
+}
+
+impl Constraint<1, 1> for Bound {
+    fn eval<D: Scalar>(&self, [theta]: [D; 1], _t: D) -> [D; 1] {
+        [(theta - self.bound) * self.sign]
+    }
+}
+
 fn refuse(part: Part, reason: impl Into<String>) -> Error {
     Problem::JointCoordinates { reason: reason.into() }.at(part)
 }
@@ -64,9 +77,16 @@ impl Mechanism {
     /// ground by one path of joints); bodies welded by fixed joints ride
     /// with their parent, and those welded to the ground are ground. The
     /// joints' damping and friction and `<mimic>` couplings (one row
-    /// each) are modelled; drives, limits, loads, actuators and bodies'
-    /// own initial velocities are refused for now, by name.
+    /// each) are modelled, and limits as stops
+    /// ([`TreeStops`](crate::stops::TreeStops)); drives, loads, actuators
+    /// and bodies' own initial velocities are refused for now, by name.
     pub fn in_joint_coordinates(&self) -> Result<InJoints> {
+        self.in_joint_coordinates_holding(&[])
+    }
+
+    /// [`Mechanism::in_joint_coordinates`] with the stops `held` as rows
+    /// `g = s (θ − bound) = 0` after all others, in that order.
+    pub fn in_joint_coordinates_holding(&self, held: &[Stop]) -> Result<InJoints> {
         if self.bodies.is_empty() {
             return Err(Problem::NoBodies.into());
         }
@@ -158,6 +178,16 @@ impl Mechanism {
             }
             builder = builder.constrain(Coupled { multiplier: coupling.multiplier, offset: coupling.offset }, [f, l]);
         }
+        for &stop in held {
+            let at = Part::Element { index: stop.joint, kind: "limit" };
+            let Some(c) =
+                joints.iter().position(|&j| j == stop.joint).filter(|_| self.joints[stop.joint].limit.is_some())
+            else {
+                return Err(Error::from(Problem::NoSuchJoint { index: stop.joint }).at(at));
+            };
+            let (bound, sign, _) = self.stop_bound(stop);
+            builder = builder.constrain(Bound { bound, sign }, [c]);
+        }
         Ok(InJoints { model: builder.build()?, q0: vec![0.0; n], v0: vec![0.0; n], joints })
     }
 
@@ -174,14 +204,14 @@ impl Mechanism {
                 JointKind::Revolute | JointKind::Prismatic | JointKind::Fixed => None,
                 kind => Some(format!("a {} joint has more or less than one coordinate", kind.name())),
             };
-            let reason = reason
-                .or_else(|| {
-                    (joint.angle.is_some() || joint.displacement.is_some())
-                        .then(|| "drives are not modelled yet".into())
-                })
-                .or_else(|| joint.limit.is_some().then(|| "joint limits are not modelled yet".into()));
+            let reason = reason.or_else(|| {
+                (joint.angle.is_some() || joint.displacement.is_some()).then(|| "drives are not modelled yet".into())
+            });
             if let Some(reason) = reason {
                 return Err(refuse(part, reason));
+            }
+            if let Some(limit) = &joint.limit {
+                limit.check().map_err(|e| e.at(part))?;
             }
         }
         if let Some(load) = self.loads.first() {

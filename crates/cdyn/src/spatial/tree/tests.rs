@@ -6,7 +6,8 @@
 
 use crate::dynamics::Dynamics;
 use crate::linalg::mass::DenseMass;
-use crate::spatial::{Body, Coupling, Joint, JointKind, Mechanism};
+use crate::spatial::{Body, Coupling, Joint, JointKind, JointLimit, Mechanism};
+use crate::stops::{Change, Event, TreeStops, run_with_stops};
 use crate::{Control, Scheme, Settings, Simulation};
 
 /// A branched tree: a revolute root on a tilted axis, a revolute joint on
@@ -193,7 +194,50 @@ fn what_joint_coordinates_cannot_describe_is_refused_by_name() {
     floating.joints.remove(5);
     let text = message(floating);
     assert!(text.contains("branch") && text.contains("not joined to the ground"), "{text}");
-    let mut limited = branched();
-    limited.joints[0] = limited.joints[0].clone().with_limit(crate::spatial::JointLimit::new(-1.0, 1.0));
-    assert!(message(limited).contains("limits are not modelled"));
+    let mut driven = branched();
+    driven.joints[0] = driven.joints[0].clone().with_angle(crate::model::timefn::TimeFn::linear(0.0, 1.0));
+    assert!(message(driven).contains("drives are not modelled"));
+    let mut inverted = branched();
+    inverted.joints[2] = inverted.joints[2].clone().with_limit(JointLimit::new(1.0, -1.0));
+    let text = message(inverted);
+    assert!(text.contains("element 2 (prismatic)") && text.contains("lower"), "{text}");
+}
+
+/// The hand-computed stop of `tests/limits.rs` in joint coordinates: a rod
+/// released from rest at φ₀ = 1.2 rad from the vertical falls onto a stop
+/// at φ = 0.3 rad (`θ = φ − φ₀ = −0.9`), reached at `t*` with all its
+/// kinetic energy lost (`e = 0`), and is held there by gravity.
+#[test]
+fn a_pendulum_in_joint_coordinates_is_stopped_at_its_limit_when_computed_by_hand() {
+    let (g, m, l, jyy, phi0, phi_stop) = (9.81, 2.0, 0.5, 0.02, 1.2_f64, 0.3_f64);
+    let rod = Body::new("rod", m, [0.02, jyy, 0.005])
+        .with_position([-l * phi0.sin(), 0.0, -l * phi0.cos()])
+        .with_orientation([(phi0 / 2.0).cos(), 0.0, (phi0 / 2.0).sin(), 0.0]);
+    let limit = JointLimit::new(phi_stop - phi0, f64::INFINITY);
+    let pivot = Joint::new(JointKind::Revolute, 0, None, [0.0; 3]).with_axis([0.0, 1.0, 0.0]).with_limit(limit);
+    let mechanism = Mechanism::new([0.0, 0.0, -g]).with_bodies(vec![rod]).with_joints(vec![pivot]);
+    let inertia = jyy + m * l * l;
+    let k = m * g * l / inertia;
+    let t_star = crate::reference::time_to_swing(k, phi0, phi_stop).unwrap();
+    let rate = (2.0 * k * (phi_stop.cos() - phi0.cos())).sqrt();
+    let built = mechanism.in_joint_coordinates().unwrap();
+    let system = TreeStops::new(mechanism).unwrap();
+    let h = 1e-3;
+    let settings = Settings::new(Scheme::RungeKutta4, h, Control::robust());
+    let mut held = Vec::new();
+    let report = run_with_stops::<_, crate::Error>(&system, settings, &built.q0, &built.v0, 1.5, 1, |t, q, v| {
+        held.push((t, q[0], v[0]));
+        Ok(())
+    })
+    .unwrap();
+    let [Event { t, change: Change::Impact { rate: hit, kinetic_lost, held: true }, .. }] = report.events[..] else {
+        panic!("{:?}", report.events)
+    };
+    assert!((t - t_star).abs() < 1e-6, "stopped at {t}, by hand {t_star}");
+    assert!((-hit - rate).abs() < h * k, "{hit} against {rate}");
+    assert!((kinetic_lost - 0.5 * inertia * hit * hit).abs() < 1e-12 * kinetic_lost, "{kinetic_lost}");
+    let after: Vec<_> = held.iter().filter(|(s, ..)| *s > t + h).collect();
+    assert!(after.len() > 500);
+    let worst = after.iter().fold(0.0_f64, |w, (_, x, r)| w.max((x - (phi_stop - phi0)).abs()).max(r.abs()));
+    assert!(worst < 1e-9, "off the stop by {worst}");
 }
