@@ -77,3 +77,9 @@ def urdf_joints(
     q: List[List[float]],
     v: List[List[float]],
 ) -> Tuple[List[str], List[float], List[float], List[str], List[List[Tuple[float, float, float]]], float]: ...
+def urdf_tree(
+    path: str,
+    gravity: List[float],
+    theta: List[List[float]],
+    rate: List[List[float]],
+) -> Tuple[List[str], List[List[float]], float]: ...

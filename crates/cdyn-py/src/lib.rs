@@ -359,6 +359,7 @@ fn _cdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_suite, m)?)?;
     m.add_function(wrap_pyfunction!(run_precision, m)?)?;
     m.add_function(wrap_pyfunction!(robot::urdf_joints, m)?)?;
+    m.add_function(wrap_pyfunction!(robot::urdf_tree, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
