@@ -7,7 +7,9 @@ the same machine), microseconds per call:
   evaluation of the dynamics in redundant coordinates: M(q) by blocks,
   Φ_q and γ by automatic differentiation, S factored), of AB-3 with
   `robust`, of RK-4 (four evaluations) and of generalized-α (implicit),
-  h = 1e-4, best of 5 trials;
+  h = 1e-4, best of 5 trials; the same in joint coordinates
+  (`Mechanism::in_joint_coordinates`: one coordinate per joint, M(θ) and
+  the velocity terms by the composite-body and Newton-Euler passes);
 - Pinocchio: `pin.aba` (forward dynamics in joint coordinates) called from
   Python, best of 5 trials of 20 000 calls, less the same call on a model
   of one revolute joint (the per-call floor of Python and the bindings,
@@ -103,9 +105,7 @@ def main():
     root = robots_dir()
     floor = best_per_call(aba_call(floor_model()))
     print(f"Pinocchio per-call floor (ABA of one revolute joint from Python): {floor:.3f} µs")
-    print("| Robot | n, m | cdyn AB-3 | cdyn AB-3, robust | cdyn RK-4 | cdyn generalized-α | Pinocchio ABA (C++) "
-          "| MuJoCo Euler | MuJoCo RK4 | MuJoCo implicitfast |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
     for name, relative in ROBOTS:
         path = os.path.join(root, relative)
         out = subprocess.run([binary, path], check=True, capture_output=True, text=True).stdout
@@ -115,9 +115,23 @@ def main():
         euler = mujoco_step(mj, mujoco.mjtIntegrator.mjINT_EULER)
         rk4 = mujoco_step(mj, mujoco.mjtIntegrator.mjINT_RK4)
         implicit = mujoco_step(mj, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+        rows.append((name, cdyn, aba, euler, rk4, implicit))
+    print("\nBody coordinates:\n")
+    print("| Robot | n, m | cdyn AB-3 | cdyn AB-3, robust | cdyn RK-4 | cdyn generalized-α | Pinocchio ABA (C++) "
+          "| MuJoCo Euler | MuJoCo RK4 | MuJoCo implicitfast |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name, cdyn, aba, euler, rk4, implicit in rows:
         print(f"| {name} | {cdyn['n']}, {cdyn['m']} | {cdyn['ab3_us']:.2f} | {cdyn['ab3_robust_us']:.2f} "
               f"| {cdyn['rk4_us']:.2f} | {cdyn['alpha_us']:.2f} | {aba:.2f} | {euler:.2f} | {rk4:.2f} "
               f"| {implicit:.2f} |")
+    print("\nJoint coordinates:\n")
+    print("| Robot | n, m | cdyn AB-3 | cdyn AB-3, robust | cdyn RK-4 | cdyn generalized-α | Pinocchio ABA (C++) "
+          "| AB-3 / ABA |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, cdyn, aba, *_ in rows:
+        print(f"| {name} | {cdyn['joints_n']}, {cdyn['joints_m']} | {cdyn['joints_ab3_us']:.2f} "
+              f"| {cdyn['joints_ab3_robust_us']:.2f} | {cdyn['joints_rk4_us']:.2f} | {cdyn['joints_alpha_us']:.2f} "
+              f"| {aba:.2f} | {cdyn['joints_ab3_us'] / aba:.2f} |")
 
 
 if __name__ == "__main__":
