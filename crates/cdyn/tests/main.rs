@@ -12,6 +12,7 @@ mod derivatives;
 mod euler_parameters;
 mod generalized_alpha;
 mod inputs;
+mod joint_coordinates;
 mod kinetic;
 mod layout;
 mod limits;

@@ -17,16 +17,9 @@ impl Mechanism {
         poses: &[Pose],
         forces: &mut Vec<Part>,
     ) -> Result<ModelBuilder> {
-        let mut declared: Vec<&Input> = Vec::new();
+        builder = self.declare_inputs(builder);
         for (k, actuator) in self.actuators.iter().enumerate() {
-            let index = self.joints.len() + self.loads.len() + self.couplings.len() + k;
-            let at = Part::Element { index, kind: "actuator" };
-            for (input, _) in actuator.functions().filter_map(|f| f.input.as_ref()) {
-                if !declared.contains(&input) {
-                    builder = builder.input(input);
-                    declared.push(input);
-                }
-            }
+            let at = self.actuator_part(k);
             let element = self.joint_actuator(actuator, poses).map_err(|e| e.at(at.clone()))?;
             builder = match reads(&self.joints[actuator.joint]) {
                 Reads::Ground(at) => builder.force(element, at),
@@ -35,6 +28,23 @@ impl Mechanism {
             forces.push(at);
         }
         Ok(builder)
+    }
+
+    /// Declares every input the actuators read, once each.
+    pub(super) fn declare_inputs(&self, mut builder: ModelBuilder) -> ModelBuilder {
+        let mut declared: Vec<&Input> = Vec::new();
+        for (input, _) in self.actuators.iter().flat_map(|a| a.functions()).filter_map(|f| f.input.as_ref()) {
+            if !declared.contains(&input) {
+                builder = builder.input(input);
+                declared.push(input);
+            }
+        }
+        builder
+    }
+
+    /// How errors name actuator `k`: after the joints, loads and couplings.
+    pub(super) fn actuator_part(&self, k: usize) -> Part {
+        Part::Element { index: self.joints.len() + self.loads.len() + self.couplings.len() + k, kind: "actuator" }
     }
 
     /// Actuator `actuator`'s element, checked: on a revolute or prismatic joint.

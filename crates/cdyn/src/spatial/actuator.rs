@@ -145,28 +145,36 @@ pub(crate) struct JointActuator {
     pub range: Option<JointLimit>,
 }
 
-impl JointActuator {
-    /// `τ` at the coordinates `x`, rates `xd` and time `t`, clamped.
-    fn torque<D: Scalar, const K: usize>(&self, x: &[D; K], xd: &[D; K], t: D) -> D {
-        let tau = match &self.law.drive {
+impl Law {
+    /// `τ` at time `t`, clamped, for a servo whose joint is `error(θ_ref)`
+    /// off its target `θ_ref` and moves at `rate()` (read only by a servo).
+    #[inline(always)]
+    pub(crate) fn torque<D: Scalar>(&self, t: D, error: impl FnOnce(D) -> D, rate: impl FnOnce() -> D) -> D {
+        let tau = match &self.drive {
             Drive::Torque(f) => f.eval(t),
-            Drive::Servo { target, rate, kp, kd } => {
-                let error = match self.range {
-                    Some(_) => self.coordinate.in_range(x, self.sides::<K>(), self.range) - target.eval(t),
-                    None => self.coordinate.at(x, self.sides::<K>(), target.eval(t)),
-                };
-                (rate.eval(t) - self.rate(x, xd)) * *kd - error * *kp
+            Drive::Servo { target, rate: target_rate, kp, kd } => {
+                (target_rate.eval(t) - rate()) * *kd - error(target.eval(t)) * *kp
             }
         };
-        let effort = self.law.effort;
         // The clamp: τ held at ±effort, whose derivatives are then zero.
-        if tau.re() > effort {
-            D::from(effort)
-        } else if tau.re() < -effort {
-            D::from(-effort)
+        if tau.re() > self.effort {
+            D::from(self.effort)
+        } else if tau.re() < -self.effort {
+            D::from(-self.effort)
         } else {
             tau
         }
+    }
+}
+
+impl JointActuator {
+    /// `τ` at the coordinates `x`, rates `xd` and time `t`, clamped.
+    fn torque<D: Scalar, const K: usize>(&self, x: &[D; K], xd: &[D; K], t: D) -> D {
+        let error = |target: D| match self.range {
+            Some(_) => self.coordinate.in_range(x, self.sides::<K>(), self.range) - target,
+            None => self.coordinate.at(x, self.sides::<K>(), target),
+        };
+        self.law.torque(t, error, || self.rate(x, xd))
     }
 
     fn sides<const K: usize>(&self) -> [Option<usize>; 2] {

@@ -2,16 +2,16 @@
 //! formulation does not model yet refused by name.
 
 use super::dynamics::TreeKinetic;
+use super::elements::{Actuated, Bound, Coupled, Driven};
 use super::gravity::TreeGravity;
 use super::motion::{Inertia, M3};
 use super::{Node, Shared, Tree};
-use crate::ad::scalar::Scalar;
 use crate::error::{Error, Part, Problem, Result};
 use crate::limit::Stop;
 use crate::model::Model;
-use crate::model::constraint::Constraint;
 use crate::model::force::PotentialBlock;
-use crate::spatial::joint::JointKind;
+use crate::model::timefn::TimeFn;
+use crate::spatial::joint::{Joint, JointKind};
 use crate::spatial::mechanism::Mechanism;
 use crate::spatial::placing::joint_law;
 use crate::spatial::posing::line;
@@ -24,9 +24,10 @@ use std::sync::Arc;
 pub struct InJoints {
     /// The model: coordinate `k` is joint `joints[k]`'s angle (displacement).
     pub model: Model,
-    /// All coordinates 0: the pose the mechanism is defined in.
+    /// The pose the mechanism is defined in, all coordinates 0 but a driven
+    /// joint's, at its drive's `f(0)`.
     pub q0: Vec<f64>,
-    /// All rates 0.
+    /// All rates 0 but a driven joint's, `ḟ(0)`.
     pub v0: Vec<f64>,
     /// The mechanism's joint of each coordinate, in joint order.
     pub joints: Vec<usize>,
@@ -42,30 +43,6 @@ impl InJoints {
     }
 }
 
-/// `x_f − m x_l − offset`: a `<mimic>` coupling between two joint coordinates.
-struct Coupled {
-    multiplier: f64,
-    offset: f64,
-}
-
-impl Constraint<2, 1> for Coupled {
-    fn eval<D: Scalar>(&self, [follower, leader]: [D; 2], _t: D) -> [D; 1] {
-        [follower - leader * self.multiplier - self.offset]
-    }
-}
-
-/// `s (θ − bound)`: a held stop.
-struct Bound {
-    bound: f64,
-    sign: f64,
-}
-
-impl Constraint<1, 1> for Bound {
-    fn eval<D: Scalar>(&self, [theta]: [D; 1], _t: D) -> [D; 1] {
-        [(theta - self.bound) * self.sign]
-    }
-}
-
 fn refuse(part: Part, reason: impl Into<String>) -> Error {
     Problem::JointCoordinates { reason: reason.into() }.at(part)
 }
@@ -77,9 +54,11 @@ impl Mechanism {
     /// ground by one path of joints); bodies welded by fixed joints ride
     /// with their parent, and those welded to the ground are ground. The
     /// joints' damping and friction and `<mimic>` couplings (one row
-    /// each) are modelled, and limits as stops
-    /// ([`TreeStops`](crate::stops::TreeStops)); drives, loads, actuators
-    /// and bodies' own initial velocities are refused for now, by name.
+    /// each), drives (a row `θ − f(t)` each, the joint started at `f(0)`,
+    /// `ḟ(0)`), actuators (a torque on the coordinate; a servo's error is
+    /// `θ − θ_ref` itself, turns counted) and limits as stops
+    /// ([`TreeStops`](crate::stops::TreeStops)); loads and bodies' own
+    /// initial velocities are refused for now, by name.
     pub fn in_joint_coordinates(&self) -> Result<InJoints> {
         self.in_joint_coordinates_holding(&[])
     }
@@ -158,11 +137,29 @@ impl Mechanism {
         let names = joints.iter().map(|k| format!("joint {k}")).collect();
         let mut builder =
             Model::builder(vec![0.0; n]).coordinate_names(names).whole(Box::new(TreeKinetic(shared)), gravity);
+        let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
         for (c, &k) in joints.iter().enumerate() {
             let at = Part::Element { index: k, kind: self.joints[k].kind.name() };
-            if let Some(law) = joint_law(&self.joints[k]).map_err(|e| e.at(at))? {
+            if let Some(law) = joint_law(&self.joints[k]).map_err(|e| e.at(at.clone()))? {
                 builder = builder.force(law, [c]);
             }
+            if let Some(f) = drive(&self.joints[k]).map_err(|e| e.at(at))? {
+                // Started where the drive has it: the row holds from t = 0.
+                (q0[c], v0[c]) = (f.eval(0.0), f.derivative().eval(0.0));
+                builder = builder.constrain(Driven(f.clone()), [c]);
+            }
+        }
+        builder = self.declare_inputs(builder);
+        for (k, actuator) in self.actuators.iter().enumerate() {
+            let at = self.actuator_part(k);
+            let joint = self.joints.get(actuator.joint).ok_or(Problem::NoSuchJoint { index: actuator.joint });
+            let joint = joint.map_err(|e| Error::from(e).at(at.clone()))?;
+            let Some(c) = joints.iter().position(|&j| j == actuator.joint) else {
+                let kind = joint.kind.name();
+                return Err(Error::from(Problem::NoCoordinate { index: actuator.joint, kind }).at(at));
+            };
+            let law = actuator.law(joint.limit.map_or(f64::INFINITY, |l| l.effort)).map_err(|e| e.at(at))?;
+            builder = builder.force(Actuated(law), [c]);
         }
         for (k, coupling) in self.couplings.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
@@ -188,7 +185,7 @@ impl Mechanism {
             let (bound, sign, _) = self.stop_bound(stop);
             builder = builder.constrain(Bound { bound, sign }, [c]);
         }
-        Ok(InJoints { model: builder.build()?, q0: vec![0.0; n], v0: vec![0.0; n], joints })
+        Ok(InJoints { model: builder.build()?, q0, v0, joints })
     }
 
     fn refuse_what_is_not_modelled(&self) -> Result<()> {
@@ -204,9 +201,6 @@ impl Mechanism {
                 JointKind::Revolute | JointKind::Prismatic | JointKind::Fixed => None,
                 kind => Some(format!("a {} joint has more or less than one coordinate", kind.name())),
             };
-            let reason = reason.or_else(|| {
-                (joint.angle.is_some() || joint.displacement.is_some()).then(|| "drives are not modelled yet".into())
-            });
             if let Some(reason) = reason {
                 return Err(refuse(part, reason));
             }
@@ -220,12 +214,24 @@ impl Mechanism {
                 "loads are not modelled yet",
             ));
         }
-        if !self.actuators.is_empty() {
-            return Err(refuse(
-                Part::Element { index: self.actuators[0].joint, kind: "actuator" },
-                "actuators are not modelled yet",
-            ));
-        }
         Ok(())
+    }
+}
+
+/// A joint's drive, checked: an angle on a revolute joint, a displacement
+/// on a prismatic one, finite; none on a fixed one.
+fn drive(joint: &Joint) -> Result<Option<&TimeFn>> {
+    let kind = joint.kind.name();
+    let (own, other, key) = match joint.kind {
+        JointKind::Revolute => (&joint.angle, &joint.displacement, "displacement"),
+        JointKind::Prismatic => (&joint.displacement, &joint.angle, "angle"),
+        _ => (&None, &joint.angle, "angle"),
+    };
+    if other.is_some() {
+        return Err(Problem::JointKey { key, kind, wanted: false }.into());
+    }
+    match own {
+        Some(f) if !f.is_finite() => Err(Problem::NonFiniteFunction.into()),
+        f => Ok(f.as_ref()),
     }
 }

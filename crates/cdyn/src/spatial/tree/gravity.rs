@@ -84,3 +84,49 @@ impl PotentialBlock for TreeGravity {
         self
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::spatial::{Body, Joint, JointKind, Mechanism};
+
+    /// `∇²V` against central differences of the closed-form `∇V` (itself
+    /// held to differences of `V` in `tests/joint_coordinates.rs`), on a
+    /// chain of a revolute, a prismatic and a revolute joint on tilted
+    /// axes, with a branch, at a few states.
+    #[test]
+    fn the_hessian_agrees_with_differences_of_the_gradient() {
+        let body = |name: &str, r: [f64; 3]| Body::new(name, 1.3, [0.02, 0.03, 0.025]).with_position(r);
+        let joint = |kind, a, b, point, axis| Joint::new(kind, a, b, point).with_axis(axis);
+        let mechanism = Mechanism::new([0.4, -1.0, -9.81])
+            .with_bodies(vec![body("a", [0.2, 0.0, -0.1]), body("b", [0.4, 0.1, -0.3]), body("c", [0.5, 0.3, -0.5])])
+            .with_joints(vec![
+                joint(JointKind::Revolute, 0, None, [0.0; 3], [0.0, 0.3, 1.0]),
+                joint(JointKind::Prismatic, 1, Some(0), [0.3, 0.0, -0.2], [0.2, 1.0, 0.1]),
+                joint(JointKind::Revolute, 2, Some(0), [0.4, 0.2, -0.4], [1.0, 0.0, 0.5]),
+            ]);
+        let model = mechanism.in_joint_coordinates().unwrap().model;
+        let n = model.n();
+        let mut entries = Vec::new();
+        model.iteration_entries(&mut entries);
+        assert_eq!(entries.len(), n * n);
+        for q in [[0.3, -0.2, 1.1], [-1.4, 0.5, -0.7], [2.5, 0.05, 0.2]] {
+            let mut hessian = vec![0.0; entries.len()];
+            model.iteration_values(&q, &[0.0; 3], 0.0, 1.0, 0.0, &mut hessian);
+            let gradient_at = |i: usize, s: f64| {
+                let mut x = q;
+                x[i] += s;
+                let mut g = vec![0.0; n];
+                model.potential(&x, Some(&mut g));
+                g
+            };
+            for i in 0..n {
+                let (plus, minus) = (gradient_at(i, 1e-6), gradient_at(i, -1e-6));
+                for j in 0..n {
+                    let fd = (plus[j] - minus[j]) / 2e-6;
+                    let at = entries.iter().position(|&e| e == (j as u32, i as u32)).unwrap();
+                    assert!((hessian[at] - fd).abs() < 1e-6, "∂²V/∂θ_{j}∂θ_{i} = {} vs {fd}", hessian[at]);
+                }
+            }
+        }
+    }
+}

@@ -14,13 +14,15 @@
 //! differentiate at `O(n²)` passes per state.
 //!
 //! Here the tree and the work its elements share; `build` the tree and
-//! model from a mechanism; `kinematics` the poses at `θ`; `motion` the
+//! model from a mechanism; `elements` the rows and forces on its
+//! coordinates; `kinematics` the poses at `θ`; `motion` the
 //! spatial vectors.
 //!
-//! May import: `error`, `model`, `spatial`.
+//! May import: `error`, `ad`, `model`, `limit`, `spatial`.
 
 mod build;
 mod dynamics;
+mod elements;
 mod gravity;
 mod kinematics;
 mod motion;
@@ -96,6 +98,3 @@ impl Shared {
         self.work.lock().unwrap_or_else(|e| e.into_inner())
     }
 }
-
-#[cfg(test)]
-mod tests;

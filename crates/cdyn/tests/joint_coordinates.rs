@@ -2,13 +2,15 @@
 //! finite differences of its own `T` and `V`, its accelerations against
 //! the same mechanism in body coordinates (a different formulation: seven
 //! coordinates per body, the joints as constraint rows, `M(q)` and the
-//! rows by automatic differentiation), and the energy over a run.
+//! rows by automatic differentiation), the energy over a run, and a stop
+//! computed by hand. (Gravity's Hessian: a unit test in `tree/gravity.rs`.)
 
-use crate::dynamics::Dynamics;
-use crate::linalg::mass::DenseMass;
-use crate::spatial::{Body, Coupling, Joint, JointKind, JointLimit, Mechanism};
-use crate::stops::{Change, Event, TreeStops, run_with_stops};
-use crate::{Control, Scheme, Settings, Simulation};
+use cdyn::dynamics::Dynamics;
+use cdyn::linalg::mass::DenseMass;
+use cdyn::model::timefn::TimeFn;
+use cdyn::spatial::{Actuator, Body, Coupling, Joint, JointKind, JointLimit, Mechanism};
+use cdyn::stops::{Change, Event, TreeStops, run_with_stops};
+use cdyn::{Control, Scheme, Settings, Simulation};
 
 /// A branched tree: a revolute root on a tilted axis, a revolute joint on
 /// it, a prismatic joint beyond, a revolute joint given child first (its
@@ -103,25 +105,10 @@ fn the_closed_forms_agree_with_finite_differences_of_the_energies() {
         let mut grad = vec![0.0; n];
         let v0 = model.potential(&q, Some(&mut grad));
         assert!((v0 - potential(&q)).abs() < 1e-15 * v0.abs().max(1.0));
-        let mut entries = Vec::new();
-        model.iteration_entries(&mut entries);
-        let mut hessian = vec![0.0; entries.len()];
-        model.iteration_values(&q, &v, 0.0, 1.0, 0.0, &mut hessian);
         for i in 0..n {
             let e = 1e-6;
             let fd = (potential(&along(&q, &unit(i), e)) - potential(&along(&q, &unit(i), -e))) / (2.0 * e);
             assert!((grad[i] - fd).abs() < 1e-7, "∂V/∂θ_{i} = {} vs {fd}", grad[i]);
-            let gradient_at = |s: f64| {
-                let mut g = vec![0.0; n];
-                model.potential(&along(&q, &unit(i), s), Some(&mut g));
-                g
-            };
-            let (gp, gm) = (gradient_at(e), gradient_at(-e));
-            for j in 0..n {
-                let fd = (gp[j] - gm[j]) / (2.0 * e);
-                let at = entries.iter().position(|&(r, c)| (r as usize, c as usize) == (j, i)).unwrap();
-                assert!((hessian[at] - fd).abs() < 1e-6, "∂²V/∂θ_{j}∂θ_{i} = {} vs {fd}", hessian[at]);
-            }
         }
     }
 }
@@ -129,19 +116,33 @@ fn the_closed_forms_agree_with_finite_differences_of_the_energies() {
 #[test]
 fn joint_accelerations_agree_with_the_mechanism_in_body_coordinates() {
     let mut mechanism = branched();
-    // Damping and friction act on both formulations' joint rates.
+    // Damping and friction act on both formulations' joint rates; a torque
+    // of time on the root, a servo clamped at its effort on the hand and a
+    // drive on the branch, at t = 0.4.
     mechanism.joints[1] = mechanism.joints[1].clone().with_damping(0.7).with_friction(0.2);
     mechanism.joints[2] = mechanism.joints[2].clone().with_damping(1.3);
+    mechanism.joints[3] = mechanism.joints[3].clone().with_limit(JointLimit::new(-3.0, 3.0).with_effort(0.4));
+    let drive = TimeFn::sine(0.3, 2.0, 0.1);
+    mechanism.joints[5] = mechanism.joints[5].clone().with_angle(drive.clone());
+    mechanism.actuators = vec![
+        Actuator::torque(0, TimeFn::polynomial(vec![0.5, -1.0, 2.0])),
+        Actuator::servo(3, TimeFn::linear(0.2, 0.5), 3.0, 0.4),
+    ];
+    let t = 0.4;
     let in_joints = mechanism.in_joint_coordinates().unwrap();
     let bodies = mechanism.build().unwrap();
     let n = in_joints.model.n();
+    let driven = in_joints.joints.iter().position(|&j| j == 5).unwrap();
     let (mut tree, mut full) = (Dynamics::new(&in_joints.model), Dynamics::new(&bodies.model));
     let mut worst: f64 = 0.0;
     for seed in 1..6 {
-        let (theta, rate) = (spread(n, seed, 1.5), spread(n, seed + 20, 3.0));
-        tree.evaluate(&in_joints.model, &theta, &rate, 0.0).unwrap();
+        let (mut theta, mut rate) = (spread(n, seed, 1.5), spread(n, seed + 20, 3.0));
+        // On the drive's row, where its two forms (θ − f and the body
+        // coordinates' own) have the same second derivative.
+        (theta[driven], rate[driven]) = (drive.eval(t), drive.derivative().eval(t));
+        tree.evaluate(&in_joints.model, &theta, &rate, t).unwrap();
         let (q, v) = in_joints.bodies(&mechanism, &theta, &rate).unwrap();
-        full.evaluate(&bodies.model, &q, &v, 0.0).unwrap();
+        full.evaluate(&bodies.model, &q, &v, t).unwrap();
         let read = mechanism.joint_coordinates(&q, &v, full.acc()).unwrap();
         for (c, &joint) in in_joints.joints.iter().enumerate() {
             let [_, r, a] = read[joint].unwrap();
@@ -152,6 +153,10 @@ fn joint_accelerations_agree_with_the_mechanism_in_body_coordinates() {
         }
     }
     assert!(worst > 0.0, "two formulations agree to round-off, not bit for bit");
+    // The driven joint follows its drive, the clamped servo pushes at its effort.
+    let c = driven;
+    assert!((tree.acc()[c] - drive.derivative().derivative().eval(t)).abs() < 1e-9);
+    assert_eq!((in_joints.q0[c], in_joints.v0[c]), (drive.eval(0.0), drive.derivative().eval(0.0)));
 }
 
 #[test]
@@ -167,7 +172,7 @@ fn a_mimic_coupling_holds_and_energy_is_kept_over_a_run() {
     let settings = Settings::new(Scheme::RungeKutta4, 1e-3, Control::none());
     let mut sim = Simulation::new(&built.model, settings, &q0, &built.v0).unwrap();
     let e0 = built.model.potential(&q0, None);
-    sim.run::<crate::Error>(2.0, 1000, |_| Ok(())).unwrap();
+    sim.run::<cdyn::Error>(2.0, 1000, |_| Ok(())).unwrap();
     let end = sim.measure();
     assert!(end.phi.abs() < 1e-12 && end.phi_dot.abs() < 1e-12, "|Φ| = {}, |Φ̇| = {}", end.phi, end.phi_dot);
     assert!(end.psi.abs() < 1e-9 * e0.abs(), "Ψ = {} of E = {e0}", end.psi);
@@ -195,8 +200,13 @@ fn what_joint_coordinates_cannot_describe_is_refused_by_name() {
     let text = message(floating);
     assert!(text.contains("branch") && text.contains("not joined to the ground"), "{text}");
     let mut driven = branched();
-    driven.joints[0] = driven.joints[0].clone().with_angle(crate::model::timefn::TimeFn::linear(0.0, 1.0));
-    assert!(message(driven).contains("drives are not modelled"));
+    driven.joints[2] = driven.joints[2].clone().with_angle(TimeFn::linear(0.0, 1.0));
+    let text = message(driven);
+    assert!(text.contains("element 2 (prismatic)") && text.contains("angle"), "{text}");
+    let mut welded = branched();
+    welded.actuators = vec![Actuator::torque(4, TimeFn::constant(1.0))];
+    let text = message(welded);
+    assert!(text.contains("actuator") && text.contains("fixed"), "{text}");
     let mut inverted = branched();
     inverted.joints[2] = inverted.joints[2].clone().with_limit(JointLimit::new(1.0, -1.0));
     let text = message(inverted);
@@ -218,14 +228,14 @@ fn a_pendulum_in_joint_coordinates_is_stopped_at_its_limit_when_computed_by_hand
     let mechanism = Mechanism::new([0.0, 0.0, -g]).with_bodies(vec![rod]).with_joints(vec![pivot]);
     let inertia = jyy + m * l * l;
     let k = m * g * l / inertia;
-    let t_star = crate::reference::time_to_swing(k, phi0, phi_stop).unwrap();
+    let t_star = cdyn::reference::time_to_swing(k, phi0, phi_stop).unwrap();
     let rate = (2.0 * k * (phi_stop.cos() - phi0.cos())).sqrt();
     let built = mechanism.in_joint_coordinates().unwrap();
     let system = TreeStops::new(mechanism).unwrap();
     let h = 1e-3;
     let settings = Settings::new(Scheme::RungeKutta4, h, Control::robust());
     let mut held = Vec::new();
-    let report = run_with_stops::<_, crate::Error>(&system, settings, &built.q0, &built.v0, 1.5, 1, |t, q, v| {
+    let report = run_with_stops::<_, cdyn::Error>(&system, settings, &built.q0, &built.v0, 1.5, 1, |t, q, v| {
         held.push((t, q[0], v[0]));
         Ok(())
     })
