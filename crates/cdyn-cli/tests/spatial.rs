@@ -651,3 +651,43 @@ fn bad_actuators_and_initial_joints_get_one_line_naming_the_entry() {
         }
     }
 }
+
+#[test]
+fn a_robot_in_joint_coordinates_writes_the_same_columns_and_motion_as_in_body_coordinates() {
+    // arm_pd.toml (three servos, one clamped at its effort) for 0.5 s, in
+    // both coordinates: the same columns, the bodies' poses and the joints
+    // to the integrators' error; an unknown choice is one line.
+    let text = example("arm_pd.toml").replace("t_end = 2.0", "t_end = 0.5");
+    let runs: Vec<(Vec<String>, Vec<Vec<f64>>)> = ["bodies", "joints"]
+        .iter()
+        .map(|c| {
+            let text = text.replace("urdf = \"arm.urdf\"", &format!("urdf = \"arm.urdf\"\ncoordinates = \"{c}\""));
+            let (dir, path) = scenario("arm_pd.toml", &text);
+            std::fs::write(dir.join("arm.urdf"), example("arm.urdf")).unwrap();
+            let out = dir.join("out");
+            let result = cdyn(&["run", path_str(&path), "--out", path_str(&out)]);
+            assert!(result.status.success(), "{c}: {}", String::from_utf8_lossy(&result.stderr));
+            assert!(out.join("mechanism.svg").metadata().is_ok_and(|m| m.len() > 1000), "{c}: the 3-D view");
+            table(&out.join("arm_pd.csv"))
+        })
+        .collect();
+    let [(bodies_header, bodies), (joints_header, joints)] = &runs[..] else { unreachable!() };
+    assert_eq!(bodies_header, joints_header);
+    assert_eq!(bodies.len(), joints.len());
+    let mut worst: f64 = 0.0;
+    for (b, j) in bodies.iter().zip(joints) {
+        for (k, name) in bodies_header.iter().enumerate().filter(|(_, h)| !matches!(h.as_str(), "phi" | "psi")) {
+            // Euler parameters are the same rotation up to sign.
+            let sign = if name.contains(".e") && b[k] * j[k] < 0.0 && (b[k] + j[k]).abs() < 1e-6 { -1.0 } else { 1.0 };
+            worst = worst.max((b[k] - sign * j[k]).abs());
+        }
+    }
+    assert!(worst < 1e-6, "the two runs differ by {worst:e}");
+    let turned = joints.iter().map(|r| r[bodies_header.iter().position(|h| h == "shoulder_yaw.q").unwrap()].abs());
+    assert!(turned.fold(0.0, f64::max) > 0.2, "the yaw servo swings the arm");
+    let (dir, path) =
+        scenario("bad.toml", &text.replace("urdf = \"arm.urdf\"", "urdf = \"arm.urdf\"\ncoordinates = \"angles\""));
+    std::fs::write(dir.join("arm.urdf"), example("arm.urdf")).unwrap();
+    let line = one_error_line(&cdyn(&["run", path_str(&path), "--out", path_str(&dir.join("out"))]));
+    assert!(line.contains("[model] coordinates = \"angles\"") && line.contains("\"joints\""), "{line}");
+}

@@ -133,6 +133,7 @@ fn joint_accelerations_agree_with_the_mechanism_in_body_coordinates() {
     let bodies = mechanism.build().unwrap();
     let n = in_joints.model.n();
     let driven = in_joints.joints.iter().position(|&j| j == 5).unwrap();
+    let (mut poses, mut pose) = (in_joints.poses.clone(), vec![0.0; 7 * mechanism.bodies.len()]);
     let (mut tree, mut full) = (Dynamics::new(&in_joints.model), Dynamics::new(&bodies.model));
     let mut worst: f64 = 0.0;
     for seed in 1..6 {
@@ -143,6 +144,12 @@ fn joint_accelerations_agree_with_the_mechanism_in_body_coordinates() {
         tree.evaluate(&in_joints.model, &theta, &rate, t).unwrap();
         let (q, v) = in_joints.bodies(&mechanism, &theta, &rate).unwrap();
         full.evaluate(&bodies.model, &q, &v, t).unwrap();
+        // The bodies' poses as a run in joint coordinates records them.
+        poses.at(&theta, &mut pose);
+        for (mine, theirs) in pose.chunks(7).zip(q.chunks(7)) {
+            let same = |s: f64| (0..7).all(|i| (mine[i] - if i < 3 { 1.0 } else { s } * theirs[i]).abs() < 1e-12);
+            assert!(same(1.0) || same(-1.0), "{mine:?} against {theirs:?}");
+        }
         let read = mechanism.joint_coordinates(&q, &v, full.acc()).unwrap();
         for (c, &joint) in in_joints.joints.iter().enumerate() {
             let [_, r, a] = read[joint].unwrap();

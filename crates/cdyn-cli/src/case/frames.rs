@@ -11,6 +11,8 @@ const MAX_NUMBERS: usize = 1_000_000;
 /// Positions at evenly spaced samples of a run (every `stride`-th one).
 #[derive(Debug, Clone, Default)]
 pub struct Frames {
+    /// A run in joint coordinates: its frames are the bodies' poses at its `q`.
+    poses: Option<cdyn::spatial::BodyPoses>,
     /// Times of the frames.
     pub t: Vec<f64>,
     /// Positions, `n` per frame, frame after frame.
@@ -35,6 +37,23 @@ impl Frames {
     pub fn of(n: usize) -> Self {
         let limit = MAX_FRAMES.min((MAX_NUMBERS / n.max(1)).max(2));
         Frames { n, stride: 1, limit, ..Frames::default() }
+    }
+
+    /// Frames of a spatial run in joint coordinates: the bodies' poses at each `q`.
+    pub fn of_poses(poses: cdyn::spatial::BodyPoses) -> Self {
+        Frames { poses: Some(poses.clone()), ..Frames::of(poses.len()) }
+    }
+
+    /// Keeps the positions at `q` (the bodies' poses where the run is in joint coordinates).
+    fn keep(&mut self, q: &[f64]) {
+        match &mut self.poses {
+            Some(poses) => {
+                let start = self.q.len();
+                self.q.resize(start + self.n, 0.0);
+                poses.at(q, &mut self.q[start..]);
+            }
+            None => self.q.extend_from_slice(&q[..self.n]),
+        }
     }
 
     /// Frames kept.
@@ -69,14 +88,14 @@ impl Frames {
             }
         }
         self.t.push(t);
-        self.q.extend_from_slice(&q[..self.n]);
+        self.keep(q);
     }
 
     /// Keeps the end state `(t, q)` as the last frame, if it is not already.
     pub fn end(&mut self, t: f64, q: &[f64]) {
         if self.limit > 0 && self.t.last() != Some(&t) {
             self.t.push(t);
-            self.q.extend_from_slice(&q[..self.n]);
+            self.keep(q);
         }
     }
 

@@ -36,6 +36,7 @@ pub fn cases() -> Result<Vec<Case>> {
                 force_entries: Vec::new(),
                 limits: None,
                 joint_columns: None,
+                poses: None,
             });
         }
     }

@@ -152,6 +152,46 @@ impl Example {
         }
     }
 
+    /// A spatial mechanism in joint coordinates
+    /// ([`Mechanism::in_joint_coordinates`](crate::spatial::Mechanism::in_joint_coordinates))
+    /// as an example with the observables of [`Example::from_spatial_named`]:
+    /// the bodies' coordinates (their poses at `θ`), each joint's `.q` and
+    /// `.v` (the coordinates themselves), each actuator's `.tau`.
+    pub fn from_joint_coordinates(
+        mechanism: &crate::spatial::Mechanism,
+        in_joints: crate::spatial::InJoints,
+        joint_name: impl Fn(usize) -> String,
+    ) -> Self {
+        let mut observables: Vec<String> =
+            mechanism.bodies.iter().flat_map(|b| crate::spatial::coordinate_names(&b.name)).collect();
+        let joints = &in_joints.joints;
+        observables
+            .extend(joints.iter().flat_map(|&k| [format!("{}.q", joint_name(k)), format!("{}.v", joint_name(k))]));
+        observables.extend(mechanism.actuators.iter().map(|a| format!("{}.tau", joint_name(a.joint))));
+        let (bodies, n) = (in_joints.poses.len(), in_joints.model.n());
+        let crate::spatial::InJoints { model, q0, v0, poses, torques, .. } = in_joints;
+        let poses = std::sync::Mutex::new(poses);
+        let observe = move |t: f64, q: &[f64], v: &[f64], out: &mut [f64]| {
+            poses.lock().unwrap_or_else(|e| e.into_inner()).at(q, &mut out[..bodies]);
+            for (c, pair) in out[bodies..bodies + 2 * n].chunks_exact_mut(2).enumerate() {
+                pair.copy_from_slice(&[q[c], v[c]]);
+            }
+            for (i, tau) in out[bodies + 2 * n..].iter_mut().enumerate() {
+                *tau = torques.at(i, q, v, t);
+            }
+        };
+        Example {
+            model,
+            q0,
+            v0,
+            observables,
+            observe: Box::new(observe),
+            reference: None,
+            drawing: None,
+            sketch: Some(mechanism.sketch()),
+        }
+    }
+
     /// The observables of the state `(q, v)` at time `t`.
     pub fn observe(&self, t: f64, q: &[f64], v: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.observables.len()];

@@ -68,7 +68,7 @@ pub use load::Load;
 pub use mechanism::{Built, Coupling, Mechanism};
 pub use named::MergedLink;
 pub use sketch::{Anchor, Limb, Sketch};
-pub use tree::InJoints;
+pub use tree::{BodyPoses, CoordinateTorques, InJoints};
 #[cfg(feature = "urdf")]
 pub use urdf::{UrdfRobot, from_urdf, read_urdf};
 pub use visual::{Shape, Visual};

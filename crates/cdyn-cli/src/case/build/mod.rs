@@ -108,7 +108,7 @@ impl Scenario {
                 );
             }
         }
-        let Described { mut example, rows, notes, force_entries, limits, joint_columns } = self.example(file)?;
+        let Described { mut example, rows, notes, force_entries, limits, joint_columns, poses } = self.example(file)?;
         // A run with limits rebuilds its model at each stop, from the
         // mechanism: what was added to the built model would be lost. The
         // inputs are not: the mechanism's actuators hold them (the same
@@ -199,6 +199,7 @@ impl Scenario {
             force_entries,
             limits,
             joint_columns,
+            poses,
         })
     }
 
@@ -219,7 +220,7 @@ impl Scenario {
                 "{file}: [model.parameters] is for the other built-in models; this kind takes its keys in [model] or none"
             );
         }
-        let own_keys = |key: &String| pendulum || (m.kind == Kind::Spatial && key == "urdf");
+        let own_keys = |key: &String| pendulum || (m.kind == Kind::Spatial && (key == "urdf" || key == "coordinates"));
         if let Some(key) = m.pendulum_keys.keys().find(|k| !own_keys(k)) {
             bail!(
                 "{file}: [model] {key}: only the pendulum models take parameters in [model]; the other built-in models take theirs in [model.parameters]"
@@ -290,13 +291,14 @@ struct Described {
     force_entries: Vec<String>,
     limits: Option<Limits>,
     joint_columns: Option<JointColumns>,
+    poses: Option<cdyn::spatial::BodyPoses>,
 }
 
 impl Described {
     /// A built-in model: no entries, nothing left out.
     fn plain(example: Example) -> Self {
         let (rows, notes, force_entries) = (Vec::new(), Vec::new(), Vec::new());
-        Self { example, rows, notes, force_entries, limits: None, joint_columns: None }
+        Self { example, rows, notes, force_entries, limits: None, joint_columns: None, poses: None }
     }
 }
 

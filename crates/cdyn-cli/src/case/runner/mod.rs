@@ -68,6 +68,9 @@ pub struct Case {
     /// Where a spatial run's joint columns are among the observables, for
     /// `summary.json`'s `joint_space`.
     pub joint_columns: Option<JointColumns>,
+    /// A spatial run in joint coordinates: the reader of the bodies' poses
+    /// its drawings show (its own `q` are the joints').
+    pub poses: Option<cdyn::spatial::BodyPoses>,
 }
 
 impl Case {
@@ -156,7 +159,10 @@ fn simulate<K: Sink>(
 ) -> Result<(Record, Method), K::Error> {
     let ex = &case.example;
     let mut frames = match watch {
-        Watch::Interrupts(_) if ex.drawing.is_some() || ex.sketch.is_some() => Frames::of(ex.model.n()),
+        Watch::Interrupts(_) if ex.drawing.is_some() || ex.sketch.is_some() => match &case.poses {
+            Some(poses) => Frames::of_poses(poses.clone()),
+            None => Frames::of(ex.model.n()),
+        },
         _ => Frames::none(),
     };
     if let Some(limits) = &case.limits {

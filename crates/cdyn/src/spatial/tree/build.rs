@@ -5,12 +5,13 @@ use super::dynamics::TreeKinetic;
 use super::elements::{Actuated, Bound, Coupled, Driven};
 use super::gravity::TreeGravity;
 use super::motion::{Inertia, M3};
-use super::{Node, Shared, Tree};
+use super::{BodyPoses, Node, Shared, Tree};
 use crate::error::{Error, Part, Problem, Result};
 use crate::limit::Stop;
 use crate::model::Model;
 use crate::model::force::PotentialBlock;
 use crate::model::timefn::TimeFn;
+use crate::spatial::actuator::Law;
 use crate::spatial::joint::{Joint, JointKind};
 use crate::spatial::mechanism::Mechanism;
 use crate::spatial::placing::joint_law;
@@ -31,6 +32,26 @@ pub struct InJoints {
     pub v0: Vec<f64>,
     /// The mechanism's joint of each coordinate, in joint order.
     pub joints: Vec<usize>,
+    /// The reader of the bodies' poses at joint coordinates.
+    pub poses: BodyPoses,
+    /// The reader of the actuators' torques.
+    pub torques: CoordinateTorques,
+    /// The part behind each constraint row (drives, couplings, held stops).
+    pub rows: Vec<Part>,
+    /// The part behind each force element (joints' damping and friction, actuators).
+    pub forces: Vec<Part>,
+}
+
+/// The torque (force) each actuator of a tree applies, read from its joint coordinates.
+#[derive(Debug, Clone)]
+pub struct CoordinateTorques(Vec<(usize, Law)>);
+
+impl CoordinateTorques {
+    /// The torque actuator `i` applies at `(θ, θ̇)` and time `t`.
+    pub fn at(&self, i: usize, q: &[f64], v: &[f64], t: f64) -> f64 {
+        let (c, law) = &self.0[i];
+        law.torque(t, |target| q[*c] - target, || v[*c])
+    }
 }
 
 impl InJoints {
@@ -130,26 +151,31 @@ impl Mechanism {
             }
         }
         let n = joints.len();
-        let shared = Arc::new(Shared::new(Tree { nodes, n }));
+        let bodies = self.bodies.iter().zip(&carrier).zip(&poses).map(|((_, &c), &(r, p))| (c, r, p)).collect();
+        let shared = Arc::new(Shared::new(Tree { nodes, n, bodies }));
         let gravity = (self.gravity != [0.0; 3]).then(|| {
             Box::new(TreeGravity { shared: shared.clone(), gravity: self.gravity }) as Box<dyn PotentialBlock>
         });
         let names = joints.iter().map(|k| format!("joint {k}")).collect();
         let mut builder =
-            Model::builder(vec![0.0; n]).coordinate_names(names).whole(Box::new(TreeKinetic(shared)), gravity);
+            Model::builder(vec![0.0; n]).coordinate_names(names).whole(Box::new(TreeKinetic(shared.clone())), gravity);
         let (mut q0, mut v0) = (vec![0.0; n], vec![0.0; n]);
+        let (mut rows, mut forces) = (Vec::new(), Vec::new());
         for (c, &k) in joints.iter().enumerate() {
             let at = Part::Element { index: k, kind: self.joints[k].kind.name() };
             if let Some(law) = joint_law(&self.joints[k]).map_err(|e| e.at(at.clone()))? {
                 builder = builder.force(law, [c]);
+                forces.push(at.clone());
             }
             if let Some(f) = drive(&self.joints[k]).map_err(|e| e.at(at))? {
                 // Started where the drive has it: the row holds from t = 0.
                 (q0[c], v0[c]) = (f.eval(0.0), f.derivative().eval(0.0));
                 builder = builder.constrain(Driven(f.clone()), [c]);
+                rows.push(Part::Element { index: k, kind: self.joints[k].kind.name() });
             }
         }
         builder = self.declare_inputs(builder);
+        let mut actuators = Vec::with_capacity(self.actuators.len());
         for (k, actuator) in self.actuators.iter().enumerate() {
             let at = self.actuator_part(k);
             let joint = self.joints.get(actuator.joint).ok_or(Problem::NoSuchJoint { index: actuator.joint });
@@ -159,7 +185,9 @@ impl Mechanism {
                 return Err(Error::from(Problem::NoCoordinate { index: actuator.joint, kind }).at(at));
             };
             let law = actuator.law(joint.limit.map_or(f64::INFINITY, |l| l.effort)).map_err(|e| e.at(at))?;
-            builder = builder.force(Actuated(law), [c]);
+            builder = builder.force(Actuated(law.clone()), [c]);
+            forces.push(self.actuator_part(k));
+            actuators.push((c, law));
         }
         for (k, coupling) in self.couplings.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
@@ -174,6 +202,7 @@ impl Mechanism {
                 crate::error::finite(name, value).map_err(|e| e.at(at.clone()))?;
             }
             builder = builder.constrain(Coupled { multiplier: coupling.multiplier, offset: coupling.offset }, [f, l]);
+            rows.push(at);
         }
         for &stop in held {
             let at = Part::Element { index: stop.joint, kind: "limit" };
@@ -184,8 +213,18 @@ impl Mechanism {
             };
             let (bound, sign, _) = self.stop_bound(stop);
             builder = builder.constrain(Bound { bound, sign }, [c]);
+            rows.push(at);
         }
-        Ok(InJoints { model: builder.build()?, q0, v0, joints })
+        Ok(InJoints {
+            model: builder.build()?,
+            q0,
+            v0,
+            joints,
+            poses: BodyPoses::new(&shared),
+            torques: CoordinateTorques(actuators),
+            rows,
+            forces,
+        })
     }
 
     fn refuse_what_is_not_modelled(&self) -> Result<()> {

@@ -14,12 +14,13 @@
 //! differentiate at `O(n²)` passes per state.
 //!
 //! Here the tree and the work its elements share; `build` the tree and
-//! model from a mechanism; `elements` the rows and forces on its
+//! model from a mechanism; `bodies` the bodies' poses for output; `elements` the rows and forces on its
 //! coordinates; `kinematics` the poses at `θ`; `motion` the
 //! spatial vectors.
 //!
 //! May import: `error`, `ad`, `model`, `limit`, `spatial`.
 
+mod bodies;
 mod build;
 mod dynamics;
 mod elements;
@@ -27,7 +28,8 @@ mod gravity;
 mod kinematics;
 mod motion;
 
-pub use build::InJoints;
+pub use bodies::BodyPoses;
+pub use build::{CoordinateTorques, InJoints};
 
 use kinematics::Kinematics;
 use motion::{Inertia, Motion, V3, Wrench};
@@ -50,11 +52,14 @@ pub(super) struct Node {
     inertia: Inertia,
 }
 
-/// The tree: its nodes and the coordinates they read (`0 .. n`).
+/// The tree: its nodes, the coordinates they read (`0 .. n`), and each
+/// body of the mechanism with the node that carries it (`None`: welded to
+/// the ground) and its initial pose.
 #[derive(Debug, Clone)]
 pub(super) struct Tree {
     nodes: Vec<Node>,
     n: usize,
+    bodies: Vec<(Option<usize>, V3, [f64; 4])>,
 }
 
 /// Buffers of one evaluation, a slot per node.
