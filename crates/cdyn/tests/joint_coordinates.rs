@@ -214,6 +214,10 @@ fn what_joint_coordinates_cannot_describe_is_refused_by_name() {
     welded.actuators = vec![Actuator::torque(4, TimeFn::constant(1.0))];
     let text = message(welded);
     assert!(text.contains("actuator") && text.contains("fixed"), "{text}");
+    let mut lost = branched();
+    lost.joints[1].point[2] = f64::NAN;
+    let text = message(lost);
+    assert!(text.contains("element 1 (revolute)") && text.contains("point = NaN must be finite"), "{text}");
     let mut inverted = branched();
     inverted.joints[2] = inverted.joints[2].clone().with_limit(JointLimit::new(1.0, -1.0));
     let text = message(inverted);

@@ -243,6 +243,9 @@ impl Mechanism {
             if let Some(reason) = reason {
                 return Err(refuse(part, reason));
             }
+            if let Some(&value) = joint.point.iter().find(|x| !x.is_finite()) {
+                return Err(Problem::Parameter { name: "point", value, reason: "must be finite" }.at(part));
+            }
             if let Some(limit) = &joint.limit {
                 limit.check().map_err(|e| e.at(part))?;
             }
