@@ -267,6 +267,44 @@ def test_joint_trajectories_agree_with_pinocchio(relative, t_end, joints):
     assert worst[0] < 1e-8 and worst[1] < 1e-8, worst
 
 
+@pytest.mark.parametrize(
+    "relative, t_end, joints",
+    [
+        (UR5, 1.0, {}),
+        (SO100, 0.05, {"shoulder_lift": 1.0, "elbow_flex": -1.0}),
+        (PANDA, 0.05, {"panda_joint4": -1.5}),
+    ],
+)
+def test_joint_coordinate_runs_follow_pinocchio_to_round_off(relative, t_end, joints):
+    """`coordinates = "joints"`: the same RK-4 in the same coordinates as
+    Pinocchio's, so the runs agree to round-off, not to truncation error."""
+    robot = Robot(relative)
+    scenario = {
+        "model": {"kind": "spatial", "urdf": str(robot.path), "gravity": GRAVITY, "coordinates": "joints"},
+        "integrator": {"scheme": "rk4", "h": H, "t_end": t_end},
+        "output": {"every": 100},
+    }
+    q0 = pin.neutral(robot.model)
+    if joints:
+        scenario["initial"] = {"joints": joints}
+        for name, value in joints.items():
+            q0[robot.model.joints[robot.model.getJointId(name)].idx_q] = value
+    result = cdyn.run(cdyn.from_dict(scenario))
+    assert result.error is None, result.error
+    reference = rk4_in_joint_space(robot, q0, np.zeros(robot.model.nv), H, round(t_end / H))[::100]
+    assert len(reference) == len(result.q)
+    names, _, _ = _cdyn.urdf_tree(str(robot.path), GRAVITY, [], [])
+    worst, travel = np.zeros(2), 0.0
+    for c, name in enumerate(names):
+        k, m = robot.index(name)
+        for (q, v), theta, rate in zip(reference, result.q, result.v):
+            worst = np.maximum(worst, [abs(theta[c] - m * angles(robot, q)[k]), abs(rate[c] - m * v[k])])
+            travel = max(travel, abs(theta[c] - result.q[0][c]))
+    print(relative, "travel", travel, "worst |Δθ|, |Δθ̇|", worst)
+    assert travel > 1e-3
+    assert worst[0] < 1e-11 and worst[1] < 1e-10, worst
+
+
 # Z1's joints have regularized Coulomb friction (slip 0.01 rad/s) on light
 # wrist links: too stiff for RK-4 at H, whose refusal names
 # generalized_alpha, which then takes it (its Newton iteration damped
