@@ -4,8 +4,9 @@
 //! with every kind of element (also with a redundant row, tolerated); the
 //! robust preset after its automatic gains are chosen, and the projection
 //! method (general models only); a tractor with a trailer on knife edges
-//! (nonholonomic rows); and the models whose `M(q)` comes from a kinetic
-//! energy (the double pendulum and the loaded four-bar in angles).
+//! (nonholonomic rows); the models whose `M(q)` comes from a kinetic
+//! energy (the double pendulum and the loaded four-bar in angles); and an
+//! arm in joint coordinates (its `M(θ)` and gravity in closed form).
 
 use cdyn::control::methods;
 use cdyn::control::projection::{OnFailure, Projection};
@@ -177,6 +178,25 @@ fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: 
     allocations_stepping(Simulation::new(&ex.model, settings, &ex.q0, &ex.v0).unwrap(), warm_up, steps)
 }
 
+/// An arm in joint coordinates: two revolute joints, a prismatic one tied
+/// to the second by a `<mimic>` row, a damped joint and a servo.
+fn joint_tree() -> cdyn::spatial::InJoints {
+    use cdyn::spatial::{Actuator, Body, Coupling, Joint, JointKind};
+    let body = |name: &str, r: [f64; 3]| Body::new(name, 1.2, [0.02, 0.03, 0.025]).with_position(r);
+    let joint = |kind, a, b, point, axis| Joint::new(kind, a, b, point).with_axis(axis);
+    cdyn::spatial::Mechanism::new([0.0, 0.0, -9.81])
+        .with_bodies(vec![body("a", [0.2, 0.0, -0.1]), body("b", [0.5, 0.1, -0.2]), body("c", [0.7, 0.1, -0.4])])
+        .with_joints(vec![
+            joint(JointKind::Revolute, 0, None, [0.0; 3], [0.0, 0.3, 1.0]),
+            joint(JointKind::Revolute, 1, Some(0), [0.4, 0.0, -0.15], [1.0, 0.0, 0.2]).with_damping(0.3),
+            joint(JointKind::Prismatic, 2, Some(1), [0.6, 0.1, -0.3], [0.0, 0.2, 1.0]),
+        ])
+        .with_couplings(vec![Coupling::new(2, 1, 0.1, 0.0)])
+        .with_actuators(vec![Actuator::servo(0, TimeFn::linear(0.1, 0.5), 20.0, 2.0)])
+        .in_joint_coordinates()
+        .unwrap()
+}
+
 /// As [`allocations_per_run`], for the Example 1 pendulum as a small system.
 fn small_allocations_per_run(settings: Settings, warm_up: usize, steps: usize) -> usize {
     let (system, q0, v0) = small_pendulum(PendulumParams::default()).unwrap();
@@ -211,6 +231,7 @@ fn steps_do_not_allocate() {
     let cdyn::spatial::Built { model: spatial, q0: sq0, v0: sv0, .. } =
         cdyn::spatial::chain(40, 0.3, 1.0).build().unwrap();
     assert!(spatial.mass_blocks().is_some());
+    let tree = joint_tree();
     assert!(count() > before);
     for scheme in Scheme::GENERAL {
         for control in controls() {
@@ -257,6 +278,9 @@ fn steps_do_not_allocate() {
             let sim = Simulation::new(&spatial, Settings::new(scheme, 1e-3, control), &sq0, &sv0).unwrap();
             let n = allocations_stepping(sim, 5, 200);
             assert_eq!(n, 0, "spatial chain, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+            let sim = Simulation::new(&tree.model, Settings::new(scheme, 1e-3, control), &tree.q0, &tree.v0).unwrap();
+            let n = allocations_stepping(sim, 5, 200);
+            assert_eq!(n, 0, "arm in joint coordinates, {scheme:?}, {control:?}: {n} allocations in 200 steps");
         }
         let n = allocations_per_run(&andrews, Settings::new(scheme, 1e-5, methods::robust()), 5, 200);
         assert_eq!(n, 0, "andrews, {scheme:?}, robust: {n} allocations in 200 steps");
@@ -290,5 +314,7 @@ fn steps_do_not_allocate() {
         }
         let n = allocations_stepping(Simulation::new(&spatial, settings(1e-3), &sq0, &sv0).unwrap(), 5, 200);
         assert_eq!(n, 0, "spatial chain, {scheme:?}, {control:?}: {n} allocations in 200 steps");
+        let n = allocations_stepping(Simulation::new(&tree.model, settings(1e-3), &tree.q0, &tree.v0).unwrap(), 5, 200);
+        assert_eq!(n, 0, "arm in joint coordinates, {scheme:?}, {control:?}: {n} allocations in 200 steps");
     }
 }
