@@ -1,7 +1,7 @@
 """The FMU of `cdyn fmu`, imported by FMPy (a real importer, pinned in
 requirements-test.txt): its model description validates with no problems,
 FMPy's simulation equals `cdyn run` to the bit (also with joint limits, on
-examples/limited_pendulum.toml), the Python PD controller of
+examples/limited_pendulum.toml in body and in joint coordinates), the Python PD controller of
 examples/pd_pendulum.py gives the same run through the FMU, the C API and
 the Python API (and examples/pd_pendulum.c ends where they do), and
 refused calls are fmi2Error with a logged line."""
@@ -59,15 +59,19 @@ def test_fmpy_simulation_equals_cdyn_run(fmu, cli, tmp_path):
 LIMITED = ROOT / "examples" / "limited_pendulum.toml"
 
 
-def test_fmpy_simulation_with_joint_limits_equals_cdyn_run(cli, tmp_path):
-    """examples/limited_pendulum.toml: the rod falls onto its limit at
-    t = 0.335 s and is held there; every output of the FMU at each
-    communication step (10 steps of h) is `cdyn run`'s row to the bit,
-    the impact's segment and the held one's included."""
+@pytest.mark.parametrize("coordinates", ["bodies", "joints"])
+def test_fmpy_simulation_with_joint_limits_equals_cdyn_run(cli, tmp_path, coordinates):
+    """examples/limited_pendulum.toml, in body and in joint coordinates: the
+    rod falls onto its limit at t = 0.335 s and is held there; every output
+    of the FMU at each communication step (10 steps of h) is `cdyn run`'s
+    row to the bit, the impact's segment and the held one's included."""
+    scenario = tmp_path / "limited_pendulum.toml"
+    text = LIMITED.read_text().replace('kind = "spatial"', f'kind = "spatial"\ncoordinates = "{coordinates}"', 1)
+    scenario.write_text(text)
     fmu = tmp_path / "limited_pendulum.fmu"
-    done = subprocess.run([os.environ["CDYN_BIN"], "fmu", LIMITED, "--out", fmu], capture_output=True, text=True)
+    done = subprocess.run([os.environ["CDYN_BIN"], "fmu", scenario, "--out", fmu], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    assert cli("run", LIMITED, "--out", tmp_path).returncode == 0
+    assert cli("run", scenario, "--out", tmp_path).returncode == 0
     header, rows = read_csv(tmp_path / "limited_pendulum.csv")
     result = fmpy.simulate_fmu(str(fmu), step_size=0.001, output_interval=0.01, stop_time=1.0)
     assert len(result) == len(rows) == 101
