@@ -3,9 +3,10 @@
 //! angle or displacement from the initial pose, as
 //! [`Mechanism::joint_coordinates`](super::Mechanism::joint_coordinates)
 //! counts it), bodies welded by fixed joints riding with their parent,
-//! and nothing left for the constraints to hold but what couples joints
-//! (`<mimic>`). It is the formulation of robot libraries (Pinocchio,
-//! MuJoCo): a UR5 has 6 coordinates instead of 42 coordinates and 36 rows.
+//! and nothing left for the constraints to hold but `<mimic>` couplings,
+//! drives and held stops. It is the formulation of robot libraries
+//! (Pinocchio, MuJoCo): a UR5 has 6 coordinates instead of 42 coordinates
+//! and 36 rows.
 //!
 //! The kinetic energy and gravity are given to the model as one element
 //! each, in closed form by the spatial algebra of Featherstone's
@@ -14,9 +15,9 @@
 //! differentiate at `O(n²)` passes per state.
 //!
 //! Here the tree and the work its elements share; `build` the tree and
-//! model from a mechanism; `bodies` the bodies' poses for output; `elements` the rows and forces on its
-//! coordinates; `kinematics` the poses at `θ`; `motion` the
-//! spatial vectors.
+//! model from a mechanism; `elements` the rows and forces on its
+//! coordinates; `bodies` the bodies' poses for output; `kinematics` the
+//! poses at `θ`; `motion` the spatial vectors.
 //!
 //! May import: `error`, `ad`, `model`, `limit`, `spatial`.
 
