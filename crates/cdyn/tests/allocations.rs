@@ -179,7 +179,8 @@ fn allocations_per_run(ex: &Example, settings: Settings, warm_up: usize, steps: 
 }
 
 /// An arm in joint coordinates: two revolute joints, a prismatic one tied
-/// to the second by a `<mimic>` row, a damped joint and a servo.
+/// to the second by a `<mimic>` row, a damped joint, a servo, a spring
+/// with its damper to the ground and a rotary damper.
 fn joint_tree() -> cdyn::spatial::InJoints {
     use cdyn::spatial::{Actuator, Body, Coupling, Joint, JointKind};
     let body = |name: &str, r: [f64; 3]| Body::new(name, 1.2, [0.02, 0.03, 0.025]).with_position(r);
@@ -192,6 +193,18 @@ fn joint_tree() -> cdyn::spatial::InJoints {
             joint(JointKind::Prismatic, 2, Some(1), [0.6, 0.1, -0.3], [0.0, 0.2, 1.0]),
         ])
         .with_couplings(vec![Coupling::new(2, 1, 0.1, 0.0)])
+        .with_loads(vec![
+            cdyn::spatial::Load::Spring {
+                a: 2,
+                b: None,
+                point: [0.7, 0.1, -0.4],
+                point_b: [0.9, 0.0, 0.0],
+                stiffness: 30.0,
+                damping: 0.5,
+                length: None,
+            },
+            cdyn::spatial::Load::RotaryDamper { a: 1, b: Some(0), axis: [1.0, 0.0, 0.0], damping: 0.2 },
+        ])
         .with_actuators(vec![Actuator::servo(0, TimeFn::linear(0.1, 0.5), 20.0, 2.0)])
         .in_joint_coordinates()
         .unwrap()

@@ -8,7 +8,7 @@
 use cdyn::dynamics::Dynamics;
 use cdyn::linalg::mass::DenseMass;
 use cdyn::model::timefn::TimeFn;
-use cdyn::spatial::{Actuator, Body, Coupling, Joint, JointKind, JointLimit, Mechanism};
+use cdyn::spatial::{Actuator, Body, Coupling, Joint, JointKind, JointLimit, Load, Mechanism};
 use cdyn::stops::{Change, Event, TreeStops, run_with_stops};
 use cdyn::{Control, Scheme, Settings, Simulation};
 
@@ -128,6 +128,33 @@ fn joint_accelerations_agree_with_the_mechanism_in_body_coordinates() {
         Actuator::torque(0, TimeFn::polynomial(vec![0.5, -1.0, 2.0])),
         Actuator::servo(3, TimeFn::linear(0.2, 0.5), 3.0, 0.4),
     ];
+    // Every load: springs with dampers between two bodies and to the
+    // ground, rotary dampers between two bodies and from a welded one to the
+    // ground, a force at a point and a torque.
+    mechanism.loads = vec![
+        Load::Spring {
+            a: 3,
+            b: Some(5),
+            point: [0.72, 0.33, -0.52],
+            point_b: [-0.2, 0.2, -0.45],
+            stiffness: 40.0,
+            damping: 1.5,
+            length: Some(0.3),
+        },
+        Load::Spring {
+            a: 2,
+            b: None,
+            point: [0.6, 0.25, -0.3],
+            point_b: [0.8, 0.0, 0.1],
+            stiffness: 25.0,
+            damping: 0.8,
+            length: None,
+        },
+        Load::RotaryDamper { a: 1, b: Some(0), axis: [0.3, 1.0, 0.0], damping: 0.6 },
+        Load::RotaryDamper { a: 4, b: None, axis: [0.0, 0.2, 1.0], damping: 0.9 },
+        Load::Force { body: 3, force: [1.0, -2.0, 0.5], point: Some([0.75, 0.3, -0.55]) },
+        Load::Torque { body: 5, torque: [0.2, 0.1, -0.3] },
+    ];
     let t = 0.4;
     let in_joints = mechanism.in_joint_coordinates().unwrap();
     let bodies = mechanism.build().unwrap();
@@ -218,6 +245,18 @@ fn what_joint_coordinates_cannot_describe_is_refused_by_name() {
     lost.joints[1].point[2] = f64::NAN;
     let text = message(lost);
     assert!(text.contains("element 1 (revolute)") && text.contains("point = NaN must be finite"), "{text}");
+    // A load reaches at most 12 joint coordinates (the sizes its AD elements are compiled for).
+    let links: Vec<Body> = (0..13)
+        .map(|k| Body::new(&format!("l{k}"), 1.0, [0.01; 3]).with_position([0.1 * k as f64 + 0.05, 0.0, 0.0]))
+        .collect();
+    let pins: Vec<Joint> = (0..13)
+        .map(|k| {
+            Joint::new(JointKind::Revolute, k, k.checked_sub(1), [0.1 * k as f64, 0.0, 0.0]).with_axis([0.0, 0.0, 1.0])
+        })
+        .collect();
+    let tip = Load::Torque { body: 12, torque: [0.0, 0.0, 1.0] };
+    let text = message(Mechanism::new([0.0; 3]).with_bodies(links).with_joints(pins).with_loads(vec![tip]));
+    assert!(text.contains("element 13 (torque)") && text.contains("13 joints from the ground"), "{text}");
     let mut inverted = branched();
     inverted.joints[2] = inverted.joints[2].clone().with_limit(JointLimit::new(1.0, -1.0));
     let text = message(inverted);

@@ -206,33 +206,66 @@ fn in_body((r, p): ([f64; 3], [f64; 4]), point: [f64; 3]) -> [f64; 3] {
     unrotate(p, std::array::from_fn(|i| point[i] - r[i]))
 }
 
-/// Adds the elements of one load.
-pub(super) fn add_load(builder: ModelBuilder, load: &Load, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
+/// A load checked, as both coordinate systems read it: its numbers finite
+/// (and non-negative where they must be), a spring's rest length resolved
+/// (the initial distance unless given), a damper's axis of unit length, a
+/// force's point resolved (the body's centre of mass unless given).
+pub(super) fn checked_load(load: &Load, poses: &[([f64; 3], [f64; 4])]) -> Result<Load> {
     let pose = |i: usize| poses.get(i).copied().ok_or(Error::from(Problem::NoSuchBody { index: i }));
     let finite = |name: &'static str, x: &[f64]| match x.iter().find(|x| !x.is_finite()) {
         Some(&value) => Err(Error::from(Problem::Parameter { name, value, reason: "must be finite" })),
         None => Ok(()),
     };
-    Ok(match *load {
+    let mut load = load.clone();
+    match &mut load {
         Load::Spring { a, b, point, point_b, stiffness, damping, length } => {
-            crate::error::non_negative("stiffness", stiffness)?;
-            crate::error::non_negative("damping", damping)?;
-            finite("point", &point)?;
-            finite("point_b", &point_b)?;
+            crate::error::non_negative("stiffness", *stiffness)?;
+            crate::error::non_negative("damping", *damping)?;
+            finite("point", point)?;
+            finite("point_b", point_b)?;
             let initial = (0..3).map(|i| (point_b[i] - point[i]).powi(2)).sum::<f64>().sqrt();
-            let length = match length {
+            *length = Some(match *length {
                 Some(l) => crate::error::non_negative("length", l)?,
                 None => initial,
-            };
+            });
             if initial == 0.0 {
                 let reason = "must differ from point: a spring needs a line";
                 return Err(Problem::Parameter { name: "point_b", value: 0.0, reason }.into());
             }
-            let sa = in_body(pose(a)?, point);
+            pose(*a)?;
+            b.map(pose).transpose()?;
+        }
+        Load::RotaryDamper { a, b, axis, damping } => {
+            crate::error::non_negative("damping", *damping)?;
+            *axis = unit("axis", *axis)?;
+            pose(*a)?;
+            b.map(pose).transpose()?;
+        }
+        Load::Force { body, force, point } => {
+            finite("force", force)?;
+            let at = point.unwrap_or(pose(*body)?.0);
+            finite("point", &at)?;
+            *point = Some(at);
+        }
+        Load::Torque { body, torque } => {
+            finite("torque", torque)?;
+            pose(*body)?;
+        }
+    }
+    Ok(load)
+}
+
+/// Adds the elements of one load.
+pub(super) fn add_load(builder: ModelBuilder, load: &Load, poses: &[([f64; 3], [f64; 4])]) -> Result<ModelBuilder> {
+    let pose = |i: usize| poses[i];
+    Ok(match checked_load(load, poses)? {
+        Load::Spring { a, b, point, point_b, stiffness, damping, length } => {
+            let length = length.unwrap_or_default();
+            let sa = in_body(pose(a), point);
             let a_at = SpatialBody::of(a).coordinates();
             match b {
                 Some(b) => {
-                    let sb = in_body(pose(b)?, point_b);
+                    let sb = in_body(pose(b), point_b);
                     let b_at = SpatialBody::of(b).coordinates();
                     let at: [usize; 14] = std::array::from_fn(|i| if i < 7 { a_at[i] } else { b_at[i - 7] });
                     let builder = builder.potential(SpringEnergy { sa, sb, ground: false, k: stiffness, length }, at);
@@ -254,13 +287,10 @@ pub(super) fn add_load(builder: ModelBuilder, load: &Load, poses: &[([f64; 3], [
             }
         }
         Load::RotaryDamper { a, b, axis, damping } => {
-            crate::error::non_negative("damping", damping)?;
-            let axis = unit("axis", axis)?;
-            let (_, pa) = pose(a)?;
+            let (_, pa) = pose(a);
             let a_at = SpatialBody::of(a).euler_parameters();
             match b {
                 Some(b) => {
-                    pose(b)?;
                     let b_at = SpatialBody::of(b).euler_parameters();
                     let at: [usize; 8] = std::array::from_fn(|i| if i < 4 { a_at[i] } else { b_at[i - 4] });
                     builder.force(BodyRotaryDamper { axis: unrotate(pa, axis), law: Law::damper(damping) }, at)
@@ -269,15 +299,10 @@ pub(super) fn add_load(builder: ModelBuilder, load: &Load, poses: &[([f64; 3], [
             }
         }
         Load::Force { body, force, point } => {
-            finite("force", &force)?;
-            let (r, p) = pose(body)?;
-            let point = point.unwrap_or(r);
-            finite("point", &point)?;
-            builder.force(PointForce { s: in_body((r, p), point), f: force }, SpatialBody::of(body).coordinates())
+            let s = in_body(pose(body), point.unwrap_or_default());
+            builder.force(PointForce { s, f: force }, SpatialBody::of(body).coordinates())
         }
         Load::Torque { body, torque } => {
-            finite("torque", &torque)?;
-            pose(body)?;
             builder.force(BodyTorque { n: torque }, SpatialBody::of(body).euler_parameters())
         }
     })

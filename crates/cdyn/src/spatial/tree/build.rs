@@ -4,17 +4,19 @@
 use super::dynamics::TreeKinetic;
 use super::elements::{Actuated, Bound, Coupled, Driven};
 use super::gravity::TreeGravity;
+use super::loads::{BodyTorque, LineDamper, Path, PointForce, RotaryDamper, SpringEnergy, Step};
 use super::motion::{Inertia, M3};
 use super::{BodyPoses, Node, Shared, Tree};
 use crate::error::{Error, Part, Problem, Result};
 use crate::limit::Stop;
-use crate::model::Model;
 use crate::model::force::PotentialBlock;
 use crate::model::timefn::TimeFn;
+use crate::model::{Model, ModelBuilder};
 use crate::spatial::actuator::Law;
 use crate::spatial::joint::{Joint, JointKind};
+use crate::spatial::load::Load;
 use crate::spatial::mechanism::Mechanism;
-use crate::spatial::placing::joint_law;
+use crate::spatial::placing::{checked_load, joint_law};
 use crate::spatial::posing::line;
 use crate::spatial::rotation::rotate;
 use std::sync::Arc;
@@ -64,6 +66,13 @@ impl InJoints {
     }
 }
 
+/// Runs `$body` with the const `$k` the number of coordinates `$at` (1 to [`LOAD_REACH`]).
+macro_rules! by_reach {
+    ($at:expr, $k:ident, $body:expr) => {
+        crate::with_const!($at.len(), $k, [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12], $body)
+    };
+}
+
 fn refuse(part: Part, reason: impl Into<String>) -> Error {
     Problem::JointCoordinates { reason: reason.into() }.at(part)
 }
@@ -77,9 +86,10 @@ impl Mechanism {
     /// joints' damping and friction and `<mimic>` couplings (one row
     /// each), drives (a row `θ − f(t)` each, the joint started at `f(0)`,
     /// `ḟ(0)`), actuators (a torque on the coordinate; a servo's error is
-    /// `θ − θ_ref` itself, turns counted) and limits as stops
-    /// ([`TreeStops`](crate::stops::TreeStops)); loads and bodies' own
-    /// initial velocities are refused for now, by name.
+    /// `θ − θ_ref` itself, turns counted), loads (on the coordinates of
+    /// their bodies' paths) and limits as stops
+    /// ([`TreeStops`](crate::stops::TreeStops)); bodies' own initial
+    /// velocities are refused, by name.
     pub fn in_joint_coordinates(&self) -> Result<InJoints> {
         self.in_joint_coordinates_holding(&[])
     }
@@ -151,6 +161,7 @@ impl Mechanism {
             }
         }
         let n = joints.len();
+        let steps = nodes.clone();
         let bodies = self.bodies.iter().zip(&carrier).zip(&poses).map(|((_, &c), &(r, p))| (c, r, p)).collect();
         let shared = Arc::new(Shared::new(Tree { nodes, n, bodies }));
         let gravity = (self.gravity != [0.0; 3]).then(|| {
@@ -188,6 +199,13 @@ impl Mechanism {
             builder = builder.force(Actuated(law.clone()), [c]);
             forces.push(self.actuator_part(k));
             actuators.push((c, law));
+        }
+        for (k, load) in self.loads.iter().enumerate() {
+            let at = Part::Element { index: self.joints.len() + k, kind: load.kind() };
+            let before = builder.force_elements();
+            builder = add_load(builder, &checked_load(load, &poses).map_err(|e| e.at(at.clone()))?, &steps, &carrier)
+                .map_err(|e| e.at(at.clone()))?;
+            forces.extend(std::iter::repeat_n(at, builder.force_elements() - before));
         }
         for (k, coupling) in self.couplings.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + self.loads.len() + k, kind: "mimic" };
@@ -250,14 +268,86 @@ impl Mechanism {
                 limit.check().map_err(|e| e.at(part))?;
             }
         }
-        if let Some(load) = self.loads.first() {
-            return Err(refuse(
-                Part::Element { index: self.joints.len(), kind: load.kind() },
-                "loads are not modelled yet",
-            ));
-        }
         Ok(())
     }
+}
+
+/// The most joint coordinates one load may reach (the union of its bodies' paths).
+const LOAD_REACH: usize = 12;
+
+/// Adds one checked load's elements on the coordinates of its bodies' paths
+/// (`carrier`: each body's node; `nodes` the tree's, parents first).
+fn add_load(builder: ModelBuilder, load: &Load, nodes: &[Node], carrier: &[Option<usize>]) -> Result<ModelBuilder> {
+    let mut coordinates: Vec<usize> = Vec::new();
+    let mut path = |body: Option<usize>| -> Path {
+        let mut chain = Vec::new();
+        let mut at = body.and_then(|b| carrier[b]);
+        while let Some(t) = at {
+            chain.push(t);
+            at = nodes[t].parent;
+        }
+        chain
+            .into_iter()
+            .rev()
+            .map(|t| {
+                let node = &nodes[t];
+                let slot = coordinates.iter().position(|&c| c == node.coordinate).unwrap_or_else(|| {
+                    coordinates.push(node.coordinate);
+                    coordinates.len() - 1
+                });
+                Step { rotary: node.rotary, axis: node.axis, point: node.point, slot }
+            })
+            .collect()
+    };
+    enum Element {
+        Spring(SpringEnergy, Option<LineDamper>),
+        Rotary(RotaryDamper),
+        Force(PointForce),
+        Torque(BodyTorque),
+    }
+    let element = match load.clone() {
+        Load::Spring { a, b, point, point_b, stiffness, damping, length } => {
+            let (pa, pb) = (path(Some(a)), path(b));
+            let points = [point, point_b];
+            let damper = (damping > 0.0).then(|| LineDamper { a: pa.clone(), b: pb.clone(), points, c: damping });
+            Element::Spring(
+                SpringEnergy { a: pa, b: pb, points, k: stiffness, length: length.unwrap_or_default() },
+                damper,
+            )
+        }
+        Load::RotaryDamper { a, b, axis, damping } => {
+            Element::Rotary(RotaryDamper { a: path(Some(a)), b: path(b), axis, c: damping, ground: b.is_none() })
+        }
+        Load::Force { body, force, point } => {
+            Element::Force(PointForce { body: path(Some(body)), point: point.unwrap_or_default(), force })
+        }
+        Load::Torque { body, torque } => Element::Torque(BodyTorque { body: path(Some(body)), torque }),
+    };
+    if coordinates.is_empty() {
+        // Every body it acts on is welded to the ground: it does no work.
+        return Ok(builder);
+    }
+    if coordinates.len() > LOAD_REACH {
+        let reason = format!("a load on bodies {} joints from the ground (at most {LOAD_REACH})", coordinates.len());
+        return Err(Problem::JointCoordinates { reason }.into());
+    }
+    let at = coordinates.as_slice();
+    Ok(match element {
+        Element::Spring(spring, damper) => {
+            let builder = by_reach!(at, K, builder.potential(spring, at_k::<K>(at)));
+            match damper {
+                Some(d) => by_reach!(at, K, builder.force(d, at_k::<K>(at))),
+                None => builder,
+            }
+        }
+        Element::Rotary(e) => by_reach!(at, K, builder.force(e, at_k::<K>(at))),
+        Element::Force(e) => by_reach!(at, K, builder.force(e, at_k::<K>(at))),
+        Element::Torque(e) => by_reach!(at, K, builder.force(e, at_k::<K>(at))),
+    })
+}
+
+fn at_k<const K: usize>(at: &[usize]) -> [usize; K] {
+    std::array::from_fn(|i| at[i])
 }
 
 /// A joint's drive, checked: an angle on a revolute joint, a displacement

@@ -16,7 +16,7 @@
 //!
 //! Here the tree and the work its elements share; `build` the tree and
 //! model from a mechanism; `elements` the rows and forces on its
-//! coordinates; `bodies` the bodies' poses for output; `kinematics` the
+//! coordinates; `loads` springs, dampers, forces and torques on bodies; `bodies` the bodies' poses for output; `kinematics` the
 //! poses at `θ`; `motion` the spatial vectors.
 //!
 //! May import: `error`, `ad`, `model`, `limit`, `spatial`.
@@ -27,6 +27,7 @@ mod dynamics;
 mod elements;
 mod gravity;
 mod kinematics;
+mod loads;
 mod motion;
 
 pub use bodies::BodyPoses;
