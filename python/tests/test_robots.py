@@ -214,6 +214,25 @@ def angles(robot, q):
 
 H = 1e-4
 
+
+def run_beside_pinocchio(robot, t_end, joints, coordinates):
+    """`cdyn run` of the robot from its zero pose (`joints` set) in
+    `coordinates`, sampled every 100 steps of H, and Pinocchio's RK-4 from
+    the same state at the same samples."""
+    model = {"kind": "spatial", "urdf": str(robot.path), "gravity": GRAVITY, "coordinates": coordinates}
+    scenario = {"model": model, "integrator": {"scheme": "rk4", "h": H, "t_end": t_end}, "output": {"every": 100}}
+    q0 = pin.neutral(robot.model)
+    if joints:
+        scenario["initial"] = {"joints": joints}
+        for name, value in joints.items():
+            q0[robot.model.joints[robot.model.getJointId(name)].idx_q] = value
+    result = cdyn.run(cdyn.from_dict(scenario))
+    assert result.error is None, result.error
+    reference = rk4_in_joint_space(robot, q0, np.zeros(robot.model.nv), H, round(t_end / H))[::100]
+    assert len(reference) == len(result.q)
+    return result, reference
+
+
 # The issue's 1 s at h = 1e-4 for UR5 (6 s in CI with the dev-profile
 # wheel). SO-100 and Panda fall faster (light links; 3.1 rad in 1 s), and
 # over 1 s the two RK-4 solutions — one in joint coordinates, one in
@@ -239,22 +258,7 @@ H = 1e-4
 )
 def test_joint_trajectories_agree_with_pinocchio(relative, t_end, joints):
     robot = Robot(relative)
-    scenario = {
-        "model": {"kind": "spatial", "urdf": str(robot.path), "gravity": GRAVITY},
-        "integrator": {"scheme": "rk4", "h": H, "t_end": t_end},
-        "output": {"every": 100},
-    }
-    q0 = pin.neutral(robot.model)
-    if joints:
-        scenario["initial"] = {"joints": joints}
-        for name, value in joints.items():
-            q0[robot.model.joints[robot.model.getJointId(name)].idx_q] = value
-    scenario = cdyn.from_dict(scenario)
-    result = cdyn.run(scenario)
-    assert result.error is None, result.error
-    steps = round(t_end / H)
-    reference = rk4_in_joint_space(robot, q0, np.zeros(robot.model.nv), H, steps)[::100]
-    assert len(reference) == len(result.q)
+    result, reference = run_beside_pinocchio(robot, t_end, joints, "bodies")
     joints = robot.cdyn_joints(result.q, result.v)
     worst, travel = np.zeros(2), 0.0
     for name, values in joints.items():
@@ -279,20 +283,7 @@ def test_joint_coordinate_runs_follow_pinocchio_to_round_off(relative, t_end, jo
     """`coordinates = "joints"`: the same RK-4 in the same coordinates as
     Pinocchio's, so the runs agree to round-off, not to truncation error."""
     robot = Robot(relative)
-    scenario = {
-        "model": {"kind": "spatial", "urdf": str(robot.path), "gravity": GRAVITY, "coordinates": "joints"},
-        "integrator": {"scheme": "rk4", "h": H, "t_end": t_end},
-        "output": {"every": 100},
-    }
-    q0 = pin.neutral(robot.model)
-    if joints:
-        scenario["initial"] = {"joints": joints}
-        for name, value in joints.items():
-            q0[robot.model.joints[robot.model.getJointId(name)].idx_q] = value
-    result = cdyn.run(cdyn.from_dict(scenario))
-    assert result.error is None, result.error
-    reference = rk4_in_joint_space(robot, q0, np.zeros(robot.model.nv), H, round(t_end / H))[::100]
-    assert len(reference) == len(result.q)
+    result, reference = run_beside_pinocchio(robot, t_end, joints, "joints")
     names, _, _ = _cdyn.urdf_tree(str(robot.path), GRAVITY, [], [])
     worst, travel = np.zeros(2), 0.0
     for c, name in enumerate(names):

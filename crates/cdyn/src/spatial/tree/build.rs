@@ -161,7 +161,6 @@ impl Mechanism {
             }
         }
         let n = joints.len();
-        let steps = nodes.clone();
         let bodies = self.bodies.iter().zip(&carrier).zip(&poses).map(|((_, &c), &(r, p))| (c, r, p)).collect();
         let shared = Arc::new(Shared::new(Tree { nodes, n, bodies }));
         let gravity = (self.gravity != [0.0; 3]).then(|| {
@@ -203,8 +202,13 @@ impl Mechanism {
         for (k, load) in self.loads.iter().enumerate() {
             let at = Part::Element { index: self.joints.len() + k, kind: load.kind() };
             let before = builder.force_elements();
-            builder = add_load(builder, &checked_load(load, &poses).map_err(|e| e.at(at.clone()))?, &steps, &carrier)
-                .map_err(|e| e.at(at.clone()))?;
+            builder = add_load(
+                builder,
+                &checked_load(load, &poses).map_err(|e| e.at(at.clone()))?,
+                &shared.tree.nodes,
+                &carrier,
+            )
+            .map_err(|e| e.at(at.clone()))?;
             forces.extend(std::iter::repeat_n(at, builder.force_elements() - before));
         }
         for (k, coupling) in self.couplings.iter().enumerate() {

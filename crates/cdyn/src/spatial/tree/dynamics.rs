@@ -49,12 +49,9 @@ impl TreeKinetic {
         energy
     }
 
-    /// `∂T/∂θ_t`, added into `grad_q`, after [`passes`](Self::passes).
-    fn add_gradient(&self, work: &Work, grad_q: &mut [f64]) {
-        for (t, node) in self.0.tree.nodes.iter().enumerate() {
-            let s = work.kin.nodes[t].s;
-            grad_q[node.coordinate] -= s.cross(work.vel[t]).dot(work.momentum[t]);
-        }
+    /// `∂T/∂θ_t = −(S_t ×ₘ V_t) · H_t`, after [`passes`](Self::passes).
+    fn gradient(&self, work: &Work, t: usize) -> f64 {
+        -work.kin.nodes[t].s.cross(work.vel[t]).dot(work.momentum[t])
     }
 
     /// `M(θ)` by composite rigid bodies, written into `put(i, j, value)` for every `i, j`.
@@ -92,11 +89,12 @@ impl TreeKinetic {
     ) -> f64 {
         let mut work = self.0.lock();
         let energy = self.passes(&mut work, q, v, true);
-        self.add_gradient(&work, grad_q);
         for (t, node) in self.0.tree.nodes.iter().enumerate() {
-            // Ṁ θ̇ = (Ṁ θ̇ − ∂T/∂θ) + ∂T/∂θ.
             let s = work.kin.nodes[t].s;
-            mdot_v[node.coordinate] += s.dot(work.force[t]) - s.cross(work.vel[t]).dot(work.momentum[t]);
+            let gradient = self.gradient(&work, t);
+            grad_q[node.coordinate] += gradient;
+            // Ṁ θ̇ = (Ṁ θ̇ − ∂T/∂θ) + ∂T/∂θ.
+            mdot_v[node.coordinate] += s.dot(work.force[t]) + gradient;
         }
         self.mass(&mut work, put);
         energy
@@ -130,7 +128,9 @@ impl KineticBlock for TreeKinetic {
         let mut work = self.0.lock();
         let energy = self.passes(&mut work, q, v, false);
         if let Some(g) = grad_q {
-            self.add_gradient(&work, g);
+            for (t, node) in self.0.tree.nodes.iter().enumerate() {
+                g[node.coordinate] += self.gradient(&work, t);
+            }
         }
         energy
     }

@@ -6,7 +6,7 @@
 //! space axes, and each node's bodies are its initial inertia moved by `G_t`.
 
 use super::Tree;
-use super::motion::{Inertia, M3, Motion, V3, add, scale, times};
+use super::motion::{Inertia, M3, Motion, V3, add, product, rotation, scale, times};
 use crate::spatial::rotation::cross;
 
 /// One node (a joint with a coordinate) at `θ`.
@@ -31,21 +31,6 @@ pub(super) struct Kinematics {
 }
 
 const IDENTITY: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-
-/// The rotation by `angle` about the unit `u` (Rodrigues).
-pub(super) fn rotation(u: V3, angle: f64) -> M3 {
-    let (s, c) = angle.sin_cos();
-    let k = 1.0 - c;
-    [
-        [c + k * u[0] * u[0], k * u[0] * u[1] - s * u[2], k * u[0] * u[2] + s * u[1]],
-        [k * u[1] * u[0] + s * u[2], c + k * u[1] * u[1], k * u[1] * u[2] - s * u[0]],
-        [k * u[2] * u[0] - s * u[1], k * u[2] * u[1] + s * u[0], c + k * u[2] * u[2]],
-    ]
-}
-
-fn product(a: &M3, b: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j]))
-}
 
 impl Kinematics {
     pub fn new(tree: &Tree) -> Self {

@@ -12,7 +12,7 @@
 //! `F` there, a torque `τ` on the body, give the coordinate `j` the
 //! generalized forces `F · (ω_j × x + v_j)` and `τ · ω_j`.
 
-use super::motion::V3;
+use super::motion::{V3, add, dot, product, rotation, scale, times};
 use crate::ad::scalar::Scalar;
 use crate::model::force::{Force, Potential};
 use crate::spatial::rotation::cross;
@@ -37,14 +37,6 @@ fn lift<D: Scalar>(a: V3) -> D3<D> {
     a.map(D::from)
 }
 
-fn times<D: Scalar>(r: &[D3<D>; 3], a: D3<D>) -> D3<D> {
-    std::array::from_fn(|i| r[i][0] * a[0] + r[i][1] * a[1] + r[i][2] * a[2])
-}
-
-fn dot<D: Scalar>(a: D3<D>, b: D3<D>) -> D {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// Walks `path` at the coordinates `x`: calls `each(slot, ω, v)` with each
 /// joint's motion, root first, and returns the body's displacement `(R, p)`.
 fn walk<D: Scalar, const K: usize>(
@@ -59,28 +51,16 @@ fn walk<D: Scalar, const K: usize>(
         let w = times(&r, lift(s.axis));
         let theta = x[s.slot];
         if s.rotary {
-            let at = times(&r, lift(s.point));
-            let at = [at[0] + p[0], at[1] + p[1], at[2] + p[2]];
+            let at = add(times(&r, lift(s.point)), p);
             each(s.slot, w, cross(at, w));
-            // Rodrigues' rotation about the axis through the point, after R.
-            let (sn, cs) = (theta.sin(), theta.cos());
-            let u = s.axis;
-            let k = D::from(1.0) - cs;
-            let turn: [D3<D>; 3] = std::array::from_fn(|i| {
-                std::array::from_fn(|j| {
-                    let skew = [[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]][i][j];
-                    one(i, j) * cs + sn * skew + k * (u[i] * u[j])
-                })
-            });
-            let arm = times(&turn, lift(s.point));
-            let shift = times(&r, std::array::from_fn(|i| D::from(s.point[i]) - arm[i]));
-            p = [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]];
-            r = std::array::from_fn(|i| {
-                std::array::from_fn(|j| r[i][0] * turn[0][j] + r[i][1] * turn[1][j] + r[i][2] * turn[2][j])
-            });
+            // G ∘ (x ↦ Q (x − P) + P): R Q, and p + R (P − Q P).
+            let turn = rotation(s.axis, theta);
+            let (point, arm): (D3<D>, D3<D>) = (lift(s.point), times(&turn, lift(s.point)));
+            p = add(p, times(&r, std::array::from_fn(|i| point[i] - arm[i])));
+            r = product(&r, &turn);
         } else {
             each(s.slot, [D::zero(); 3], w);
-            p = [p[0] + w[0] * theta, p[1] + w[1] * theta, p[2] + w[2] * theta];
+            p = add(p, scale(theta, w));
         }
     }
     (r, p)
@@ -89,8 +69,7 @@ fn walk<D: Scalar, const K: usize>(
 /// A body point's place at `x` (a ground point where the path is empty).
 fn place<D: Scalar, const K: usize>(path: &[Step], x: &[D; K], point: V3) -> D3<D> {
     let (r, p) = walk(path, x, |_, _, _| {});
-    let at = times(&r, lift(point));
-    [at[0] + p[0], at[1] + p[1], at[2] + p[2]]
+    add(times(&r, lift(point)), p)
 }
 
 /// A body point's place and velocity at `(x, ẋ)`, and `F`'s generalized forces added into `out`
@@ -109,16 +88,12 @@ fn apply<D: Scalar, const K: usize>(
         motions[slot] = (w, v);
         on[slot] = true;
     });
-    let at = times(&r, lift(point));
-    let at = [at[0] + p[0], at[1] + p[1], at[2] + p[2]];
-    let unit = |(w, v): (D3<D>, D3<D>)| {
-        let c = cross(w, at);
-        [c[0] + v[0], c[1] + v[1], c[2] + v[2]]
-    };
+    let at = add(times(&r, lift(point)), p);
+    let unit = |(w, v): (D3<D>, D3<D>)| add(cross(w, at), v);
     let mut velocity = [D::zero(); 3];
     for k in (0..K).filter(|&k| on[k]) {
         let u = unit(motions[k]);
-        velocity = std::array::from_fn(|i| velocity[i] + u[i] * xd[k]);
+        velocity = add(velocity, scale(xd[k], u));
     }
     let f = force(at, velocity);
     for k in (0..K).filter(|&k| on[k]) {
@@ -132,7 +107,7 @@ fn spin<D: Scalar, const K: usize>(path: &[Step], x: &[D; K], xd: &[D; K]) -> (D
     let (r, _) = walk(path, x, |slot, w, _| axes[slot] = w);
     let mut w = [D::zero(); 3];
     for (k, a) in axes.iter().enumerate() {
-        w = std::array::from_fn(|i| w[i] + a[i] * xd[k]);
+        w = add(w, scale(xd[k], *a));
     }
     (w, axes, r)
 }

@@ -4,25 +4,43 @@
 //! the origin, and a rigid body's inertia there. Written out in 3-vectors:
 //! every product here is a handful of cross products, not a 6 × 6 matrix.
 
+use crate::ad::scalar::Scalar;
 use crate::spatial::rotation::cross;
 
 pub(super) type V3 = [f64; 3];
 pub(super) type M3 = [[f64; 3]; 3];
 
-pub(super) fn dot(a: V3, b: V3) -> f64 {
+// Written generic over the scalar: the tree's passes run them in `f64`,
+// its loads (`loads.rs`) in dual numbers.
+
+pub(super) fn dot<D: Scalar>(a: [D; 3], b: [D; 3]) -> D {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-pub(super) fn add(a: V3, b: V3) -> V3 {
+pub(super) fn add<D: Scalar>(a: [D; 3], b: [D; 3]) -> [D; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
-pub(super) fn scale(s: f64, a: V3) -> V3 {
+pub(super) fn scale<D: Scalar>(s: D, a: [D; 3]) -> [D; 3] {
     [s * a[0], s * a[1], s * a[2]]
 }
 
-pub(super) fn times(m: &M3, a: V3) -> V3 {
+pub(super) fn times<D: Scalar>(m: &[[D; 3]; 3], a: [D; 3]) -> [D; 3] {
     [dot(m[0], a), dot(m[1], a), dot(m[2], a)]
+}
+
+pub(super) fn product<D: Scalar>(a: &[[D; 3]; 3], b: &[[D; 3]; 3]) -> [[D; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j]))
+}
+
+/// The rotation by `angle` about the unit `u` (Rodrigues).
+pub(super) fn rotation<D: Scalar>(u: V3, angle: D) -> [[D; 3]; 3] {
+    let (s, c) = angle.sin_cos();
+    let k = D::from(1.0) - c;
+    let skew = [[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]];
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| k * (u[i] * u[j]) + s * skew[i][j] + if i == j { c } else { D::zero() })
+    })
 }
 
 /// A twist (or a motion subspace's column, or a spatial acceleration).
