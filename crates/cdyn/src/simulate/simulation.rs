@@ -63,6 +63,12 @@ impl<'m> Simulation<'m> {
         self.system.add_evaluations(previous.evaluations());
     }
 
+    /// Counts `n` evaluations made for this run elsewhere (the part steps
+    /// of [`crate::stops`] to an impact).
+    pub(crate) fn count_evaluations(&mut self, n: u64) {
+        self.system.add_evaluations(n);
+    }
+
     /// Writes `(q, v, e)` into the state and restarts the scheme (see [`Simulation::set_state`]).
     pub(super) fn replace_state(&mut self, q: &[f64], v: &[f64], e: f64) {
         let (t, n) = (self.t(), self.system.n());

@@ -29,6 +29,9 @@ pub struct Stepper<S: System> {
     tuning: Tuning,
     pub(super) x: S::State,
     step: u64,
+    /// The time of step 0: 0 but for a part step within one of another
+    /// run ([`crate::stops`] steps to an impact inside a step).
+    start_time: f64,
     /// Newton iterations of the projection so far, and steps it failed.
     projection_iterations: u64,
     projection_failures: u64,
@@ -115,6 +118,7 @@ impl<S: System> Stepper<S> {
             tuning,
             x,
             step: 0,
+            start_time: 0.0,
             projection_iterations: 0,
             projection_failures: 0,
             rank_loss: None,
@@ -187,7 +191,13 @@ impl<S: System> Stepper<S> {
     }
     /// Current time, `step · h` (not accumulated, so it does not drift).
     pub fn t(&self) -> f64 {
-        self.step as f64 * self.settings.h
+        self.start_time + self.step as f64 * self.settings.h
+    }
+
+    /// Makes step 0 time `t0`: for a part of a step of another run, taken
+    /// from its time (a model with drives or inputs reads it).
+    pub(crate) fn set_start_time(&mut self, t0: f64) {
+        self.start_time = t0;
     }
     /// Current positions.
     pub fn q(&self) -> &[f64] {

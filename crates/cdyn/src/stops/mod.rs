@@ -5,11 +5,12 @@
 //! model only while it holds: the run steps the model of the stops held,
 //! and between two steps
 //!
-//! - a stop whose gap closed (`g < 0`) is hit: the positions are projected
-//!   onto `g = 0` and the other rows, the velocities by Newton's impact law
-//!   (the plastic correction in the kinetic-energy metric, which takes
-//!   exactly the kinetic energy of the velocity along the stop, scaled by
-//!   `1 + e` for restitution `e`), and with `e = 0` the stop is held;
+//! - a stop whose gap closed (`g < 0`) is hit where it closed: the
+//!   positions are projected onto `g = 0` and the other rows, the
+//!   velocities by Newton's impact law (the plastic correction in the
+//!   kinetic-energy metric, which takes exactly the kinetic energy of the
+//!   velocity along the stop, scaled by `1 + e` for restitution `e`), and
+//!   with `e = 0` the stop is held;
 //! - a held stop whose multiplier turned to pulling (`λ > 0` for the row
 //!   `g = 0`, whose force is `−g_qᵀ λ`) is released.
 //!
@@ -29,13 +30,16 @@
 //! of such a gap as the one nearest the stop's last (one step turns a
 //! joint far less than half a turn), so that its stops follow the turns.
 //!
-//! The stops are seen at the end of a step: the impact is applied there
-//! (up to one step `h` late, the joint past its stop by at most `|ġ| h`,
-//! which the projection removes), and the crossing time the event reports
-//! is the root of the cubic through `(g, ġ)` at the step's two ends.
+//! A stop is found closed at the end of a step; the step is then taken
+//! again in parts ([`StopSimulation`]): to the crossing, the root of the
+//! cubic through `(g, ġ)` at the step's two ends, where the impact is
+//! applied at the stop's own rate, and on to the step's end, so the run
+//! stays on its grid `t = k h`. The parts take the run's scheme, or its
+//! start-up scheme where it is a multistep one (RK-4 for AB-3 and ABM-4).
 //!
 //! May import: `error`, `model`, `dynamics`, `simulate`, `spatial`, `planar`, `limit`.
 
+mod impact;
 mod planar;
 mod reads;
 mod snapshot;

@@ -14,7 +14,6 @@
 use super::start::{START_SLACK, refuse_passed};
 use super::turns::read_following;
 use super::unilateral::{Change, Event, Report, Unilateral};
-use crate::dynamics::assemble::assemble;
 use crate::dynamics::{Breakdown, Dynamics};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -50,7 +49,12 @@ pub struct StopSimulation<S: Deref<Target: Unilateral>> {
     /// reading on its way to `before`.
     pub(super) after: Vec<[f64; 2]>,
     /// The stops the step just taken closed.
-    hits: Vec<usize>,
+    pub(super) hits: Vec<usize>,
+    /// `(q, v)` at the start of the step being taken: where a step that
+    /// closed a stop steps again from, to the crossing.
+    pub(super) start: Vec<f64>,
+    /// Evaluations of the part steps to impacts, for the run's count.
+    pub(super) part_evaluations: u64,
     /// Evaluates the multipliers of the held stops' rows.
     pub(super) dynamics: Dynamics,
     pub(super) report: Report,
@@ -71,13 +75,32 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         // A velocity bound first exceeded in an ordinary step finds its place.
         report.overspeed.reserve_exact(system.speed_bounds());
         let (held, implied) = (Vec::with_capacity(before.len()), Vec::with_capacity(before.len()));
-        Ok(Self { sim, model, system, settings, held, implied, before, after, hits, dynamics, report })
+        let start = [q0, v0].concat();
+        Ok(Self {
+            sim,
+            model,
+            system,
+            settings,
+            held,
+            implied,
+            before,
+            after,
+            hits,
+            start,
+            part_evaluations: 0,
+            dynamics,
+            report,
+        })
     }
 
-    /// One step of size `h`, then the stops: those it closed are hit (the
-    /// state after the impact is the step's), held ones pulled away from
-    /// are released.
+    /// One step of size `h`, then the stops: where it closed some, it is
+    /// taken again in parts, to the first crossing, the impact there, and
+    /// on to the step's end (see [`hit_within`](Self::hit_within)); held
+    /// stops pulled away from are released.
     pub fn step(&mut self) -> Result<()> {
+        let n = self.model.n();
+        self.start[..n].copy_from_slice(self.sim.q());
+        self.start[n..].copy_from_slice(self.sim.v());
         self.sim.step()?;
         let (step, t) = (self.sim.steps(), self.sim.t());
         let (q, v) = (self.sim.q(), self.sim.v());
@@ -93,11 +116,10 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
             (0..after.len()).filter(|k| !held.contains(k) && !implied.contains(k) && after[*k][0] < -START_SLACK),
         );
         if !self.hits.is_empty() {
-            let (hits, gaps) = (std::mem::take(&mut self.hits), std::mem::take(&mut self.after));
-            let result = self.impact(&hits, &gaps, step, t);
-            (self.hits, self.after) = (hits, gaps);
-            let (q, v, held_more) = result?;
-            return self.restart(&q, &v, held_more);
+            let hits = std::mem::take(&mut self.hits);
+            let result = self.hit_within(&hits, step, t);
+            self.hits = hits;
+            return result;
         }
         if !self.held.is_empty() && self.release(step, t)? {
             let (q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
@@ -105,96 +127,6 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         }
         std::mem::swap(&mut self.before, &mut self.after);
         Ok(())
-    }
-
-    /// Hits the stops `hits` (whose gaps closed in the step to `t`):
-    /// Newton's impact and the stops held if plastic. Returns the state
-    /// after it and whether more stops are held, for the new segment.
-    fn impact(&mut self, hits: &[usize], gaps: &[[f64; 2]], step: u64, t: f64) -> Result<(Vec<f64>, Vec<f64>, bool)> {
-        let h = self.settings.h;
-        let (mut q, v) = (self.sim.q().to_vec(), self.sim.v().to_vec());
-        let (rows, implied) = self.split_implied(hits, &q, &v, t)?;
-        // The positions onto every row, stops hit included, and the
-        // velocities there with (v̂) and without (v_p) the stops hit
-        // moving: v_p is Newton's plastic impact; v̂ + (1 + e)(v_p − v̂)
-        // meets the other rows and leaves the stops at −e times v̂'s rate.
-        let mut impact = self.system.model_holding(&rows)?;
-        let mut plastic = v.clone();
-        assemble(&impact, &mut q, &mut plastic, t, ASSEMBLY_TOLERANCE)?;
-        let mut free = v;
-        assemble(&self.model, &mut q.clone(), &mut free, t, ASSEMBLY_TOLERANCE)?;
-        // Only the rates are read from these: a periodic gap's turn does not matter.
-        let mut rates = vec![[0.0; 2]; gaps.len()];
-        self.system.gaps(&q, &free, &mut rates)?;
-        // A stop whose gap is opening again at the stop crossed and turned
-        // within the step (a graze): its position is put back, and the
-        // impact is of the stops still closing. Held on the sign of ġ
-        // alone, Panda's joint 6 lost 0.16 J grazing its lower limit.
-        let closing = |k: &usize| rates[*k][1] < 0.0;
-        let held = self.held.len();
-        let rows: Vec<usize> = rows[..held].iter().chain(rows[held..].iter().filter(|k| closing(k))).copied().collect();
-        let implied: Vec<usize> = implied.into_iter().filter(closing).collect();
-        if rows.len() < impact.m() - (self.model.m() - held) {
-            // M-orthogonal projections nest: onto fewer rows from v̂.
-            impact = self.system.model_holding(&rows)?;
-            plastic.clone_from(&free);
-            assemble(&impact, &mut q.clone(), &mut plastic, t, ASSEMBLY_TOLERANCE)?;
-        }
-        // One coefficient for stops hit at once: the largest of theirs. A
-        // rebound that the load pressing into the stop (g̈ < 0, over the
-        // step) would end within a step, `2 e |ġ| < |g̈| h`, is a plastic
-        // impact: bounces shrinking by e each would otherwise come at every
-        // step without end (Zeno), each a hit.
-        // The rebound is from ġ at the crossing, not at the step's end: seen
-        // up to h late, the joint has gained speed from the load since, and
-        // rebounding with it gave back energy the bounce did not have (a
-        // bounce every second step without end, at 7.4e-3 rad/s, seen).
-        let crossings: Vec<[f64; 2]> = hits.iter().map(|&k| crossing(self.before[k], gaps[k], h)).collect();
-        let bounces = |(k, [_, rate]): (usize, [f64; 2])| {
-            let pressing = (self.before[k][1] - gaps[k][1]) / h;
-            closing(&k) && 2.0 * self.system.restitution(k) * -rate >= pressing * h
-        };
-        let bouncing = || hits.iter().copied().zip(crossings.iter().copied()).filter(|&hit| bounces(hit));
-        let e = bouncing().map(|(k, _)| self.system.restitution(k)).fold(0.0, f64::max);
-        let slower = bouncing().map(|(k, [_, rate])| (rate / rates[k][1]).clamp(0.0, 1.0)).fold(1.0, f64::min);
-        // v_p + e r (v_p − v̂): the stops' rate −e r ġ, r = ġ(crossing) / ġ.
-        let v: Vec<f64> = free.iter().zip(&plastic).map(|(f, p)| p + e * slower * (p - f)).collect();
-        let kinetic_lost = impact.kinetic(&q, &free) - impact.kinetic(&q, &v);
-        let held_more = e == 0.0 && rows.len() > held;
-        for (&stop, [s, _]) in hits.iter().zip(crossings) {
-            let t = t - h + s * h;
-            let held = held_more && closing(&stop);
-            let change = Change::Impact { rate: rates[stop][1], kinetic_lost, held };
-            self.report.events.push(Event { stop, step, t, change });
-        }
-        if held_more {
-            self.held = rows;
-            self.implied.extend(implied);
-        }
-        Ok((q, v, held_more))
-    }
-
-    /// The stops to hold as rows after hitting `hits` at `(q, v)` — the
-    /// held ones and each hit whose row is independent of the model's rows
-    /// and of those before it — and the hits left out, which the rows
-    /// already hold: a row that depends on the others would make the
-    /// constraints singular. Panda's two fingers, one a `<mimic>` of the
-    /// other, reach their lower bound together; with the first finger's
-    /// stop and the mimic row held, the second's stop holds nothing more.
-    fn split_implied(&self, hits: &[usize], q: &[f64], v: &[f64], t: f64) -> Result<(Vec<usize>, Vec<usize>)> {
-        let (mut rows, mut implied) = (self.held.clone(), Vec::new());
-        let others = self.model.m() - self.held.len();
-        for &stop in hits {
-            // More rows than coordinates cannot be independent.
-            let independent = others + rows.len() < q.len() && {
-                rows.push(stop);
-                let model = self.system.model_holding(&rows)?;
-                rows.pop();
-                !matches!(Dynamics::new(&model).evaluate(&model, q, v, t), Err(Breakdown::Singular(_)))
-            };
-            if independent { rows.push(stop) } else { implied.push(stop) }
-        }
-        Ok((rows, implied))
     }
 
     /// Releases the held stops whose multiplier turned to pulling at the
@@ -232,11 +164,17 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     pub(super) fn restart(&mut self, q: &[f64], v: &[f64], held_changed: bool) -> Result<()> {
         let model =
             if held_changed { Arc::new(self.system.model_holding(&self.held)?) } else { Arc::clone(&self.model) };
+        self.restart_with(q, v, model, held_changed)
+    }
+
+    /// [`restart`](Self::restart) with `model`, that of the stops held now.
+    pub(super) fn restart_with(&mut self, q: &[f64], v: &[f64], model: Arc<Model>, held_changed: bool) -> Result<()> {
         // The run's state need not meet the start's tolerance: it is the
         // run's, as consistent as its method keeps it.
         let settings = Settings { consistency_tolerance: None, ..self.settings };
         let mut sim = start(&model, settings, q, v)?;
         sim.continue_from(&self.sim);
+        sim.count_evaluations(std::mem::take(&mut self.part_evaluations));
         // The old simulation goes first, then the model it borrowed.
         self.sim = sim;
         if held_changed {
@@ -353,30 +291,3 @@ fn breakdown(b: Breakdown, step: u64, t: f64) -> Error {
 /// on Panda), far below a real load (a release delayed by this fraction of
 /// the load's rise time).
 const RELEASE_THRESHOLD: f64 = 1e-10;
-
-/// How closely an impact's projection meets the rows.
-const ASSEMBLY_TOLERANCE: f64 = 1e-12;
-
-/// Where in a step of `h` (a fraction of it) the cubic through `(g, ġ)` at
-/// both ends crosses zero (`g ≥ 0` at the start, `< 0` at the end), by
-/// bisection, and the cubic's rate there.
-fn crossing([g0, r0]: [f64; 2], [g1, r1]: [f64; 2], h: f64) -> [f64; 2] {
-    let cubic = |s: f64| {
-        let (s2, s3) = (s * s, s * s * s);
-        g0 * (2.0 * s3 - 3.0 * s2 + 1.0)
-            + r0 * h * (s3 - 2.0 * s2 + s)
-            + g1 * (3.0 * s2 - 2.0 * s3)
-            + r1 * h * (s3 - s2)
-    };
-    let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if cubic(mid) >= 0.0 { lo = mid } else { hi = mid }
-    }
-    let s = 0.5 * (lo + hi);
-    let slope = g0 * (6.0 * s * s - 6.0 * s)
-        + r0 * h * (3.0 * s * s - 4.0 * s + 1.0)
-        + g1 * (6.0 * s - 6.0 * s * s)
-        + r1 * h * (3.0 * s * s - 2.0 * s);
-    [s, slope / h]
-}

@@ -72,12 +72,10 @@ pub enum Change {
         /// `ġ` just before the impact, at the stop (the positions projected
         /// onto it, the velocities onto the other rows there).
         rate: f64,
-        /// `T⁻ − T⁺` across the impact, at the stop: `(ġ² − e² ġ_c²) / (2 g_q M⁻¹ g_qᵀ)`
-        /// for one stop, with `ġ_c` the rate at the crossing (the rebound's
-        /// `−e ġ_c`: from the step's end, up to `h` after the crossing, it
-        /// would give back the energy the load put in since). A rebound the
-        /// load would end within a step (`2 e |ġ_c| < |g̈| h`) is plastic:
-        /// bounces end held instead of coming at every step.
+        /// `T⁻ − T⁺` across the impact, at the stop: `(1 − e²) ġ² / (2 g_q M⁻¹ g_qᵀ)`
+        /// for one stop. A rebound the load would end within a step
+        /// (`2 e |ġ| < |g̈| h`) is plastic: bounces end held instead of
+        /// coming at every step.
         kinetic_lost: f64,
         /// Whether the stop is held now.
         held: bool,
@@ -95,10 +93,10 @@ pub enum Change {
 pub struct Event {
     /// Which stop (see [`Unilateral::stops`]).
     pub stop: usize,
-    /// The step after which it was seen (`t = step · h`).
+    /// The step within which it happened (ending at `t = step · h`).
     pub step: u64,
-    /// When: for an impact, the crossing time within that step; for a
-    /// release, the step's end.
+    /// When: for an impact, the crossing within that step, where it is
+    /// applied; for a release, the step's end.
     pub t: f64,
     /// What happened.
     pub change: Change,
