@@ -95,8 +95,8 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
 
     /// One step of size `h`, then the stops: where it closed some, it is
     /// taken again in parts, to the first crossing, the impact there, and
-    /// on to the step's end (see [`hit_within`](Self::hit_within)); held
-    /// stops pulled away from are released.
+    /// on to the step's end (see [`crate::stops`]); held stops pulled
+    /// away from are released.
     pub fn step(&mut self) -> Result<()> {
         let n = self.model.n();
         self.start[..n].copy_from_slice(self.sim.q());
