@@ -31,9 +31,8 @@ pub use crate::dynamics::momentum::MAX_HELD;
 pub(crate) struct Held {
     /// Each a [`Kind::Rotation`] or a [`Kind::Declared`].
     kinds: Vec<Kind>,
-    /// `I_j` at the start: what is held.
+    /// `I_j` held (its value at the start or after an impact), and at the latest update.
     targets: Vec<f64>,
-    /// `I_j` at the latest update.
     values: Vec<f64>,
     /// `k × n` each.
     field: Vec<f64>,
@@ -53,6 +52,11 @@ pub(crate) struct Held {
 }
 
 impl Held {
+    /// Holds its invariants at `targets` (one each, in order) from now on.
+    pub(crate) fn set_targets(&mut self, targets: &[f64]) {
+        self.targets.copy_from_slice(targets);
+    }
+
     /// Holds the invariants of `kinds` at `targets` in a model of `n`
     /// coordinates and `m` constraint rows.
     pub(crate) fn new(kinds: Vec<Kind>, targets: Vec<f64>, n: usize, m: usize) -> Self {

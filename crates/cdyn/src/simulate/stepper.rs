@@ -194,10 +194,35 @@ impl<S: System> Stepper<S> {
         self.start_time + self.step as f64 * self.settings.h
     }
 
-    /// Makes step 0 time `t0`: for a part of a step of another run, taken
-    /// from its time (a model with drives or inputs reads it).
-    pub(crate) fn set_start_time(&mut self, t0: f64) {
-        self.start_time = t0;
+    /// A copy of this run moved to `(q, v)` at time `t0` and stepped once
+    /// by `dt`: a part of a step ([`crate::stops`] steps to an impact
+    /// within one), with this run's model, gains and symmetries, not the
+    /// set-up of a new run (two thirds of it finding the symmetries). Its
+    /// `∫Ė` is `e`, the run's own there; without one, the part starts from
+    /// an impact and holds the energy and momenta at their values there
+    /// ([`System::hold_from`]). The scheme starts afresh, a multistep one
+    /// by its start-up scheme, as after any restart.
+    pub(crate) fn part_step(&self, q: &[f64], v: &[f64], e: Option<f64>, t0: f64, dt: f64) -> Result<Self>
+    where
+        S: Clone,
+    {
+        let mut part = self.clone();
+        (part.settings.h, part.step, part.start_time) = (dt, 0, t0);
+        if part.settings.scheme == Scheme::GeneralizedAlpha {
+            part.system.prepare_generalized_alpha(part.settings.generalized_alpha, q, v, dt);
+        }
+        let n = q.len();
+        let x = part.x.as_mut_slice();
+        x[..n].copy_from_slice(q);
+        x[n..2 * n].copy_from_slice(v);
+        match e {
+            Some(e) => x[2 * n] = e,
+            None => part.system.hold_from(x),
+        }
+        part.integrator.restart();
+        part.system.restart(part.x.as_slice(), t0);
+        part.step()?;
+        Ok(part)
     }
     /// Current positions.
     pub fn q(&self) -> &[f64] {

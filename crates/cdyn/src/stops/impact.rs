@@ -29,7 +29,8 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         // What is left of the step: from `(q, v)` at `t_from`, where the
         // gaps are `from`, to the step's end, where the state is `end` and
         // the gaps `to`.
-        let (mut q, mut v, mut t_from) = (self.start[..n].to_vec(), self.start[n..].to_vec(), t - self.settings.h);
+        let (mut q, mut v) = (self.start[..n].to_vec(), self.start[n..2 * n].to_vec());
+        let mut t_from = t - self.settings.h;
         let mut end = (self.sim.q().to_vec(), self.sim.v().to_vec());
         let (mut from, mut to, mut hits) = (self.before.clone(), self.after.clone(), hits.to_vec());
         let (mut model, mut changed, mut at) = (Arc::clone(&self.model), false, from.clone());
@@ -44,7 +45,9 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
                 // are found again after it.
                 let with_first: Vec<usize> =
                     (0..hits.len()).filter(|&i| crossings[i] <= first + SAME_CROSSING).collect();
-                let crossed = self.part_step(&model, q, v, t_from, first * left)?;
+                // The run's own ∫Ė where the part starts from the step's start.
+                let e = (round == 0).then(|| self.start[2 * n]);
+                let crossed = self.part_step(&model, (q, v), e, t_from, first * left)?;
                 let hit = with_first.iter().map(|&i| hits[i]).collect();
                 (crossed, t_from + first * left, hit, with_first.iter().map(|&i| pressing[i]).collect())
             } else {
@@ -63,7 +66,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
                 break;
             }
             read_following(&*self.system, &q, &v, &at, &mut from)?;
-            end = self.part_step(&model, q.clone(), v.clone(), t_from, t - t_from)?;
+            end = self.part_step(&model, (q.clone(), v.clone()), None, t_from, t - t_from)?;
             read_following(&*self.system, &end.0, &end.1, &from, &mut to)?;
             let (held, implied) = (&self.held, &self.implied);
             hits = (0..to.len())
@@ -77,21 +80,36 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         self.restart_with(&q, &v, model, changed)
     }
 
-    /// `(q, v)` stepped on by `dt`, a part of a step, from time `t0`: by the
-    /// run's scheme, or its start-up scheme where it is a multistep one
-    /// (whose history is at `h`). A part shorter than round-off of `h` is
-    /// not taken.
-    fn part_step(&mut self, model: &Model, q: Vec<f64>, v: Vec<f64>, t0: f64, dt: f64) -> Result<(Vec<f64>, Vec<f64>)> {
+    /// `(q, v)` stepped on by `dt`, a part of a step, from time `t0`, in
+    /// the segment of `model`: by a copy of the run's simulation where that
+    /// is its model, else of one started there (`Simulation::part_step`:
+    /// the run's scheme, a multistep one's start-up). `∫Ė` starts at `e`,
+    /// the run's own; without one, from an impact, whose changes to the
+    /// energy and momenta the control laws must not undo. A part shorter
+    /// than round-off of `h` is not taken.
+    fn part_step(
+        &mut self,
+        model: &Arc<Model>,
+        (q, v): (Vec<f64>, Vec<f64>),
+        e: Option<f64>,
+        t0: f64,
+        dt: f64,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
         if dt <= SAME_CROSSING * self.settings.h {
             return Ok((q, v));
         }
-        let scheme = self.settings.scheme.info().startup.unwrap_or(self.settings.scheme);
-        let settings = Settings { h: dt, scheme, consistency_tolerance: None, ..self.settings };
-        let mut part = Simulation::new(model, settings, &q, &v)?;
-        part.set_start_time(t0);
-        part.step()?;
-        self.part_evaluations += part.evaluations();
-        Ok((part.q().to_vec(), part.v().to_vec()))
+        let part = |sim: &Simulation<'_>| -> Result<(Vec<f64>, Vec<f64>, u64)> {
+            let part = sim.part_step(&q, &v, e, t0, dt)?;
+            Ok((part.q().to_vec(), part.v().to_vec(), part.evaluations() - sim.evaluations()))
+        };
+        let (q, v, evaluations) = if Arc::ptr_eq(model, &self.model) {
+            part(&self.sim)?
+        } else {
+            let settings = Settings { consistency_tolerance: None, ..self.settings };
+            part(&Simulation::new(model, settings, &q, &v)?)?
+        };
+        self.part_evaluations += evaluations;
+        Ok((q, v))
     }
 
     /// Hits the stops `hits` at `(q, v)` and time `t`, where they close, in

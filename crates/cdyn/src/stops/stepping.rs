@@ -50,8 +50,8 @@ pub struct StopSimulation<S: Deref<Target: Unilateral>> {
     pub(super) after: Vec<[f64; 2]>,
     /// The stops the step just taken closed.
     pub(super) hits: Vec<usize>,
-    /// `(q, v)` at the start of the step being taken: where a step that
-    /// closed a stop steps again from, to the crossing.
+    /// `(q, v, ∫Ė)` at the start of the step being taken: where a step
+    /// that closed a stop steps again from, to the crossing.
     pub(super) start: Vec<f64>,
     /// Evaluations of the part steps to impacts, for the run's count.
     pub(super) part_evaluations: u64,
@@ -75,7 +75,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         // A velocity bound first exceeded in an ordinary step finds its place.
         report.overspeed.reserve_exact(system.speed_bounds());
         let (held, implied) = (Vec::with_capacity(before.len()), Vec::with_capacity(before.len()));
-        let start = [q0, v0].concat();
+        let start = [q0, v0, &[0.0]].concat();
         Ok(Self {
             sim,
             model,
@@ -100,7 +100,8 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     pub fn step(&mut self) -> Result<()> {
         let n = self.model.n();
         self.start[..n].copy_from_slice(self.sim.q());
-        self.start[n..].copy_from_slice(self.sim.v());
+        self.start[n..2 * n].copy_from_slice(self.sim.v());
+        self.start[2 * n] = self.sim.energy_input();
         self.sim.step()?;
         let (step, t) = (self.sim.steps(), self.sim.t());
         let (q, v) = (self.sim.q(), self.sim.v());

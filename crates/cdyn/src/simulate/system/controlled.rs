@@ -20,6 +20,8 @@ use crate::simulate::generalized_alpha::{self, GeneralizedAlpha, StepReport};
 use crate::simulate::rattle;
 use std::cell::Cell;
 
+mod between;
+
 /// A model with a control law: the right-hand side an [`Integrator`](crate::integrate::Integrator) steps.
 #[derive(Clone)]
 pub struct ControlledSystem<'m> {
@@ -139,28 +141,6 @@ impl<'m> ControlledSystem<'m> {
     /// The control law it adds.
     pub fn control(&self) -> &Control {
         &self.control
-    }
-
-    /// Changes an input by `set` at the state `x`, time `t`; returns how much `∫Ė` must move so that `Ψ` stays (see
-    /// [`Simulation::set_input`](crate::Simulation::set_input)): the jump of
-    /// `V`, or where the constraints moved (a drive's target), the change
-    /// of `T + V` as `(q, v)` are projected onto them at once.
-    pub(crate) fn change_input(&mut self, x: &mut [f64], t: f64, set: impl FnOnce()) -> Result<f64, Failure> {
-        let (model, n) = (self.model, self.model.n());
-        let (q, v, _) = split_state_mut(x, n);
-        let (before, after) = (&mut self.projection.rows, &mut self.projection.rows_2);
-        let energy = model.kinetic(q, v) + model.potential(q, None);
-        model.constraint_values(q, t, before);
-        set();
-        model.constraint_values(q, t, after);
-        if before.iter().zip(after.iter()).all(|(a, b)| a.to_bits() == b.to_bits()) {
-            return Ok(model.kinetic(q, v) + model.potential(q, None) - energy);
-        }
-        let tolerance = 256.0 * f64::EPSILON * q.iter().fold(1.0_f64, |a, q| a.max(q.abs()));
-        let (d, work) = (&mut self.dynamics, &mut self.projection);
-        crate::dynamics::manifold::positions(model, d, q, v, t, tolerance, 50, work)?;
-        crate::dynamics::manifold::velocities(model, d, v, work);
-        Ok(model.kinetic(q, v) + model.potential(q, None) - energy)
     }
 
     /// The dynamics of the latest general evaluation (of every evaluation, unless a small model runs in arrays).
@@ -327,6 +307,9 @@ impl System for ControlledSystem<'_> {
     }
     fn symmetries(&self) -> &Symmetries {
         &self.symmetries
+    }
+    fn hold_from(&mut self, x: &mut [f64]) {
+        self.hold_at(x);
     }
     fn momentum(&mut self, j: usize, x: &[f64]) -> f64 {
         let (q, v, _) = split_state(x, self.model.n());

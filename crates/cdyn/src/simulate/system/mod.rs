@@ -128,6 +128,14 @@ pub trait System: Rhs<Error = EvalError> {
     fn restart(&mut self, x: &[f64], t: f64) {
         let _ = (x, t);
     }
+    /// Holds, from the state `x` on, the energy and the momenta at their
+    /// values there: sets `x`'s `∫Ė` so that `Ψ = 0`, and the kept
+    /// momenta's targets. For a part step from an impact
+    /// ([`crate::stops`]), which changed them and must not be undone.
+    fn hold_from(&mut self, x: &mut [f64]) {
+        let _ = x;
+        unreachable!("a system without stops")
+    }
     /// The momenta the system keeps ([`crate::dynamics::momentum`]); none unless it finds them.
     fn symmetries(&self) -> &Symmetries {
         &NO_SYMMETRIES
