@@ -46,7 +46,8 @@ pub enum Load<B = usize> {
     },
     /// A rotary damper: the torque `−c ω_rel h` on `b` and its opposite on
     /// `a`, `h` the axis carried by `a`, `ω_rel` the rate of `b` relative
-    /// to `a` about it.
+    /// to `a` about it. With the ground for `b`, the torque `−c ω h` on `a`
+    /// alone, `h` fixed in space and `ω` `a`'s rate about it.
     RotaryDamper {
         /// The first body.
         a: B,
