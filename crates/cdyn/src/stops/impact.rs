@@ -20,10 +20,10 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     /// taken again from its start in parts, to the earliest crossing (the
     /// root of the cubic through `(g, ġ)` at the two ends), where the stops
     /// crossing then are hit, and on from the impact to the step's end,
-    /// where any stop closed since is found the same way. Seen at the
-    /// step's end instead, an impact came up to `h` late, from a state past
-    /// the stop by up to `|ġ| h`, and its projection moved the bodies by
-    /// that much: two formulations of one robot differed by it.
+    /// where any stop closed since is found the same way. The impact acts
+    /// at the stop, at the joint's rate there, not up to `h` late from a
+    /// state past the stop, whose projection back would move the bodies
+    /// by as much, and differently in each formulation of a mechanism.
     pub(super) fn hit_within(&mut self, hits: &[usize], step: u64, t: f64) -> Result<()> {
         let n = self.model.n();
         // What is left of the step: from `(q, v)` at `t_from`, where the
@@ -116,7 +116,6 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
     /// the segment of `model`: Newton's impact, and the stops held if
     /// plastic. `pressing` is each one's `−g̈` over the step. Returns the
     /// state after it and whether more stops are held.
-    #[allow(clippy::too_many_arguments)]
     fn impact(
         &mut self,
         model: &Model,
