@@ -13,7 +13,7 @@ fn light_bench_writes_a_complete_report() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let r: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("bench.json")).unwrap()).unwrap();
     assert_eq!(r["schema_version"].as_u64(), Some(3));
-    assert_eq!(r["realtime"]["step_times"].as_array().unwrap().len(), 5);
+    assert_eq!(r["realtime"]["step_times"].as_array().unwrap().len(), 6);
     let e = &r["example1"];
     for key in ["cdyn_ns_per_step", "general_ns_per_step", "handwritten_ns_per_step", "overhead_ratio"] {
         assert!(e[key].as_f64().unwrap() > 0.0, "{key}");
@@ -124,9 +124,11 @@ fn light_bench_compares_robust_projection_and_rattle_with_cvsgf_energy() {
 
 /// `cdyn bench --realtime --light`: every step timed on its own, by the
 /// wall clock and the thread's CPU clock, for an empty step, the chain at
-/// N = 10, 100, 1000 and the flyball, a co-simulation step beside a bare
-/// one; no step allocates, co-simulation's included (a changed input
-/// restarts the scheme without allocating). Timings are not asserted.
+/// N = 10, 100, 1000, the flyball and a rod falling onto a joint limit, a
+/// co-simulation step beside a bare one; no step allocates, co-simulation's
+/// included (a changed input restarts the scheme without allocating), but
+/// for the impact's, which builds the model holding the stop. Timings are
+/// not asserted.
 #[test]
 fn light_realtime_bench_times_every_step_and_allocates_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -145,15 +147,19 @@ fn light_realtime_bench_times_every_step_and_allocates_nothing() {
         cases[1].starts_with("chain N = 10,")
             && cases[3].starts_with("chain N = 1000,")
             && cases[4].starts_with("flyball")
+            && cases[5].starts_with("limited pendulum")
     );
-    for t in runs {
+    for (k, t) in runs.into_iter().enumerate() {
+        // The limited rod's run goes on past its impact, at step 336.
+        let steps = if k == 5 { 1000 } else { 200 };
         for clock in ["wall", "cpu"] {
             let p = |key: &str| t[clock][key].as_f64().unwrap();
             assert!(0.0 <= p("median_us") && p("median_us") <= p("p999_us") && p("p999_us") <= p("max_us"), "{t}");
-            assert!(t[clock]["slowest_step"].as_u64().unwrap() < 200, "{t}");
+            assert!(t[clock]["slowest_step"].as_u64().unwrap() < steps, "{t}");
         }
-        assert_eq!(t["allocations"].as_u64(), Some(0), "{t}");
-        assert_eq!(t["steps"].as_u64(), Some(200));
+        let allocations = t["allocations"].as_u64().unwrap();
+        assert!(if k == 5 { allocations > 0 } else { allocations == 0 }, "{t}");
+        assert_eq!(t["steps"].as_u64(), Some(steps));
     }
     assert!(r["cosimulation_ratio"].as_f64().unwrap() > 0.0);
 }

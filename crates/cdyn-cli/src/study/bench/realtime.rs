@@ -102,7 +102,8 @@ pub fn per_step(case: String, steps: usize, mut step: impl FnMut() -> Result<()>
 pub struct Realtime {
     /// A `--light` run: few steps, figures that mean little.
     pub light: bool,
-    /// Each step timed on its own: an empty step, the chain by N and the flyball.
+    /// Each step timed on its own: an empty step, the chain by N, the
+    /// flyball and a rod falling onto a joint limit.
     pub step_times: Vec<StepTimes>,
     /// A bare step of the pendulum, then a co-simulation step of it.
     pub cosimulation: [StepTimes; 2],
@@ -128,6 +129,12 @@ pub fn run_realtime(light: bool) -> Result<Realtime> {
     let mut sim = Simulation::new(&ex.model, case.settings, &ex.q0, &ex.v0)?;
     let name = format!("flyball governor, {}, h = {}", case.settings.scheme.info().name, case.settings.h);
     runs.push(per_step(name, steps, || Ok(sim.step()?))?);
+    // A joint limit's impact, located within its step: a rod falls onto
+    // its stop at step 336 and is held there; that step is the slowest.
+    let limited = root.join("limited_pendulum.toml");
+    let mut live = Live::from_scenario(&scenario::load(&limited)?, &limited)?;
+    let name = "limited pendulum onto its stop at step 336, rk4, h = 0.001 (the impact's step the max)";
+    runs.push(per_step(name.into(), steps.max(1000), || Ok(live.step(1)?))?);
     // Co-simulation against bare steps, on the same case.
     let pendulum = root.join("pd_pendulum.toml");
     let parsed = scenario::load(&pendulum)?;
