@@ -49,7 +49,7 @@ pub struct StopSimulation<S: Deref<Target: Unilateral>> {
     /// reading on its way to `before`.
     pub(super) after: Vec<[f64; 2]>,
     /// The stops the step just taken closed.
-    pub(super) hits: Vec<usize>,
+    hits: Vec<usize>,
     /// `(q, v, ∫Ė)` at the start of the step being taken: where a step
     /// that closed a stop steps again from, to the crossing.
     pub(super) start: Vec<f64>,
