@@ -63,8 +63,8 @@ impl<'m> Simulation<'m> {
         self.system.add_evaluations(previous.evaluations());
     }
 
-    /// Counts `n` evaluations made for this run elsewhere (the part steps
-    /// of [`crate::stops`] to an impact).
+    /// Counts `n` evaluations made for this run by copies of it (the part
+    /// steps of [`crate::stops`] to an impact).
     pub(crate) fn count_evaluations(&mut self, n: u64) {
         self.system.add_evaluations(n);
     }

@@ -108,7 +108,8 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
             let settings = Settings { consistency_tolerance: None, ..self.settings };
             part(&Simulation::new(model, settings, &q, &v)?)?
         };
-        self.part_evaluations += evaluations;
+        // Counted by the run's simulation, which the next segment continues.
+        self.sim.count_evaluations(evaluations);
         Ok((q, v))
     }
 

@@ -53,8 +53,6 @@ pub struct StopSimulation<S: Deref<Target: Unilateral>> {
     /// `(q, v, ∫Ė)` at the start of the step being taken: where a step
     /// that closed a stop steps again from, to the crossing.
     pub(super) start: Vec<f64>,
-    /// Evaluations of the part steps to impacts, for the run's count.
-    pub(super) part_evaluations: u64,
     /// Evaluates the multipliers of the held stops' rows.
     pub(super) dynamics: Dynamics,
     pub(super) report: Report,
@@ -76,21 +74,7 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         report.overspeed.reserve_exact(system.speed_bounds());
         let (held, implied) = (Vec::with_capacity(before.len()), Vec::with_capacity(before.len()));
         let start = [q0, v0, &[0.0]].concat();
-        Ok(Self {
-            sim,
-            model,
-            system,
-            settings,
-            held,
-            implied,
-            before,
-            after,
-            hits,
-            start,
-            part_evaluations: 0,
-            dynamics,
-            report,
-        })
+        Ok(Self { sim, model, system, settings, held, implied, before, after, hits, start, dynamics, report })
     }
 
     /// One step of size `h`, then the stops: where it closed some, it is
@@ -175,7 +159,6 @@ impl<S: Deref<Target: Unilateral>> StopSimulation<S> {
         let settings = Settings { consistency_tolerance: None, ..self.settings };
         let mut sim = start(&model, settings, q, v)?;
         sim.continue_from(&self.sim);
-        sim.count_evaluations(std::mem::take(&mut self.part_evaluations));
         // The old simulation goes first, then the model it borrowed.
         self.sim = sim;
         if held_changed {
