@@ -248,14 +248,14 @@ def run_beside_pinocchio(robot, t_end, joints, coordinates):
 # outside its range (−3.07 to −0.07 rad), so it starts at −1.5 there, its
 # fingers resting at their lower bound 0 (with nothing along them: held
 # by no stop, they stay there as Pinocchio's free ones do).
-@pytest.mark.parametrize(
-    "relative, t_end, joints",
-    [
-        (UR5, 1.0, {}),
-        (SO100, 0.05, {"shoulder_lift": 1.0, "elbow_flex": -1.0}),
-        (PANDA, 0.05, {"panda_joint4": -1.5}),
-    ],
-)
+TRAJECTORIES = [
+    (UR5, 1.0, {}),
+    (SO100, 0.05, {"shoulder_lift": 1.0, "elbow_flex": -1.0}),
+    (PANDA, 0.05, {"panda_joint4": -1.5}),
+]
+
+
+@pytest.mark.parametrize("relative, t_end, joints", TRAJECTORIES)
 def test_joint_trajectories_agree_with_pinocchio(relative, t_end, joints):
     robot = Robot(relative)
     result, reference = run_beside_pinocchio(robot, t_end, joints, "bodies")
@@ -271,14 +271,7 @@ def test_joint_trajectories_agree_with_pinocchio(relative, t_end, joints):
     assert worst[0] < 1e-8 and worst[1] < 1e-8, worst
 
 
-@pytest.mark.parametrize(
-    "relative, t_end, joints",
-    [
-        (UR5, 1.0, {}),
-        (SO100, 0.05, {"shoulder_lift": 1.0, "elbow_flex": -1.0}),
-        (PANDA, 0.05, {"panda_joint4": -1.5}),
-    ],
-)
+@pytest.mark.parametrize("relative, t_end, joints", TRAJECTORIES)
 def test_joint_coordinate_runs_follow_pinocchio_to_round_off(relative, t_end, joints):
     """`coordinates = "joints"`: the same RK-4 in the same coordinates as
     Pinocchio's, so the runs agree to round-off, not to truncation error."""
